@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs every build and test dependency from Debian 12 packages. Idempotent: it installs only
+# what is missing, and does nothing (quickly) when all is present. Needs root (or sudo).
+set -euo pipefail
+PACKAGES=(
+  build-essential cmake ninja-build git pkg-config
+  libembree-dev libtbb-dev libcgal-dev libopenmesh-dev libtinygltf-dev libmeshoptimizer-dev
+  libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev nlohmann-json3-dev libfmt-dev libstb-dev
+  python3 python3-matplotlib python3-numpy
+  clang libclang-rt-14-dev
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

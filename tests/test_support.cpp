@@ -1,0 +1,45 @@
+#include "tests/test_support.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+namespace vislib_test {
+
+std::string source_dir() { return VISLIB_SOURCE_DIR; }
+
+std::optional<std::string> shared_dir() {
+  const char* env = std::getenv("VISLIB_SHARED_DIR");
+  std::string dir = env ? env : source_dir() + "/../shared";
+  std::error_code ec;
+  if (std::filesystem::is_directory(dir + "/scenes", ec)) return dir;
+  return std::nullopt;
+}
+
+int run_pvs(const std::string& args, std::string* output) {
+  std::string cmd = std::string(VISLIB_PVS_EXE) + " " + args + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return -1;
+  std::array<char, 4096> buf;
+  std::string out;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) out.append(buf.data(), n);
+  int status = pclose(pipe);
+  if (output) *output = out;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string temp_dir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("vislib_test_" + name + "_" +
+                                                        std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
+}
+
+}  // namespace vislib_test

@@ -1,0 +1,25 @@
+// test_support.h: helpers shared by the tests (paths to data and ../shared, running `pvs`).
+#pragma once
+
+#include <optional>
+#include <string>
+
+namespace vislib_test {
+
+// Repository root (compiled in).
+std::string source_dir();
+// ../shared beside the repository, or std::nullopt when absent (tests that need it then call
+// GTEST_SKIP with a message).
+std::optional<std::string> shared_dir();
+// Runs the built `pvs` with `args` (a shell-quoted string); returns the exit code and captures
+// stdout+stderr into `output`.
+int run_pvs(const std::string& args, std::string* output = nullptr);
+// A fresh empty temporary directory for one test.
+std::string temp_dir(const std::string& name);
+
+}  // namespace vislib_test
+
+#define VISLIB_REQUIRE_SHARED(var)                                        \
+  auto var##_opt = vislib_test::shared_dir();                             \
+  if (!var##_opt) GTEST_SKIP() << "../shared is absent: skipping test"; \
+  const std::string var = *var##_opt
