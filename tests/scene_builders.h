@@ -1,0 +1,65 @@
+// scene_builders.h: tiny scenes for semantic tests, built in code.
+#pragma once
+
+#include <vector>
+
+#include "vislib/random.h"
+#include "vislib/scene.h"
+
+namespace vislib_test {
+
+// A scene of independent triangles (a soup), one object per triangle.
+inline vislib::Scene soup(const std::vector<std::array<vislib::Vec3, 3>>& tris) {
+  vislib::Scene s;
+  s.positions.resize(1);
+  for (const auto& t : tris) {
+    uint32_t b = uint32_t(s.positions[0].size());
+    for (const auto& p : t) s.positions[0].push_back(p);
+    s.triangles.push_back({b, b + 1, b + 2});
+    s.triangle_object.push_back(uint32_t(s.objects.size()));
+    s.objects.push_back({"t" + std::to_string(s.objects.size())});
+  }
+  return s;
+}
+
+// Appends an indexed quad (two triangles) a b c d (counter-clockwise) to `s` as one object.
+inline void add_quad(vislib::Scene& s, vislib::Vec3 a, vislib::Vec3 b, vislib::Vec3 c, vislib::Vec3 d) {
+  if (s.positions.empty()) s.positions.resize(1);
+  uint32_t base = uint32_t(s.positions[0].size());
+  for (auto p : {a, b, c, d}) s.positions[0].push_back(p);
+  uint32_t obj = uint32_t(s.objects.size());
+  s.objects.push_back({"quad" + std::to_string(obj)});
+  s.triangles.push_back({base, base + 1, base + 2});
+  s.triangles.push_back({base, base + 2, base + 3});
+  s.triangle_object.push_back(obj);
+  s.triangle_object.push_back(obj);
+}
+
+// An indexed n x n grid over [x0,x1] x [y0,y1] at depth z(x,y) with jittered interior vertices
+// (shared vertices: a closed surface without cracks).
+template <class ZFn>
+void add_grid(vislib::Scene& s, int n, double x0, double x1, double y0, double y1, ZFn z,
+              uint64_t seed, double jitter) {
+  if (s.positions.empty()) s.positions.resize(1);
+  vislib::Rng rng(seed);
+  uint32_t base = uint32_t(s.positions[0].size());
+  uint32_t obj = uint32_t(s.objects.size());
+  s.objects.push_back({"grid" + std::to_string(obj)});
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      double x = x0 + (x1 - x0) * i / n, y = y0 + (y1 - y0) * j / n;
+      if (i > 0 && i < n) x += jitter * (rng.uniform() - 0.5) * (x1 - x0) / n;
+      if (j > 0 && j < n) y += jitter * (rng.uniform() - 0.5) * (y1 - y0) / n;
+      s.positions[0].push_back({x, y, z(x, y)});
+    }
+  auto at = [&](int i, int j) { return base + uint32_t(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      s.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      s.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+      s.triangle_object.push_back(obj);
+      s.triangle_object.push_back(obj);
+    }
+}
+
+}  // namespace vislib_test

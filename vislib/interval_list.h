@@ -1,0 +1,49 @@
+// interval_list.h: per-pixel depth compositing of coverage intervals (math note §7; the paper's
+// DepthComposite, Alg. 1 line 9, with the corrections of the note).
+//
+// A pixel's list is a sorted vector of disjoint pieces [t0, t1) of the segment parameter, each
+// holding the id of the front-most triangle there and that triangle's depth function. Inserting a
+// triangle's coverage interval keeps the lower envelope: closer intervals split farther ones,
+// interpenetrating triangles split at the exact depth crossing, depth ties go to the lower id.
+// The resulting list depends only on the set of inserted intervals, never on their order.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace vislib {
+
+// Depth along the pixel ray (view-space depth lambda, scene units) as a function of t.
+// Static triangles: lambda(t) = l0 + l1 * t exactly (math note §2.4).
+struct LinearDepth {
+  double l0 = 0, l1 = 0;
+  double at(double t) const { return l0 + l1 * t; }
+};
+
+struct Piece {
+  double t0 = 0, t1 = 0;  // 0 <= t0 < t1 <= 1
+  uint32_t id = 0;        // triangle id
+  LinearDepth depth;
+};
+
+using PieceList = std::vector<Piece>;
+
+// Inserts the coverage interval `p` (p.t0 < p.t1) into `list` (sorted, disjoint, merged).
+// Not thread-safe for the same list; lists are per pixel.
+void insert_piece(PieceList& list, const Piece& p);
+
+// The piece covering t (t0 <= t < t1), if any.
+std::optional<Piece> lookup(const PieceList& list, double t);
+
+// True when the pieces cover [0, 1] without gap.
+bool covers_segment(const PieceList& list);
+
+// Largest depth over all pieces (at their ends); -inf for an empty list.
+double farthest_depth(const PieceList& list);
+
+// Checks the invariants of §7 (sorted, disjoint, 0 <= t0 < t1 <= 1, touching same-id pieces
+// merged). For tests and debug builds.
+bool is_valid(const PieceList& list);
+
+}  // namespace vislib

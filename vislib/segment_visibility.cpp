@@ -1,0 +1,316 @@
+// segment_visibility.cpp: from-segment visibility for static triangles.
+// Paper: "Complex VEs on All-In-One VR Headsets Through Continuous From-Segment Visibility
+// Computation", §3.1, Alg. 1. Math: shared/design/visibility-math.md §1, §2, §5.1, §6, §7.
+//
+// Structure (per cube face): (1) every triangle's footprint bounding box and nearest possible
+// depth; (2) counting-sort binning into tiles of tile_size^2 pixels; (3) tiles in parallel: the
+// tile's triangles front to back, coverage interval per pixel of the footprint's row spans,
+// lower-envelope insertion; triangles whose nearest depth lies behind everything in a fully
+// covered tile are skipped (exact: they cannot be first anywhere there); (4) per-tile results
+// reduced in tile order, so nothing depends on scheduling.
+#include "vislib/segment_visibility.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+
+#include "vislib/footprint.h"
+
+namespace vislib {
+
+StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1) {
+  StaticTriangle st;
+  const Vec3 delta = v1 - v0;
+  Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (math note §6)
+  for (int e = 0; e < 3; ++e) {
+    int i = e, j = (e + 1) % 3;
+    // Canonical orientation: P is the lexicographically smaller world endpoint (§2.5).
+    bool forward = !lex_less(c[j], c[i]);
+    const Vec3& P = forward ? r[i] : r[j];
+    const Vec3& Q = forward ? r[j] : r[i];
+    Vec3 E = Q - P;
+    st.KA[e] = cross(E, delta);
+    st.KB[e] = cross(E, -P);
+    st.rho[e] = forward ? 1.0 : -1.0;
+  }
+  st.n = cross(r[1] - r[0], r[2] - r[0]);
+  st.N0 = dot(st.n, r[0]);
+  st.N1 = dot(st.n, delta);
+  return st;
+}
+
+namespace {
+
+// Keeps t with A t + B > 0 inside [lo, hi]; false when nothing is left.
+inline bool halfline(double A, double B, double& lo, double& hi) {
+  if (A > 0) {
+    lo = std::max(lo, -B / A);
+  } else if (A < 0) {
+    hi = std::min(hi, -B / A);
+  } else if (!(B > 0)) {
+    return false;
+  }
+  return lo < hi;
+}
+
+}  // namespace
+
+bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double near, double& lo,
+                     double& hi, LinearDepth& depth) {
+  const double Dn = dot(d, tri.n);
+  if (Dn == 0) return false;  // ray parallel to the plane, or degenerate triangle (§2.2)
+  const double sigma = Dn > 0 ? 1.0 : -1.0;
+  lo = 0;
+  hi = 1;
+  for (int e = 0; e < 3; ++e) {
+    double A = dot(d, tri.KA[e]), B = dot(d, tri.KB[e]);
+    if (A == 0 && B == 0) {  // persistent on-edge tie: perturb d -> d + eps S + eps^2 T (§2.5)
+      A = dot(S, tri.KA[e]);
+      B = dot(S, tri.KB[e]);
+      if (A == 0 && B == 0) {
+        A = dot(T, tri.KA[e]);
+        B = dot(T, tri.KB[e]);
+      }
+    }
+    double f = sigma * tri.rho[e];
+    if (!halfline(f * A, f * B, lo, hi)) return false;
+  }
+  // In front of the near plane: lambda(t) > near  <=>  sigma (N0 - near Dn - N1 t) > 0.
+  if (!halfline(-sigma * tri.N1, sigma * (tri.N0 - near * Dn), lo, hi)) return false;
+  depth.l0 = tri.N0 / Dn;
+  depth.l1 = -tri.N1 / Dn;
+  return true;
+}
+
+namespace {
+
+struct TileResult {
+  std::vector<uint32_t> visible;   // sorted unique
+  std::vector<Witness> witnesses;  // per id in `visible` if wanted, with piece length in t
+  std::vector<double> witness_len;
+  SegmentStats stats;
+};
+
+// Witness order: longer piece first, then lower face, row, column.
+bool better_witness(double len_a, const Witness& a, double len_b, const Witness& b) {
+  if (len_a != len_b) return len_a > len_b;
+  if (a.face != b.face) return a.face < b.face;
+  if (a.y != b.y) return a.y < b.y;
+  return a.x < b.x;
+}
+
+struct FaceTriangle {
+  uint32_t id;
+  float zmin;  // nearest possible view depth over the segment (rounded down)
+};
+
+}  // namespace
+
+SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
+  assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
+  auto start = std::chrono::steady_clock::now();
+  const int N = opt.resolution;
+  const int TS = opt.tile_size;
+  const int tiles_x = (N + TS - 1) / TS;
+  const int tile_count = tiles_x * tiles_x;
+  const size_t ntri = scene.triangle_count();
+  const Vec3 delta = v1 - v0;
+
+  SegmentResult result;
+  if (opt.want_pieces) result.pieces.resize(size_t(6) * N * N);
+  std::vector<TileResult> tile_results(size_t(6) * tile_count);
+
+  // Scratch per thread: the pixel lists of one tile (capacity kept between tiles).
+  tbb::enumerable_thread_specific<std::vector<PieceList>> scratch(
+      [TS] { return std::vector<PieceList>(size_t(TS) * TS); });
+
+  std::vector<int> bbox(ntri * 4);
+  std::vector<float> zmin(ntri);
+  std::vector<uint32_t> bin_start(tile_count + 1);
+  std::vector<FaceTriangle> bins;
+
+  for (int face = 0; face < 6; ++face) {
+    const FaceAxes axes = face_axes(face, opt.orientation);
+    // (1) footprint bounds and nearest depth of every triangle on this face.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t t = r.begin(); t != r.end(); ++t) {
+        auto c = scene.corners(uint32_t(t), opt.state);
+        Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
+        int* b = &bbox[t * 4];
+        Footprint fp = compute_footprint(rel, 6, axes, opt.near);
+        if (!footprint_pixel_bounds(fp, N, b[0], b[1], b[2], b[3])) {
+          b[0] = 1;
+          b[1] = 0;  // empty
+          continue;
+        }
+        double z = INFINITY;
+        for (const Vec3& q : rel) z = std::min(z, dot(axes.F, q));
+        float zf = float(z);
+        if (double(zf) > z) zf = std::nextafter(zf, -INFINITY);
+        zmin[t] = zf;
+      }
+    });
+    // (2) bin by tile (counting sort, in id order).
+    std::fill(bin_start.begin(), bin_start.end(), 0);
+    for (size_t t = 0; t < ntri; ++t) {
+      const int* b = &bbox[t * 4];
+      if (b[0] > b[1]) continue;
+      for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
+        for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx) ++bin_start[ty * tiles_x + tx + 1];
+    }
+    for (int i = 0; i < tile_count; ++i) bin_start[i + 1] += bin_start[i];
+    bins.resize(bin_start[tile_count]);
+    {
+      std::vector<uint32_t> fill(bin_start.begin(), bin_start.end() - 1);
+      for (size_t t = 0; t < ntri; ++t) {
+        const int* b = &bbox[t * 4];
+        if (b[0] > b[1]) continue;
+        for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
+          for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx)
+            bins[fill[ty * tiles_x + tx]++] = {uint32_t(t), zmin[t]};
+      }
+    }
+
+    // (3) tiles in parallel.
+    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
+      auto& lists = scratch.local();
+      for (int tile = r.begin(); tile != r.end(); ++tile) {
+        TileResult& out = tile_results[size_t(face) * tile_count + tile];
+        const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
+        const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
+        const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
+        for (auto& l : lists) l.clear();
+        FaceTriangle* tb = bins.data() + bin_start[tile];
+        FaceTriangle* te = bins.data() + bin_start[tile + 1];
+        // Front to back (nearest possible depth), ties by id: the order only affects speed.
+        std::sort(tb, te, [](const FaceTriangle& a, const FaceTriangle& b) {
+          return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
+        });
+        out.stats.triangle_tiles += uint64_t(te - tb);
+        double tile_far = INFINITY;  // farthest depth in the tile once every pixel is covered
+        int since_check = 0;
+        for (FaceTriangle* ft = tb; ft != te; ++ft) {
+          if (opt.depth_culling) {
+            if (++since_check >= 32 || ft == tb) {
+              since_check = 0;
+              bool full = true;
+              double far = -INFINITY;
+              for (int k = 0; k < tw * th && full; ++k) {
+                const PieceList& l = lists[size_t(k / tw) * TS + k % tw];
+                full = covers_segment(l);
+                far = std::max(far, farthest_depth(l));
+              }
+              tile_far = full ? far : INFINITY;
+            }
+            if (double(ft->zmin) > tile_far) {  // sorted: every later triangle is farther too
+              out.stats.culled_triangle_tiles += uint64_t(te - ft);
+              break;
+            }
+          }
+          auto c = scene.corners(ft->id, opt.state);
+          Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
+          Footprint fp = compute_footprint(rel, 6, axes, opt.near);
+          Vec3 corners[3] = {c[0], c[1], c[2]};
+          StaticTriangle st = prepare_static_triangle(corners, v0, v1);
+          if (st.n == Vec3{0, 0, 0}) continue;  // degenerate: never covers (H5)
+          int y0 = std::max(ty0, bbox[size_t(ft->id) * 4 + 2]);
+          int y1 = std::min(ty1, bbox[size_t(ft->id) * 4 + 3]);
+          for (int y = y0; y <= y1; ++y) {
+            int x0, x1;
+            if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+            x0 = std::max(x0, tx0);
+            x1 = std::min(x1, tx1);
+            for (int x = x0; x <= x1; ++x) {
+              ++out.stats.pair_tests;
+              Vec3 d = pixel_direction(axes, x, y, N);
+              double lo, hi;
+              LinearDepth depth;
+              if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
+              ++out.stats.covered_pairs;
+              insert_piece(lists[size_t(y - ty0) * TS + (x - tx0)], Piece{lo, hi, ft->id, depth});
+            }
+          }
+        }
+        (void)delta;
+        // (4) tile results.
+        size_t bytes = 0;
+        std::vector<std::pair<uint32_t, Witness>> found;
+        std::vector<double> found_len;
+        for (int y = ty0; y <= ty1; ++y)
+          for (int x = tx0; x <= tx1; ++x) {
+            PieceList& l = lists[size_t(y - ty0) * TS + (x - tx0)];
+            bytes += l.capacity() * sizeof(Piece);
+            if (l.empty()) continue;
+            ++out.stats.pixels_with_pieces;
+            out.stats.final_pieces += l.size();
+            out.stats.max_pieces_per_pixel = std::max<uint64_t>(out.stats.max_pieces_per_pixel, l.size());
+            for (const Piece& p : l) {
+              double len = p.t1 - p.t0;
+              if (!(len > opt.eps_len)) continue;
+              found.push_back({p.id, Witness{p.id, face, x, y, 0.5 * (p.t0 + p.t1)}});
+              found_len.push_back(len);
+            }
+            if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
+          }
+        out.stats.peak_tile_bytes = double(bytes);
+        // Best witness per id within the tile.
+        std::vector<size_t> order(found.size());
+        for (size_t k = 0; k < order.size(); ++k) order[k] = k;
+        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+          if (found[a].first != found[b].first) return found[a].first < found[b].first;
+          return better_witness(found_len[a], found[a].second, found_len[b], found[b].second);
+        });
+        for (size_t k : order) {
+          if (!out.visible.empty() && out.visible.back() == found[k].first) continue;
+          out.visible.push_back(found[k].first);
+          if (opt.want_witnesses) {
+            out.witnesses.push_back(found[k].second);
+            out.witness_len.push_back(found_len[k]);
+          }
+        }
+      }
+    });
+  }
+
+  // (4) reduce in tile order: the union of ids, the best witness per id.
+  std::vector<uint32_t> all;
+  for (const TileResult& tr : tile_results) {
+    all.insert(all.end(), tr.visible.begin(), tr.visible.end());
+    SegmentStats& s = result.stats;
+    s.pair_tests += tr.stats.pair_tests;
+    s.covered_pairs += tr.stats.covered_pairs;
+    s.final_pieces += tr.stats.final_pieces;
+    s.pixels_with_pieces += tr.stats.pixels_with_pieces;
+    s.max_pieces_per_pixel = std::max(s.max_pieces_per_pixel, tr.stats.max_pieces_per_pixel);
+    s.triangle_tiles += tr.stats.triangle_tiles;
+    s.culled_triangle_tiles += tr.stats.culled_triangle_tiles;
+    s.peak_tile_bytes = std::max(s.peak_tile_bytes, tr.stats.peak_tile_bytes);
+  }
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  result.visible = std::move(all);
+  if (opt.want_witnesses) {
+    std::vector<int64_t> slot(ntri, -1);
+    for (size_t k = 0; k < result.visible.size(); ++k) slot[result.visible[k]] = int64_t(k);
+    result.witnesses.resize(result.visible.size());
+    std::vector<double> best(result.visible.size(), -1.0);
+    for (const TileResult& tr : tile_results)
+      for (size_t k = 0; k < tr.witnesses.size(); ++k) {
+        int64_t s = slot[tr.witnesses[k].tri];
+        if (best[s] < 0 || better_witness(tr.witness_len[k], tr.witnesses[k], best[s], result.witnesses[s])) {
+          best[s] = tr.witness_len[k];
+          result.witnesses[s] = tr.witnesses[k];
+        }
+      }
+  }
+  result.stats.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+}  // namespace vislib

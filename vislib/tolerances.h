@@ -1,0 +1,20 @@
+// tolerances.h: every tolerance of the visibility kernels, named, with its unit and the direction
+// in which it errs (house style §5). Predicates themselves compare with 0 exactly (math note §6).
+#pragma once
+
+namespace vislib {
+
+// Final pieces of a pixel's list shorter than this (in segment parameter t, unitless in [0,1]) do
+// not make their triangle visible. Removes T-junction leaks of ~1e-16 (math note §2.5, §7).
+// Errs towards hidden for pieces that short; 0 = exact mode.
+constexpr double kDefaultEpsLen = 1e-12;
+
+// Margin added around a footprint in face coordinates (u, w) in [-1,1] (one pixel = 2/N). Errs
+// towards scanning more pixels (safe: coverage is decided exactly afterwards).
+constexpr double kFootprintMargin = 1e-6;
+
+// Default near plane: view-space depth (scene units, metres for our scenes) below which hits do
+// not count; a typical headset near plane.
+constexpr double kDefaultNear = 0.01;
+
+}  // namespace vislib
