@@ -71,7 +71,7 @@ TEST(SegmentHardCases, H2_PersistentOnEdgeTieGivesExactlyOneTriangleAtEveryPixel
     EXPECT_EQ(w.lo, 0.0);
     EXPECT_EQ(w.hi, 1.0);
     (a.covered ? winners_t1 : winners_t2)++;
-    EXPECT_TRUE(std::isfinite(w.depth.l0) && std::isfinite(w.depth.l1));
+    EXPECT_TRUE(std::isfinite(w.depth.at(0)) && std::isfinite(w.depth.at(1)));
   }
   // With the binding table, T = (0,-1,0) on +Z: the perturbation d + eps S + eps^2 T tilts the
   // ray towards -y, so T2 (the lower triangle) wins. (The math note's first-draft table has +y

@@ -13,9 +13,11 @@ namespace {
 bool crossing(const Piece& a, const Piece& b, double lo, double hi, double& t) {
   const Piece& i = a.id < b.id ? a : b;
   const Piece& j = a.id < b.id ? b : a;
-  double den = i.depth.l1 - j.depth.l1;
+  // lambda_i - lambda_j has the sign of P(t) D_i D_j with P = N_i D_j - N_j D_i, linear here.
+  const LinearDepth &di = i.depth, &dj = j.depth;
+  double den = di.n1 * dj.dn - dj.n1 * di.dn;
   if (den == 0) return false;
-  t = (j.depth.l0 - i.depth.l0) / den;
+  t = (di.n0 * dj.dn - dj.n0 * di.dn) / den;
   return t > lo && t < hi;
 }
 

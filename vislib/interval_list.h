@@ -15,10 +15,12 @@
 namespace vislib {
 
 // Depth along the pixel ray (view-space depth lambda, scene units) as a function of t.
-// Static triangles: lambda(t) = l0 + l1 * t exactly (math note §2.4).
+// Static triangles: lambda(t) = (n0 - n1 t) / dn, linear in t (math note §2.4, (I3)), with
+// n0 = n.(a - v0), n1 = n.Delta, dn = d.n. Kept as the three numbers (not a slope and offset) so
+// that depth crossings come from exact-as-possible products (§3.4: P = N_i D_j - N_j D_i).
 struct LinearDepth {
-  double l0 = 0, l1 = 0;
-  double at(double t) const { return l0 + l1 * t; }
+  double n0 = 0, n1 = 0, dn = 1;
+  double at(double t) const { return (n0 - n1 * t) / dn; }
 };
 
 struct Piece {

@@ -82,8 +82,7 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
   }
   // In front of the near plane: lambda(t) > near  <=>  sigma (N0 - near Dn - N1 t) > 0.
   if (!halfline(-sigma * tri.N1, sigma * (tri.N0 - near * Dn), lo, hi)) return false;
-  depth.l0 = tri.N0 / Dn;
-  depth.l1 = -tri.N1 / Dn;
+  depth = LinearDepth{tri.N0, tri.N1, Dn};
   return true;
 }
 

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# README Quick start (b): install what is missing, build, run the whole test suite with ctest.
+# Tests that need ../shared (real scenes by other people) skip cleanly when it is absent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+BUILD_DIR=${BUILD_DIR:-build} bash scripts/build.sh "$@"
+cd "${BUILD_DIR:-build}"
+ctest --output-on-failure -j "$(nproc)" --timeout 1500
