@@ -142,6 +142,31 @@ TEST(PointVisibility, SameCubemapWithOneAndTwoThreads) {
   EXPECT_EQ(cube[0], cube[1]);
 }
 
+TEST(PointVisibility, CubemapEqualsSingleRayCasts) {
+  // point_cubemap uses Embree's coherent ray stream; the oracle uses single rays.
+  const Scene scene = random_soup(3000, 12, 10.0, 2.0);
+  const Vec3 eye{0.3, -0.2, 0.1};
+  const EmbreeScene es(scene, 0.0, Vec3{1, 1, 1});
+  const int n = 64;
+  size_t hits = 0;
+  for (uint64_t seed = 0; seed < 3; ++seed) {
+    const Mat3 R = random_orientation(seed);
+    const auto cube = point_cubemap(es, eye, R, n, 0.05);
+    const RayOracle oracle(es, eye, eye, R, n, 0.05);
+    for (int f = 0; f < kCubeFaces; ++f)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const uint32_t single = oracle.first_hit(f, x, y, 0.0).tri;
+          // Stream and single-ray kernels may differ only on marginal (ambiguous) rays.
+          if (cube[pixel(f, x, y, n)] != single) {
+            EXPECT_TRUE(oracle.is_ambiguous(f, x, y, 0.0)) << f << " " << x << " " << y;
+          }
+          hits += single != kNoHit;
+        }
+  }
+  EXPECT_GT(hits, 0u);
+}
+
 TEST(PointVisibility, BigCoordinatesStillHitCentimetreTriangle) {
   const Vec3 eye{1e5 + 0.123, -1e5 + 0.456, 1e5 + 0.789};
   const int n = 64, x = 20, y = 40;

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cassert>
 #include <mutex>
+#include <vector>
 #include <stdexcept>
 
 namespace vislib {
@@ -164,12 +165,12 @@ void EmbreeScene::first_hits(Vec3 eye_world, const Vec3* dirs, size_t count, dou
                              Hit* out) const {
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
+  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   const Vec3 org = eye_world - impl_->origin;
-  for (size_t i = 0; i < count; ++i) {
-    RTCRayHit rh = make_ray(org, dirs[i], tnear);
-    rtcIntersect1(impl_->scene, &ctx, &rh);
-    out[i] = to_hit(rh);
-  }
+  std::vector<RTCRayHit> rays(count);
+  for (size_t i = 0; i < count; ++i) rays[i] = make_ray(org, dirs[i], tnear);
+  rtcIntersect1M(impl_->scene, &ctx, rays.data(), unsigned(count), sizeof(RTCRayHit));
+  for (size_t i = 0; i < count; ++i) out[i] = to_hit(rays[i]);
   impl_->check();
 }
 

@@ -61,9 +61,13 @@ class EmbreeScene {
   // the next-nearest other surface along the ray. Thread-safe.
   Hit first_hit_excluding(Vec3 eye_world, Vec3 dir, double tnear, uint32_t exclude_tri) const;
 
-  // Batch form of first_hit for `count` rays from one eye (e.g. one cubemap row): out[i] is
-  // exactly first_hit(eye_world, dirs[i], tnear) (same single-ray kernel, so batch and single
-  // queries never disagree). `dirs` and `out` must hold `count` elements. Thread-safe.
+  // Batch form of first_hit for `count` rays from one eye (e.g. one cubemap row), through Embree's
+  // coherent ray stream (rtcIntersect1M; about 4x faster than single rays on a cubemap row).
+  // out[i] equals first_hit(eye_world, dirs[i], tnear) except on numerically marginal rays: the
+  // stream's packet kernels may pick the other triangle when the ray passes through a shared
+  // edge (measured: 2 of 3.1M rays on a 270k-triangle box city, both flagged by
+  // RayOracle::is_ambiguous). `dirs` and `out` must hold `count` elements. Thread-safe;
+  // deterministic (the result does not depend on which thread runs the call).
   void first_hits(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear, Hit* out) const;
 
  private:

@@ -17,8 +17,9 @@ namespace vislib {
 
 // The first-hit cubemap seen from `eye` with orientation R: 6*n*n triangle ids, index
 // (face*n + y)*n + x, exactly the convention of cubemap.h (pixel_direction of face_axes(face, R)),
-// kNoHit where no triangle is hit at lambda > z_near. Pixel i equals
-// scene.first_hit(eye, pixel_direction(...), z_near).tri.
+// kNoHit where no triangle is hit at lambda > z_near. Rows go through EmbreeScene::first_hits,
+// so a pixel equals scene.first_hit(eye, pixel_direction(...), z_near).tri except on rays through
+// a shared edge (see first_hits).
 // `n` must be >= 1, `z_near` >= 0, R a rotation. TBB-parallel over rows; each pixel is written by
 // exactly one task, so the result is identical whatever the thread count.
 std::vector<uint32_t> point_cubemap(const EmbreeScene& scene, Vec3 eye, const Mat3& R, int n,
