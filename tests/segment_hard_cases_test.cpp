@@ -9,6 +9,7 @@
 #include "tests/scene_builders.h"
 #include "vislib/footprint.h"
 #include "vislib/polynomial.h"
+#include "vislib/ray_oracle.h"
 #include "vislib/segment_visibility.h"
 
 using namespace vislib;
@@ -323,4 +324,43 @@ TEST(SegmentHardCases, H12_FootprintContainsEveryCoveredPixelWhenVerticesAreBehi
   }
   EXPECT_GT(covered, 2000);
   EXPECT_EQ(missed, 0);
+}
+
+TEST(SegmentHardCases, H13_ZeroLengthSegmentEqualsFromPointVisibility) {
+  Rng rng(13);
+  std::vector<std::array<Vec3, 3>> tris;
+  for (int i = 0; i < 25; ++i) {
+    Vec3 c{rng.uniform(-4, 4), rng.uniform(-4, 4), rng.uniform(-4, 4)};
+    std::array<Vec3, 3> t;
+    for (auto& p : t) p = c + Vec3{rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2)};
+    tris.push_back(t);
+  }
+  Scene s = soup(tris);
+  Vec3 v{0.1, -0.2, 0.3};
+  SegmentOptions o;
+  o.resolution = 32;
+  o.near = 0.01;
+  o.orientation = random_orientation(13);
+  o.want_pieces = true;
+  auto r = segment_visibility(s, v, v, o);
+  int compared = 0, mismatches = 0;
+  for (int f = 0; f < 6; ++f) {
+    FaceAxes ax = face_axes(f, o.orientation);
+    for (int y = 0; y < o.resolution; ++y)
+      for (int x = 0; x < o.resolution; ++x) {
+        const PieceList& l = r.pieces[(size_t(f) * o.resolution + y) * o.resolution + x];
+        for (const Piece& p : l) {
+          EXPECT_EQ(p.t0, 0.0);
+          EXPECT_EQ(p.t1, 1.0);
+        }
+        ASSERT_LE(l.size(), 1u);
+        OracleSample ref = brute_force_first_hit(s, 0.0, v, pixel_direction(ax, x, y, o.resolution), o.near);
+        if (ref.ambiguous) continue;
+        ++compared;
+        uint32_t ours = l.empty() ? kNoHit : l[0].id;
+        if (ours != ref.tri) ++mismatches;
+      }
+  }
+  EXPECT_GT(compared, 5000);
+  EXPECT_EQ(mismatches, 0);
 }
