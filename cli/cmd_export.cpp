@@ -1,0 +1,83 @@
+// pvs export SCENE -o flat.obj [--states K] [--time TAU]: the scene as a flat OBJ whose face i is
+// triangle id i. One `o <object name>` line each time the object changes along the id order,
+// all vertices as `v` lines (%.17g, exact round trip) in vertex order, one `f` line per triangle.
+// Positions are those at animation time TAU (Scene::position_at; default 0 = state 0).
+// Spheres, if any, go to OUT.spheres in the sphere text format (docs/sphere-format.md): all key
+// states without --time, the single state at TAU with --time.
+#include <cstdio>
+#include <optional>
+
+#include "cli/commands.h"
+#include "cli/load_scene.h"
+#include "vislib/file_util.h"
+
+namespace pvs_cli {
+namespace {
+
+struct ExportOptions {
+  std::string scene, out;
+  int states = 1;
+  std::optional<double> time;
+};
+
+void append_f(std::string& s, const char* fmt, double a, double b, double c) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c);
+  s += buf;
+}
+
+void run_export(const ExportOptions& o) {
+  vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
+  double tau = o.time.value_or(0.0);
+  std::string obj = "# pvs export of " + o.scene + ": face i is triangle id i\n";
+  for (uint32_t v = 0; v < scene.vertex_count(); ++v) {
+    vislib::Vec3 p = scene.position_at(v, tau);
+    append_f(obj, "v %.17g %.17g %.17g\n", p.x, p.y, p.z);
+  }
+  int64_t last = -1;
+  for (size_t t = 0; t < scene.triangle_count(); ++t) {
+    uint32_t object = scene.triangle_object[t];
+    if (int64_t(object) != last) {
+      obj += "o " + scene.objects[object].name + "\n";
+      last = object;
+    }
+    const auto& tri = scene.triangles[t];
+    obj += "f " + std::to_string(tri[0] + 1) + " " + std::to_string(tri[1] + 1) + " " +
+           std::to_string(tri[2] + 1) + "\n";
+  }
+  vislib::write_file_atomic(o.out, obj);
+  std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
+               scene.vertex_count(), scene.triangle_count());
+  if (scene.sphere_count() == 0) return;
+  size_t K = o.time ? 1 : scene.sphere_centers.size();
+  std::string sp = "vislib-spheres 1\n# pvs export of " + o.scene + "\nstates " + std::to_string(K) + "\n";
+  for (uint32_t i = 0; i < scene.sphere_count(); ++i) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.17g", scene.sphere_radius[i]);
+    sp += buf;
+    for (size_t k = 0; k < K; ++k) {
+      vislib::Vec3 c = o.time ? scene.sphere_center_at(i, tau) : scene.sphere_centers[k][i];
+      append_f(sp, " %.17g %.17g %.17g", c.x, c.y, c.z);
+    }
+    sp += "\n";
+  }
+  vislib::write_file_atomic(o.out + ".spheres", sp);
+  std::fprintf(stderr, "pvs: wrote %s.spheres (%zu spheres, %zu states)\n", o.out.c_str(),
+               scene.sphere_count(), K);
+}
+
+const Registration reg("export", [](CLI::App& app) {
+  auto o = std::make_shared<ExportOptions>();
+  auto* cmd = app.add_subcommand(
+      "export", "Write the scene as a flat OBJ (face i = triangle id i); spheres to OUT.spheres");
+  cmd->add_option("scene", o->scene, "Scene file")->required();
+  cmd->add_option("-o,--output", o->out, "Output .obj")->required();
+  cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--time", o->time, "Animation time in [0,1] (default: state 0)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->callback([o] { run_export(*o); });
+});
+
+}  // namespace
+}  // namespace pvs_cli

@@ -1,0 +1,62 @@
+// pvs info SCENE [--json] [--states K]: scene statistics and hygiene report (vislib/scene_info.h).
+#include <cstdio>
+
+#include "cli/commands.h"
+#include "cli/load_scene.h"
+#include "vislib/scene_info.h"
+
+namespace pvs_cli {
+namespace {
+
+struct InfoOptions {
+  std::string scene;
+  bool json = false;
+  int states = 1;
+};
+
+void run_info(const InfoOptions& o) {
+  vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
+  vislib::SceneInfo info = vislib::scene_info(scene);
+  if (o.json) {
+    std::printf("%s\n", vislib::to_json(info).c_str());
+    return;
+  }
+  auto row = [](const char* key, const std::string& value) {
+    std::printf("  %-22s %s\n", key, value.c_str());
+  };
+  auto num = [](size_t v) { return std::to_string(v); };
+  std::printf("%s\n", o.scene.c_str());
+  row("triangles", num(info.triangles));
+  row("vertices", num(info.vertices));
+  row("objects", num(info.objects));
+  row("states", num(info.states) + (info.dynamic ? " (dynamic)" : " (static)"));
+  row("spheres", num(info.spheres));
+  if (info.bbox.empty()) {
+    row("bounding box", "(empty)");
+  } else {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "[%g, %g, %g] .. [%g, %g, %g]", info.bbox.min.x, info.bbox.min.y,
+                  info.bbox.min.z, info.bbox.max.x, info.bbox.max.y, info.bbox.max.z);
+    row("bounding box", buf);
+    std::snprintf(buf, sizeof buf, "%g", info.diagonal);
+    row("diagonal", buf);
+  }
+  row("units", info.units_guess);
+  row("degenerate triangles", num(info.degenerate_triangles));
+  row("non-finite vertices", num(info.nonfinite_vertices));
+  row("duplicate vertices", num(info.duplicate_vertices));
+  row("out-of-range indices", num(info.out_of_range_indices));
+}
+
+const Registration reg("info", [](CLI::App& app) {
+  auto o = std::make_shared<InfoOptions>();
+  auto* cmd = app.add_subcommand("info", "Print scene statistics and a hygiene report");
+  cmd->add_option("scene", o->scene, "Scene file (.gltf .glb .obj .ply .off .stl .spheres)")->required();
+  cmd->add_flag("--json", o->json, "Machine-readable JSON on stdout");
+  cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
+      ->check(CLI::PositiveNumber);
+  cmd->callback([o] { run_info(*o); });
+});
+
+}  // namespace
+}  // namespace pvs_cli

@@ -1,0 +1,130 @@
+// Tests of `pvs info` and `pvs export`: exit codes and messages on bad input, JSON output, and the
+// export round trip.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "tests/import_test_files.h"
+#include "tests/test_support.h"
+#include "vislib/import.h"
+
+using namespace vislib_test;
+using json = nlohmann::json;
+
+namespace {
+
+GltfSpec triangle() {
+  GltfSpec g;
+  g.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  g.indices = {0, 1, 2};
+  return g;
+}
+
+// `pvs info PATH` must fail with exit code 2 and a message naming the file and containing `what`.
+void expect_bad_input(const std::string& path, const std::string& what) {
+  std::string out;
+  int code = run_pvs("info '" + path + "'", &out);
+  EXPECT_EQ(code, 2) << out;
+  EXPECT_NE(out.find(path), std::string::npos) << out;
+  EXPECT_NE(out.find(what), std::string::npos) << out;
+}
+
+}  // namespace
+
+TEST(CliInfo, BadInputsExitWithCode2AndNameTheFile) {
+  std::string dir = temp_dir("cli_bad");
+  expect_bad_input(dir + "/missing.gltf", "cannot open");
+  GltfSpec g = triangle();
+  g.glb = true;
+  std::string glb = read_bytes(write_gltf(dir + "/full.glb", g));
+  expect_bad_input(write_text(dir + "/truncated.glb", glb.substr(0, glb.size() - 10)), "truncated");
+  g = triangle();
+  g.position_accessor = 5;
+  expect_bad_input(write_gltf(dir + "/accessor.gltf", g), "accessor 5");
+  g = triangle();
+  g.view_length_extra = 64;
+  expect_bad_input(write_gltf(dir + "/view.gltf", g), "bufferView 0");
+  g = triangle();
+  g.indices = {0, 1, 3};
+  expect_bad_input(write_gltf(dir + "/index.gltf", g), "1 indices out of range");
+  g = triangle();
+  g.positions[8] = INFINITY;
+  expect_bad_input(write_gltf(dir + "/inf.gltf", g), "vertex 2 is not finite");
+  expect_bad_input(write_text(dir + "/nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2");
+  expect_bad_input(write_text(dir + "/scene.fbx", "Kaydara"), "unsupported file format '.fbx'");
+  expect_bad_input(write_text(dir + "/s.spheres", "vislib-spheres 1\nstates 1\n1 0 0\n"), "line 3");
+  expect_bad_input(write_text(dir + "/garbage.glb", "glTF\x02\0\0\0garbage-garbage-garbage"), "glb");
+  expect_bad_input(write_text(dir + "/garbage.gltf", "{ not json"), "invalid JSON");
+}
+
+TEST(CliInfo, JsonReportsCountsAndBox) {
+  std::string dir = temp_dir("cli_json");
+  std::string path = write_gltf(dir + "/t.gltf", triangle());
+  std::string out;
+  ASSERT_EQ(run_pvs("info --json '" + path + "'", &out), 0) << out;
+  json j = json::parse(out);
+  EXPECT_EQ(j["triangles"], 1);
+  EXPECT_EQ(j["objects"], 1);
+  EXPECT_EQ(j["states"], 1);
+  EXPECT_EQ(j["bbox"]["max"][0], 1.0);
+  EXPECT_EQ(j["degenerate_triangles"], 0);
+}
+
+TEST(CliInfo, SharedScenesReportTheReadmeTriangleCounts) {
+  VISLIB_REQUIRE_SHARED(shared);
+  std::string out;
+  ASSERT_EQ(run_pvs("info --json " + shared + "/scenes/sauer_fdm6/fdm6.obj", &out), 0) << out;
+  EXPECT_EQ(json::parse(out)["triangles"], 9779);
+  ASSERT_EQ(run_pvs("info --json --states 5 " + shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf", &out), 0);
+  EXPECT_EQ(json::parse(out)["states"], 5);
+  EXPECT_EQ(json::parse(out)["dynamic"], true);
+}
+
+TEST(CliExport, RoundTripKeepsTrianglesObjectsAndExactCoordinates) {
+  std::string dir = temp_dir("cli_export");
+  GltfSpec g = triangle();
+  g.positions = {0.1f, 1e-7f, 12345.678f, 1, 0, 0, 0, 1, 0};
+  g.nodes = json::array({{{"mesh", 0}, {"name", "a"}, {"rotation", {0.1, 0.2, 0.3, 0.927}}},
+                         {{"mesh", 0}, {"name", "b"}, {"translation", {1e5, 0.3, 0}}}});
+  g.scene_nodes = {0, 1};
+  std::string in = write_gltf(dir + "/in.gltf", g), out_obj = dir + "/flat.obj";
+  std::string out;
+  ASSERT_EQ(run_pvs("export '" + in + "' -o '" + out_obj + "'", &out), 0) << out;
+  vislib::Scene a = vislib::load_scene(in), b = vislib::load_scene(out_obj);
+  ASSERT_EQ(a.triangle_count(), b.triangle_count());
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.triangle_object, b.triangle_object);
+  ASSERT_EQ(b.objects.size(), 2u);
+  EXPECT_EQ(b.objects[1].name, "b");
+  EXPECT_EQ(a.positions, b.positions);  // %.17g: bit-exact
+  ASSERT_EQ(run_pvs("info --json '" + out_obj + "'", &out), 0) << out;
+  EXPECT_EQ(json::parse(out)["triangles"], 2);
+}
+
+TEST(CliExport, SpheresGoBesideTheObjAndRoundTrip) {
+  std::string dir = temp_dir("cli_export_spheres");
+  std::string in = write_text(dir + "/s.spheres",
+                              "vislib-spheres 1\nstates 2\n0.25 0.1 0.2 0.3 1 2 3\n2 0 0 0 0 0 1e-9\n");
+  std::string out;
+  ASSERT_EQ(run_pvs("export '" + in + "' -o '" + dir + "/o.obj'", &out), 0) << out;
+  vislib::Scene a = vislib::load_scene(in), b = vislib::load_scene(dir + "/o.obj.spheres");
+  EXPECT_EQ(a.sphere_radius, b.sphere_radius);
+  EXPECT_EQ(a.sphere_centers, b.sphere_centers);
+  ASSERT_EQ(run_pvs("export '" + in + "' -o '" + dir + "/t.obj' --time 0.5", &out), 0) << out;
+  vislib::Scene c = vislib::load_scene(dir + "/t.obj.spheres");
+  ASSERT_EQ(c.state_count(), 1u);
+  EXPECT_EQ(c.sphere_centers[0][0], a.sphere_center_at(0, 0.5));
+}
+
+TEST(CliExport, TimeSamplesTheAnimation) {
+  VISLIB_REQUIRE_SHARED(shared);
+  std::string dir = temp_dir("cli_export_time");
+  std::string in = shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf", out;
+  ASSERT_EQ(run_pvs("export '" + in + "' --states 5 --time 0.5 -o '" + dir + "/m.obj'", &out), 0) << out;
+  vislib::LoadOptions o;
+  o.states = 5;
+  vislib::Scene a = vislib::load_scene(in, o), b = vislib::load_scene(dir + "/m.obj");
+  ASSERT_EQ(a.vertex_count(), b.vertex_count());
+  for (uint32_t v = 0; v < a.vertex_count(); ++v) ASSERT_EQ(a.position_at(v, 0.5), b.positions[0][v]);
+}
