@@ -45,14 +45,16 @@ void write_and_report(const std::string& kind, const vislib::Scene& scene, const
   std::string bytes = vislib::file_extension(path) == ".glb" ? vislib::scene_to_glb(scene)
                                                              : vislib::spheres_to_text(scene);
   vislib::write_file_atomic(path, bytes);
-  std::printf("%s: %zu triangles, %zu spheres, %zu objects, %zu states, %zu bytes written to %s "
-              "in %.2f s\n",
-              kind.c_str(), scene.triangle_count(), scene.sphere_count(), scene.objects.size(),
-              scene.state_count(), bytes.size(), path.c_str(), seconds_since(t0));
+  std::printf(
+      "%s: %zu triangles, %zu spheres, %zu objects, %zu states, %zu bytes written to %s "
+      "in %.2f s\n",
+      kind.c_str(), scene.triangle_count(), scene.sphere_count(), scene.objects.size(),
+      scene.state_count(), bytes.size(), path.c_str(), seconds_since(t0));
 }
 
 void add_generate(CLI::App& app) {
-  auto* gen = app.add_subcommand("generate", "Generate a procedural test scene (city, grass, spheres)");
+  auto* gen =
+      app.add_subcommand("generate", "Generate a procedural test scene (city, grass, spheres)");
   gen->require_subcommand(1);
 
   // city
@@ -61,19 +63,24 @@ void add_generate(CLI::App& app) {
     auto out = std::make_shared<std::string>();
     auto blocks = std::make_shared<std::string>();
     auto heights = std::make_shared<std::string>();
-    auto* c = gen->add_subcommand("city", "A grid of streets and blocks lined with buildings (.glb)");
+    auto* c =
+        gen->add_subcommand("city", "A grid of streets and blocks lined with buildings (.glb)");
     c->add_option("-o,--output", *out, "Output file (.glb)")->required();
     c->add_option("--seed", o->seed, "Random seed")->capture_default_str();
     c->add_option("--blocks", *blocks, "Blocks along x and z, as X,Z (default 6,6)");
-    c->add_option("--block-size", o->block_size, "Side of a block (m)")->capture_default_str()
+    c->add_option("--block-size", o->block_size, "Side of a block (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    c->add_option("--street-width", o->street_width, "Street width (m)")->capture_default_str()
+    c->add_option("--street-width", o->street_width, "Street width (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    c->add_option("--lots", o->lots_per_side, "Buildings per block side")->capture_default_str()
+    c->add_option("--lots", o->lots_per_side, "Buildings per block side")
+        ->capture_default_str()
         ->check(CLI::Range(1, 100));
     c->add_option("--heights", *heights, "Building heights MIN,MAX (m) (default 8,60)");
     c->add_option("--panel", o->panel_size, "Facade panel size (m); 0 = one quad per wall")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     c->add_option("--target-triangles", o->target_triangles,
                   "Pick the facade detail (and, without --blocks, the grid) for about this many "
                   "triangles");
@@ -105,32 +112,44 @@ void add_generate(CLI::App& app) {
   {
     auto o = std::make_shared<vislib::GrassOptions>();
     auto out = std::make_shared<std::string>();
-    auto* c = gen->add_subcommand("grass", "A rolling terrain covered with wind-swept grass (.glb)");
+    auto* c =
+        gen->add_subcommand("grass", "A rolling terrain covered with wind-swept grass (.glb)");
     c->add_option("-o,--output", *out, "Output file (.glb)")->required();
     c->add_option("--seed", o->seed, "Random seed")->capture_default_str();
-    c->add_option("--size", o->size, "Side of the square field (m)")->capture_default_str()
+    c->add_option("--size", o->size, "Side of the square field (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    c->add_option("--density", o->density, "Blades per square meter")->capture_default_str()
+    c->add_option("--density", o->density, "Blades per square meter")
+        ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
     c->add_option("--target-triangles", o->target_triangles,
                   "Pick the blade count for this many triangles (overrides --density)");
     c->add_option("--blade-triangles", o->blade_triangles, "Triangles per blade")
-        ->capture_default_str()->check(CLI::Range(2, 5));
-    c->add_option("--blade-height", o->blade_height, "Mean blade height (m)")->capture_default_str()
+        ->capture_default_str()
+        ->check(CLI::Range(2, 5));
+    c->add_option("--blade-height", o->blade_height, "Mean blade height (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
     c->add_option("--blade-width", o->blade_width, "Mean blade base width (m)")
-        ->capture_default_str()->check(CLI::PositiveNumber);
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     c->add_option("--patch-size", o->patch_size, "Side of the square patch per object (m)")
-        ->capture_default_str()->check(CLI::PositiveNumber);
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     c->add_option("--terrain-cell", o->terrain_cell, "Terrain grid spacing (m)")
-        ->capture_default_str()->check(CLI::PositiveNumber);
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     c->add_option("--terrain-amplitude", o->terrain_amplitude, "Hill height (m)")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     c->add_option("--states", o->states, "Key states of the wind animation")
-        ->capture_default_str()->check(CLI::Range(1, 1000));
+        ->capture_default_str()
+        ->check(CLI::Range(1, 1000));
     c->add_option("--wind", o->wind_amplitude, "Gust bend angle at the tip (radians)")
-        ->capture_default_str()->check(CLI::Range(0.0, 1.4));
-    c->add_option("--wavelength", o->wind_wavelength, "Gust wavelength (m)")->capture_default_str()
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1.4));
+    c->add_option("--wavelength", o->wind_wavelength, "Gust wavelength (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
     c->callback([o, out] {
       check_extension(*out, ".glb", "grass");
@@ -147,22 +166,30 @@ void add_generate(CLI::App& app) {
     auto* c = gen->add_subcommand("spheres", "Bouncing spheres (.spheres text format)");
     c->add_option("-o,--output", *out, "Output file (.spheres)")->required();
     c->add_option("--seed", o->seed, "Random seed")->capture_default_str();
-    c->add_option("--count", o->count, "Number of spheres")->capture_default_str()
+    c->add_option("--count", o->count, "Number of spheres")
+        ->capture_default_str()
         ->check(CLI::NonNegativeNumber);
-    c->add_option("--radius", o->radius, "Sphere radius (m)")->capture_default_str()
+    c->add_option("--radius", o->radius, "Sphere radius (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    c->add_option("--area", o->area, "Side of the square area (m)")->capture_default_str()
+    c->add_option("--area", o->area, "Side of the square area (m)")
+        ->capture_default_str()
         ->check(CLI::PositiveNumber);
-    c->add_option("--states", o->states, "Key states")->capture_default_str()
+    c->add_option("--states", o->states, "Key states")
+        ->capture_default_str()
         ->check(CLI::Range(1, 100000));
     c->add_option("--duration", o->duration, "Simulated seconds from first to last state")
-        ->capture_default_str()->check(CLI::PositiveNumber);
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
     c->add_option("--max-height", o->max_height, "Initial centre height above radius, at most (m)")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     c->add_option("--speed", o->speed, "Initial speed per axis, at most (m/s)")
-        ->capture_default_str()->check(CLI::NonNegativeNumber);
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
     c->add_option("--restitution", o->restitution, "Vertical speed kept at a bounce")
-        ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1.0));
     c->callback([o, out] {
       check_extension(*out, ".spheres", "sphere");
       if (o->area < 2 * o->radius)

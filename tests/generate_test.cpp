@@ -1,3 +1,5 @@
+#include "vislib/generate.h"
+
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
@@ -7,7 +9,6 @@
 
 #include "tests/test_support.h"
 #include "vislib/file_util.h"
-#include "vislib/generate.h"
 #include "vislib/write_gltf.h"
 #include "vislib/write_spheres.h"
 
@@ -106,40 +107,45 @@ TEST(Generate, GrassTriangleCountFollowsTarget) {
 }
 
 TEST(Generate, CityBuildingsAreClosedOutwardAndNonDegenerate) {
-  Scene s = generate_city(small_city(5));
-  ASSERT_EQ(s.objects[0].name, "ground");
-  int setbacks = 0;
-  for (uint32_t obj = 1; obj < s.objects.size(); ++obj) {
-    std::map<std::pair<uint32_t, uint32_t>, int> directed;
-    double volume = 0;
-    Box3 base, top;  // footprint at y = 0 and at the roof
-    double roof = 0;
-    for (uint32_t t = 0; t < s.triangle_count(); ++t) {
-      if (s.triangle_object[t] != obj) continue;
-      const auto& tri = s.triangles[t];
-      auto c = s.corners(t);
-      EXPECT_GT(length(cross(c[1] - c[0], c[2] - c[0])), 1e-6) << s.objects[obj].name;
-      volume += dot(c[0], cross(c[1], c[2])) / 6;
-      for (int e = 0; e < 3; ++e) ++directed[{tri[e], tri[(e + 1) % 3]}];
-      for (auto& p : c) {
-        if (p.y == 0) base.extend(p);
-        roof = std::max(roof, p.y);
+  for (double panel : {0.0, 4.0, 7.3}) {
+    SCOPED_TRACE("panel " + std::to_string(panel));
+    CityOptions o = small_city(5);
+    o.panel_size = panel;
+    Scene s = generate_city(o);
+    ASSERT_EQ(s.objects[0].name, "ground");
+    int setbacks = 0;
+    for (uint32_t obj = 1; obj < s.objects.size(); ++obj) {
+      std::map<std::pair<uint32_t, uint32_t>, int> directed;
+      double volume = 0;
+      Box3 base, top;  // footprint at y = 0 and at the roof
+      double roof = 0;
+      for (uint32_t t = 0; t < s.triangle_count(); ++t) {
+        if (s.triangle_object[t] != obj) continue;
+        const auto& tri = s.triangles[t];
+        auto c = s.corners(t);
+        EXPECT_GT(length(cross(c[1] - c[0], c[2] - c[0])), 1e-6) << s.objects[obj].name;
+        volume += dot(c[0], cross(c[1], c[2])) / 6;
+        for (int e = 0; e < 3; ++e) ++directed[{tri[e], tri[(e + 1) % 3]}];
+        for (auto& p : c) {
+          if (p.y == 0) base.extend(p);
+          roof = std::max(roof, p.y);
+        }
       }
+      for (uint32_t t = 0; t < s.triangle_count(); ++t)
+        if (s.triangle_object[t] == obj)
+          for (auto& p : s.corners(t))
+            if (p.y == roof) top.extend(p);
+      if (top.min.x > base.min.x && top.max.x < base.max.x) ++setbacks;
+      // Closed with consistent winding: each directed edge once, and its reverse once.
+      for (const auto& [edge, count] : directed) {
+        EXPECT_EQ(count, 1) << s.objects[obj].name;
+        auto rev = directed.find({edge.second, edge.first});
+        EXPECT_TRUE(rev != directed.end() && rev->second == 1) << s.objects[obj].name;
+      }
+      EXPECT_GT(volume, 0) << s.objects[obj].name << " is not wound outward";
     }
-    for (uint32_t t = 0; t < s.triangle_count(); ++t)
-      if (s.triangle_object[t] == obj)
-        for (auto& p : s.corners(t))
-          if (p.y == roof) top.extend(p);
-    if (top.min.x > base.min.x && top.max.x < base.max.x) ++setbacks;
-    // Closed with consistent winding: each directed edge once, and its reverse once.
-    for (const auto& [edge, count] : directed) {
-      EXPECT_EQ(count, 1) << s.objects[obj].name;
-      auto rev = directed.find({edge.second, edge.first});
-      EXPECT_TRUE(rev != directed.end() && rev->second == 1) << s.objects[obj].name;
-    }
-    EXPECT_GT(volume, 0) << s.objects[obj].name << " is not wound outward";
+    EXPECT_GT(setbacks, 0) << "expected some buildings with setback tiers";
   }
-  EXPECT_GT(setbacks, 0) << "expected some buildings with setback tiers";
 }
 
 TEST(Generate, CityObjectsAreContiguousAndNamed) {
@@ -166,7 +172,8 @@ TEST(Generate, GrassBladeBasesStayFixedAndTerrainIsStatic) {
     EXPECT_GT(length(cross(c[1] - c[0], c[2] - c[0])), 0) << "triangle " << t;
     if (s.triangle_object[t] == 0) {
       for (uint32_t v : s.triangles[t])
-        for (size_t k = 1; k < s.state_count(); ++k) EXPECT_EQ(s.positions[k][v], s.positions[0][v]);
+        for (size_t k = 1; k < s.state_count(); ++k)
+          EXPECT_EQ(s.positions[k][v], s.positions[0][v]);
     }
   }
   // Each 3-triangle blade has 5 vertices, the 2 base ones fixed.
@@ -249,7 +256,8 @@ TEST(Generate, AnimatedGlbHasMorphTargetsPerState) {
 TEST(Generate, CliWritesFilesAndRefusesWrongExtensions) {
   std::string dir = vislib_test::temp_dir("generate_cli");
   std::string out;
-  EXPECT_EQ(vislib_test::run_pvs("generate city --blocks 2,2 --seed 3 -o " + dir + "/c.glb", &out), 0)
+  EXPECT_EQ(vislib_test::run_pvs("generate city --blocks 2,2 --seed 3 -o " + dir + "/c.glb", &out),
+            0)
       << out;
   EXPECT_NE(out.find("triangles"), std::string::npos) << out;
   EXPECT_EQ(read_file(dir + "/c.glb"), [] {
@@ -263,5 +271,6 @@ TEST(Generate, CliWritesFilesAndRefusesWrongExtensions) {
   EXPECT_EQ(vislib_test::run_pvs("generate grass --size 4 -o " + dir + "/g.obj", &out), 2) << out;
   EXPECT_NE(out.find(".glb"), std::string::npos) << out;
   EXPECT_EQ(vislib_test::run_pvs("generate spheres -o " + dir + "/s.glb", &out), 2) << out;
-  EXPECT_EQ(vislib_test::run_pvs("generate city --blocks 0,2 -o " + dir + "/c.glb", &out), 2) << out;
+  EXPECT_EQ(vislib_test::run_pvs("generate city --blocks 0,2 -o " + dir + "/c.glb", &out), 2)
+      << out;
 }

@@ -45,7 +45,8 @@ std::vector<Building> city_layout(const CityOptions& o) {
       const double bx = -total_x / 2 + bi * pitch, bz = -total_z / 2 + bj * pitch;
       // Downtown: blocks near the centre reach higher.
       double cx = bx + o.block_size / 2, cz = bz + o.block_size / 2;
-      double r = std::sqrt(cx * cx + cz * cz) / (0.5 * std::sqrt(total_x * total_x + total_z * total_z) + 1e-9);
+      double r = std::sqrt(cx * cx + cz * cz) /
+                 (0.5 * std::sqrt(total_x * total_x + total_z * total_z) + 1e-9);
       double boost = 1.0 - 0.6 * std::min(r, 1.0);
       for (int li = 0; li < o.lots_per_side; ++li)
         for (int lj = 0; lj < o.lots_per_side; ++lj) {
@@ -82,7 +83,8 @@ std::vector<Building> city_layout(const CityOptions& o) {
             n.z1 = p.z1 - inset * rng.uniform(0.5, 1.5);
             n.y0 = p.y1;
             double rest = h - p.y1;
-            n.y1 = n.y0 + (k + 1 == tiers ? rest * rng.uniform(0.8, 1.6) : rest * rng.uniform(0.4, 0.7));
+            n.y1 = n.y0 +
+                   (k + 1 == tiers ? rest * rng.uniform(0.8, 1.6) : rest * rng.uniform(0.4, 0.7));
             if (n.y1 - n.y0 < 2) n.y1 = n.y0 + 2;
             b.tiers.push_back(n);
           }
@@ -112,9 +114,11 @@ uint64_t building_triangles(const Building& b, double panel) {
   for (size_t t = 0; t < b.tiers.size(); ++t) {
     TierGrid g = tier_grid(b.tiers[t], panel);
     n += 2ull * uint64_t(g.ring()) * uint64_t(g.rows);  // walls
-    if (t == 0) n += uint64_t(g.ring());                  // bottom fan
-    if (t + 1 == b.tiers.size()) n += uint64_t(g.ring()); // roof fan
-    else n += uint64_t(g.ring()) + uint64_t(tier_grid(b.tiers[t + 1], panel).ring());  // ledge
+    if (t == 0) n += uint64_t(g.ring());                // bottom fan
+    if (t + 1 == b.tiers.size())
+      n += uint64_t(g.ring());  // roof fan
+    else
+      n += uint64_t(g.ring()) + uint64_t(tier_grid(b.tiers[t + 1], panel).ring());  // ledge
   }
   return n;
 }
@@ -234,8 +238,10 @@ double choose_panel(const std::vector<Building>& layout, const GroundGrid& g, ui
   double lo = std::log(0.02), hi = std::log(1e5);
   for (int it = 0; it < 80; ++it) {
     double mid = 0.5 * (lo + hi);
-    if (layout_triangles(layout, g, std::exp(mid)) > target) lo = mid;
-    else hi = mid;
+    if (layout_triangles(layout, g, std::exp(mid)) > target)
+      lo = mid;
+    else
+      hi = mid;
   }
   double a = std::exp(lo), b = std::exp(hi);
   uint64_t na = layout_triangles(layout, g, a), nb = layout_triangles(layout, g, b);
@@ -300,14 +306,15 @@ Scene generate_city(const CityOptions& options) {
 namespace {
 
 struct Terrain {
-  int n;          // n x n cells
-  double x0, cell;  // square grid from (x0, x0), cell side
+  int n;                  // n x n cells
+  double x0, cell;        // square grid from (x0, x0), cell side
   std::vector<double> h;  // (n+1)^2 heights, row-major in z then x
   double height(int i, int j) const { return h[size_t(j) * size_t(n + 1) + size_t(i)]; }
   // Height of the triangulated surface at (x, z): each cell split along (i,j)-(i+1,j+1).
   double surface(double x, double z) const {
     double fx = (x - x0) / cell, fz = (z - x0) / cell;
-    int i = std::clamp(int(std::floor(fx)), 0, n - 1), j = std::clamp(int(std::floor(fz)), 0, n - 1);
+    int i = std::clamp(int(std::floor(fx)), 0, n - 1),
+        j = std::clamp(int(std::floor(fz)), 0, n - 1);
     double u = std::clamp(fx - i, 0.0, 1.0), w = std::clamp(fz - j, 0.0, 1.0);
     double h00 = height(i, j), h11 = height(i + 1, j + 1);
     if (u >= w) return h00 + u * (height(i + 1, j) - h00) + w * (h11 - height(i + 1, j));
@@ -348,7 +355,8 @@ Scene generate_grass(const GrassOptions& o) {
   const uint64_t terrain_tris = 2ull * uint64_t(terrain.n) * uint64_t(terrain.n);
   uint64_t blades = uint64_t(std::llround(std::max(0.0, o.density) * o.size * o.size));
   if (o.target_triangles > 0)
-    blades = o.target_triangles > terrain_tris ? (o.target_triangles - terrain_tris + T / 2) / T : 0;
+    blades =
+        o.target_triangles > terrain_tris ? (o.target_triangles - terrain_tris + T / 2) / T : 0;
   const uint64_t vertices = uint64_t(terrain.n + 1) * uint64_t(terrain.n + 1) + blades * (T + 2);
   assert(vertices < (1ull << 32));
 
@@ -380,7 +388,8 @@ Scene generate_grass(const GrassOptions& o) {
     Rng rng(Rng::derive(o.seed, 1 + pi));
     const uint64_t count = blades / patches + (pi < blades % patches ? 1 : 0);
     for (uint64_t b = 0; b < count; ++b) {
-      double x = terrain.x0 + patch * (ix + rng.uniform()), z = terrain.x0 + patch * (iz + rng.uniform());
+      double x = terrain.x0 + patch * (ix + rng.uniform()),
+             z = terrain.x0 + patch * (iz + rng.uniform());
       Vec3 base{x, terrain.surface(x, z), z};
       double yaw = rng.uniform(0, 2 * kPi);
       Vec3 face{std::cos(yaw), 0, std::sin(yaw)}, side{-std::sin(yaw), 0, std::cos(yaw)};
@@ -392,7 +401,8 @@ Scene generate_grass(const GrassOptions& o) {
       for (int k = 0; k < K; ++k) {
         // Bend: rest lean over the blade's face plus the gust downwind (+x), as a small-angle
         // vector sum; the centre line is a circular arc of length `height` turning by `angle`.
-        double gust = 0.5 + 0.5 * std::sin(2 * kPi * (x / o.wind_wavelength - double(k) / K) + jitter);
+        double gust =
+            0.5 + 0.5 * std::sin(2 * kPi * (x / o.wind_wavelength - double(k) / K) + jitter);
         double bx = lean * face.x + o.wind_amplitude * stiffness * gust, bz = lean * face.z;
         double angle = std::min(std::sqrt(bx * bx + bz * bz), 1.4);
         Vec3 dir = angle > 0 ? Vec3{bx, 0, bz} * (1.0 / std::sqrt(bx * bx + bz * bz)) : Vec3{};
@@ -408,8 +418,10 @@ Scene generate_grass(const GrassOptions& o) {
       }
       for (int t = 0; t < T; ++t) {  // strip: consistent winding across the blade
         uint32_t a = first + uint32_t(t), b1 = a + 1, c = a + 2;
-        if (t % 2 == 0) add_tri(s, a, b1, c, obj);
-        else add_tri(s, b1, a, c, obj);
+        if (t % 2 == 0)
+          add_tri(s, a, b1, c, obj);
+        else
+          add_tri(s, b1, a, c, obj);
       }
     }
     if (o.progress && pi % 16 == 0) o.progress(double(pi) / double(patches));

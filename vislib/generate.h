@@ -21,10 +21,10 @@ namespace vislib {
 using GenerateProgress = std::function<void(double fraction)>;
 
 struct CityOptions {
-  int blocks_x = 6, blocks_z = 6;  // city blocks along x and z; each must be >= 1
-  double block_size = 60;          // side of a square block between streets (m), > 0
-  double street_width = 14;        // street between blocks (m), > 0
-  int lots_per_side = 3;           // a block is a lots x lots grid of buildings, >= 1
+  int blocks_x = 6, blocks_z = 6;          // city blocks along x and z; each must be >= 1
+  double block_size = 60;                  // side of a square block between streets (m), > 0
+  double street_width = 14;                // street between blocks (m), > 0
+  int lots_per_side = 3;                   // a block is a lots x lots grid of buildings, >= 1
   double min_height = 8, max_height = 60;  // building height range (m), 0 < min <= max
   // Facade panel size (m): walls are split into panels of about this size (window panels), which
   // only adds triangles. 0 = no split (a wall is one quad).
@@ -50,14 +50,14 @@ Scene generate_city(const CityOptions& options);
 uint64_t city_triangle_count(const CityOptions& options);
 
 struct GrassOptions {
-  double size = 100;        // side of the square field (m), > 0
-  double terrain_cell = 1;  // terrain grid spacing (m), > 0
+  double size = 100;               // side of the square field (m), > 0
+  double terrain_cell = 1;         // terrain grid spacing (m), > 0
   double terrain_amplitude = 1.5;  // height of the gentle rolling hills (m), >= 0
   double density = 20;      // blades per square meter (ignored when target_triangles > 0), >= 0
   int blade_triangles = 3;  // triangles per blade: a curved tapering strip, 2..5
   double blade_height = 0.5, blade_width = 0.02;  // mean blade height and base width (m)
-  double patch_size = 5;    // blades are grouped into one Object per patch of this side (m)
-  int states = 10;          // key states of the wind animation, >= 1
+  double patch_size = 5;        // blades are grouped into one Object per patch of this side (m)
+  int states = 10;              // key states of the wind animation, >= 1
   double wind_amplitude = 0.6;  // tip bend angle of a gust (radians), >= 0
   double wind_wavelength = 20;  // wavelength of the travelling gust wave (m), > 0
   // If > 0: the blade count is chosen so that the total triangle count is this (exactly, when it
@@ -77,15 +77,15 @@ struct GrassOptions {
 Scene generate_grass(const GrassOptions& options);
 
 struct SphereOptions {
-  int count = 10000;        // number of spheres, >= 0
-  double radius = 4;        // sphere radius (m), > 0
-  double area = 100;        // centres stay within an area x area square centred at the origin (m)
-  int states = 25;          // key states, >= 1
-  double duration = 6;      // simulated seconds between the first and the last state, > 0
-  double max_height = 40;   // initial centre heights are uniform in [radius, radius + this] (m)
-  double speed = 8;         // initial velocity components uniform in [-speed, speed] (m/s)
-  double restitution = 0.8; // vertical speed kept at a bounce, in [0, 1]
-  double gravity = 9.81;    // m/s^2
+  int count = 10000;         // number of spheres, >= 0
+  double radius = 4;         // sphere radius (m), > 0
+  double area = 100;         // centres stay within an area x area square centred at the origin (m)
+  int states = 25;           // key states, >= 1
+  double duration = 6;       // simulated seconds between the first and the last state, > 0
+  double max_height = 40;    // initial centre heights are uniform in [radius, radius + this] (m)
+  double speed = 8;          // initial velocity components uniform in [-speed, speed] (m/s)
+  double restitution = 0.8;  // vertical speed kept at a bounce, in [0, 1]
+  double gravity = 9.81;     // m/s^2
   uint64_t seed = 1;
 };
 

@@ -46,7 +46,9 @@ void vertex_float(const Scene& s, uint32_t v, size_t k, float out[3]) {
   out[2] = float(p.z);
 }
 
-Json vec3_json(const float* v) { return Json::array({double(v[0]), double(v[1]), double(v[2])}); }
+Json vec3_json(const float* v) {
+  return Json::array({double(v[0]), double(v[1]), double(v[2])});
+}
 
 }  // namespace
 
@@ -108,7 +110,8 @@ std::string scene_to_glb(const Scene& scene) {
     return views.size() - 1;
   };
   auto add_accessor = [&](size_t view, uint32_t type, size_t count, const char* kind) {
-    accessors.push_back({{"bufferView", view}, {"componentType", type}, {"count", count}, {"type", kind}});
+    accessors.push_back(
+        {{"bufferView", view}, {"componentType", type}, {"count", count}, {"type", kind}});
     return accessors.size() - 1;
   };
   bool animated = false;
@@ -140,16 +143,19 @@ std::string scene_to_glb(const Scene& scene) {
                                  m.vertices.size(), "VEC3");
         accessors[pa]["min"] = vec3_json(mm.lo);
         accessors[pa]["max"] = vec3_json(mm.hi);
-        if (k == 0) prim["attributes"]["POSITION"] = pa;
-        else targets.push_back({{"POSITION", pa}});
+        if (k == 0)
+          prim["attributes"]["POSITION"] = pa;
+        else
+          targets.push_back({{"POSITION", pa}});
       }
       if (m.dynamic) prim["targets"] = targets;
       Json mesh = {{"name", scene.objects[o].name}, {"primitives", Json::array({prim})}};
       if (m.dynamic) {
         mesh["weights"] = std::vector<double>(K - 1, 0.0);
-        samplers.push_back({{"input", time_accessor}, {"interpolation", "LINEAR"}, {"output", weight_accessor}});
-        channels.push_back({{"sampler", samplers.size() - 1},
-                            {"target", {{"node", o}, {"path", "weights"}}}});
+        samplers.push_back(
+            {{"input", time_accessor}, {"interpolation", "LINEAR"}, {"output", weight_accessor}});
+        channels.push_back(
+            {{"sampler", samplers.size() - 1}, {"target", {{"node", o}, {"path", "weights"}}}});
       }
       node["mesh"] = meshes_json.size();
       meshes_json.push_back(mesh);
@@ -162,7 +168,8 @@ std::string scene_to_glb(const Scene& scene) {
   j["nodes"] = nodes;
   if (!meshes_json.empty()) j["meshes"] = meshes_json;
   if (animated)
-    j["animations"] = Json::array({{{"name", "states"}, {"channels", channels}, {"samplers", samplers}}});
+    j["animations"] =
+        Json::array({{{"name", "states"}, {"channels", channels}, {"samplers", samplers}}});
   if (!accessors.empty()) {
     j["accessors"] = accessors;
     j["bufferViews"] = views;
