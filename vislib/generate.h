@@ -4,7 +4,8 @@
 // (Bouncing Spheres: 10,000 spheres of radius 4 m over 100 x 100 m, 25 states).
 //
 // All generators are pure functions of their options: same options (seed included) give
-// bit-identical scenes on every platform (vislib::Rng only, fixed evaluation order, no threads).
+// bit-identical scenes (vislib::Rng only, fixed evaluation order, no threads). Rng is the same
+// everywhere; sin/cos/pow come from the C library, so another libm may differ in the last bit.
 // Coordinates are meters, +Y up (as glTF), scenes centred on the origin in x and z.
 // Triangles of one object are contiguous and objects appear in order, so writing the objects as
 // glTF nodes in order and importing them back preserves triangle ids.
