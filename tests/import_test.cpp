@@ -338,3 +338,14 @@ TEST(SceneInfo, CountsDuplicatesNonFiniteAndOutOfRange) {
                           "units_guess"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
+
+TEST(ImportMesh, OffThroughOpenMeshKeepsFaceOrder) {
+  std::string dir = temp_dir("off_ok");
+  std::string path = write_text(dir + "/q.off",
+                                "OFF\n5 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n3 0 1 2\n4 1 3 4 2\n");
+  Scene s = load(path);
+  ASSERT_EQ(s.triangle_count(), 3u);  // the quad is fan-triangulated
+  EXPECT_EQ(s.objects.size(), 1u);
+  EXPECT_EQ(s.objects[0].name, "q");
+  EXPECT_EQ(s.vertex_count(), 5u);
+}
