@@ -74,6 +74,7 @@ json mat_json(const vislib::Mat3& m) { return json(std::vector<double>(m.m, m.m 
 
 json counts_json(const vislib::SegmentStats& s) {
   return {{"triangle_pixel_pairs", s.pair_tests},
+          {"culled_pixel_pairs", s.culled_pairs},
           {"covered_pairs", s.covered_pairs},
           {"final_pieces", s.final_pieces},
           {"pixels_with_pieces", s.pixels_with_pieces},

@@ -66,8 +66,11 @@ TEST(SegmentVisibility, ObjectSeenThroughAGapOnlyFromPartOfTheSegment) {
   EXPECT_TRUE(std::find(hidden.visible.begin(), hidden.visible.end(), 4u) == hidden.visible.end());
   auto seen = segment_visibility(s, {0, 0, 0}, {-4, 0, 0}, o);
   ASSERT_TRUE(std::find(seen.visible.begin(), seen.visible.end(), 4u) != seen.visible.end());
-  for (const Witness& w : seen.witnesses)
-    if (w.tri == 4) EXPECT_GT(w.t, 0.3);  // the window lines up only late on the segment
+  for (const Witness& w : seen.witnesses) {
+    if (w.tri == 4) {
+      EXPECT_GT(w.t, 0.3);  // the window lines up only late on the segment
+    }
+  }
 }
 
 TEST(SegmentVisibility, SameResultWithOneAndTwoThreads) {

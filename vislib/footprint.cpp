@@ -11,33 +11,34 @@ namespace {
 
 double cross2(Vec2 o, Vec2 a, Vec2 b) { return (a.u - o.u) * (b.w - o.w) - (a.w - o.w) * (b.u - o.u); }
 
-// Andrew's monotone chain; keeps collinear extremes out, returns CCW.
-std::vector<Vec2> convex_hull(std::vector<Vec2> pts) {
-  std::sort(pts.begin(), pts.end(),
-            [](Vec2 a, Vec2 b) { return a.u < b.u || (a.u == b.u && a.w < b.w); });
-  pts.erase(std::unique(pts.begin(), pts.end(),
-                        [](Vec2 a, Vec2 b) { return a.u == b.u && a.w == b.w; }),
-            pts.end());
-  if (pts.size() <= 2) return pts;
-  std::vector<Vec2> h(2 * pts.size());
-  size_t k = 0;
-  for (size_t i = 0; i < pts.size(); ++i) {
+// Andrew's monotone chain over pts[0, n) (reordered in place); writes the CCW hull (collinear
+// points dropped) to `out` and returns its size.
+int convex_hull(Vec2* pts, int n, Vec2* out) {
+  std::sort(pts, pts + n, [](Vec2 a, Vec2 b) { return a.u < b.u || (a.u == b.u && a.w < b.w); });
+  n = int(std::unique(pts, pts + n, [](Vec2 a, Vec2 b) { return a.u == b.u && a.w == b.w; }) - pts);
+  if (n <= 2) {
+    std::copy(pts, pts + n, out);
+    return n;
+  }
+  Vec2 h[2 * kMaxFootprintPoints];
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
     while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
     h[k++] = pts[i];
   }
-  for (size_t i = pts.size() - 1, lo = k + 1; i-- > 0;) {
+  for (int i = n - 1, lo = k + 1; i-- > 0;) {
     while (k >= lo && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
     h[k++] = pts[i];
   }
-  h.resize(k - 1);
-  return h;
+  std::copy(h, h + k - 1, out);
+  return k - 1;
 }
 
 // Margin in face coordinates: absolute plus relative to the polygon's magnitude (points near the
 // near plane project far out; their rounding grows with them).
 double margin_of(const Footprint& fp) {
   double m = 0;
-  for (Vec2 p : fp.hull) m = std::max({m, std::fabs(p.u), std::fabs(p.w)});
+  for (int i = 0; i < fp.size; ++i) m = std::max({m, std::fabs(fp.hull[i].u), std::fabs(fp.hull[i].w)});
   return kFootprintMargin + 1e-12 * m;
 }
 
@@ -47,10 +48,10 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
   Vec3 q[12];
   count = std::min(count, 12);
   for (int i = 0; i < count; ++i) q[i] = {dot(axes.S, rel[i]), dot(axes.T, rel[i]), dot(axes.F, rel[i])};
-  std::vector<Vec2> pts;
-  pts.reserve(count + count * (count - 1) / 2);
+  Vec2 pts[kMaxFootprintPoints];
+  int n = 0;
   for (int i = 0; i < count; ++i)
-    if (q[i].z >= near) pts.push_back({q[i].x / q[i].z, q[i].y / q[i].z});
+    if (q[i].z >= near) pts[n++] = {q[i].x / q[i].z, q[i].y / q[i].z};
   // Edges of the point set crossing the near plane: their crossing points (all pairs).
   for (int i = 0; i < count; ++i)
     for (int j = i + 1; j < count; ++j) {
@@ -58,11 +59,11 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
       if ((zi < 0 && zj > 0) || (zi > 0 && zj < 0)) {
         double s = (near - q[i].z) / (q[j].z - q[i].z);
         double x = q[i].x + s * (q[j].x - q[i].x), y = q[i].y + s * (q[j].y - q[i].y);
-        pts.push_back({x / near, y / near});
+        pts[n++] = {x / near, y / near};
       }
     }
   Footprint fp;
-  if (!pts.empty()) fp.hull = convex_hull(std::move(pts));
+  if (n > 0) fp.size = convex_hull(pts, n, fp.hull.data());
   return fp;
 }
 
@@ -70,7 +71,8 @@ bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y
   if (fp.empty()) return false;
   double m = margin_of(fp);
   double umin = INFINITY, umax = -INFINITY, wmin = INFINITY, wmax = -INFINITY;
-  for (Vec2 p : fp.hull) {
+  for (int i = 0; i < fp.size; ++i) {
+    Vec2 p = fp.hull[i];
     umin = std::min(umin, p.u);
     umax = std::max(umax, p.u);
     wmin = std::min(wmin, p.w);
@@ -93,8 +95,8 @@ bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1) {
   double m = margin_of(fp);
   double wc = pixel_center(y, n), wlo = wc - m, whi = wc + m;
   double umin = INFINITY, umax = -INFINITY;
-  size_t k = fp.hull.size();
-  for (size_t i = 0; i < k; ++i) {
+  const int k = fp.size;
+  for (int i = 0; i < k; ++i) {
     Vec2 a = fp.hull[i];
     if (a.w >= wlo && a.w <= whi) {
       umin = std::min(umin, a.u);

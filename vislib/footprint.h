@@ -19,11 +19,16 @@ struct Vec2 {
   double u = 0, w = 0;
 };
 
+// At most 12 input points and their 66 near-plane crossings; the hull of those has at most
+// (12 + 66) vertices, fixed storage so that the hot loop allocates nothing.
+constexpr int kMaxFootprintPoints = 12 + 66;
+
 struct Footprint {
   // Convex polygon in face coordinates (u, w) = (S.q/F.q, T.q/F.q), counter-clockwise; may be a
   // point or a segment; empty when nothing of W lies at z >= near (invisible on this face).
-  std::vector<Vec2> hull;
-  bool empty() const { return hull.empty(); }
+  std::array<Vec2, kMaxFootprintPoints> hull;
+  int size = 0;
+  bool empty() const { return size == 0; }
 };
 
 // `rel` holds the eye-relative points (e.g. a-v0, ..., c-v1: any count up to 12); `axes` the

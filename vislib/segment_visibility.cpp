@@ -88,14 +88,17 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
 
 namespace {
 
-struct TileResult {
-  std::vector<uint32_t> visible;   // sorted unique
-  std::vector<Witness> witnesses;  // per id in `visible` if wanted, with piece length in t
-  std::vector<double> witness_len;
-  SegmentStats stats;
+// What one thread found: a mark per visible triangle and, if wanted, its best witness so far.
+// Threads are reduced with a total order (union; best witness by better_witness), so the result
+// does not depend on which thread handled which tile.
+struct ThreadFound {
+  std::vector<uint8_t> seen;        // per triangle id
+  std::vector<double> witness_len;  // per triangle id: length of the witness piece (-1 = none)
+  std::vector<Witness> witness;     // per triangle id
 };
 
 // Witness order: longer piece first, then lower face, row, column.
+// A missing witness has length -1 and loses to any real one.
 bool better_witness(double len_a, const Witness& a, double len_b, const Witness& b) {
   if (len_a != len_b) return len_a > len_b;
   if (a.face != b.face) return a.face < b.face;
@@ -118,15 +121,31 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   const int tiles_x = (N + TS - 1) / TS;
   const int tile_count = tiles_x * tiles_x;
   const size_t ntri = scene.triangle_count();
-  const Vec3 delta = v1 - v0;
 
   SegmentResult result;
   if (opt.want_pieces) result.pieces.resize(size_t(6) * N * N);
-  std::vector<TileResult> tile_results(size_t(6) * tile_count);
+  std::vector<SegmentStats> tile_stats(size_t(6) * tile_count);
 
-  // Scratch per thread: the pixel lists of one tile (capacity kept between tiles).
-  tbb::enumerable_thread_specific<std::vector<PieceList>> scratch(
-      [TS] { return std::vector<PieceList>(size_t(TS) * TS); });
+  // Scratch per thread: the pixel lists of one tile (capacity kept between tiles), and for each
+  // pixel whether its list covers [0,1] and its farthest depth (for depth culling).
+  struct TileScratch {
+    std::vector<PieceList> lists;
+    std::vector<uint8_t> full;
+    std::vector<double> far;
+  };
+  tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
+    return TileScratch{std::vector<PieceList>(size_t(TS) * TS), std::vector<uint8_t>(size_t(TS) * TS),
+                       std::vector<double>(size_t(TS) * TS)};
+  });
+  tbb::enumerable_thread_specific<ThreadFound> found_by_thread([&] {
+    ThreadFound f;
+    f.seen.assign(ntri, 0);
+    if (opt.want_witnesses) {
+      f.witness_len.assign(ntri, -1.0);
+      f.witness.resize(ntri);
+    }
+    return f;
+  });
 
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
@@ -177,46 +196,50 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
 
     // (3) tiles in parallel.
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-      auto& lists = scratch.local();
+      TileScratch& sc = scratch.local();
+      auto& lists = sc.lists;
+      ThreadFound& found = found_by_thread.local();
       for (int tile = r.begin(); tile != r.end(); ++tile) {
-        TileResult& out = tile_results[size_t(face) * tile_count + tile];
+        SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
         const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
         const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
         const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
         for (auto& l : lists) l.clear();
+        std::fill(sc.full.begin(), sc.full.end(), 0);
+        std::fill(sc.far.begin(), sc.far.end(), INFINITY);
         FaceTriangle* tb = bins.data() + bin_start[tile];
         FaceTriangle* te = bins.data() + bin_start[tile + 1];
         // Front to back (nearest possible depth), ties by id: the order only affects speed.
         std::sort(tb, te, [](const FaceTriangle& a, const FaceTriangle& b) {
           return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
         });
-        out.stats.triangle_tiles += uint64_t(te - tb);
-        double tile_far = INFINITY;  // farthest depth in the tile once every pixel is covered
+        stats.triangle_tiles += uint64_t(te - tb);
+        // Depth culling (exact): a pixel whose list covers [0,1] with every piece nearer than a
+        // triangle's nearest possible depth cannot show that triangle; when that holds for every
+        // pixel of the tile, no later triangle (sorted by that depth) can show anywhere in it.
+        double tile_far = INFINITY;
         int since_check = 0;
         for (FaceTriangle* ft = tb; ft != te; ++ft) {
+          const double tz = double(ft->zmin);
           if (opt.depth_culling) {
-            if (++since_check >= 32 || ft == tb) {
+            if (++since_check >= 16 || ft == tb) {
               since_check = 0;
-              bool full = true;
               double far = -INFINITY;
-              for (int k = 0; k < tw * th && full; ++k) {
-                const PieceList& l = lists[size_t(k / tw) * TS + k % tw];
-                full = covers_segment(l);
-                far = std::max(far, farthest_depth(l));
-              }
-              tile_far = full ? far : INFINITY;
+              for (int k = 0; k < th && far < INFINITY; ++k)
+                for (int i = 0; i < tw; ++i) far = std::max(far, sc.far[size_t(k) * TS + i]);
+              tile_far = far;
             }
-            if (double(ft->zmin) > tile_far) {  // sorted: every later triangle is farther too
-              out.stats.culled_triangle_tiles += uint64_t(te - ft);
+            if (tz > tile_far) {
+              stats.culled_triangle_tiles += uint64_t(te - ft);
               break;
             }
           }
           auto c = scene.corners(ft->id, opt.state);
-          Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-          Footprint fp = compute_footprint(rel, 6, axes, opt.near);
           Vec3 corners[3] = {c[0], c[1], c[2]};
           StaticTriangle st = prepare_static_triangle(corners, v0, v1);
           if (st.n == Vec3{0, 0, 0}) continue;  // degenerate: never covers (H5)
+          Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
+          Footprint fp = compute_footprint(rel, 6, axes, opt.near);
           int y0 = std::max(ty0, bbox[size_t(ft->id) * 4 + 2]);
           int y1 = std::min(ty1, bbox[size_t(ft->id) * 4 + 3]);
           for (int y = y0; y <= y1; ++y) {
@@ -225,88 +248,82 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
             x0 = std::max(x0, tx0);
             x1 = std::min(x1, tx1);
             for (int x = x0; x <= x1; ++x) {
-              ++out.stats.pair_tests;
+              const size_t k = size_t(y - ty0) * TS + (x - tx0);
+              if (opt.depth_culling && tz > sc.far[k]) {
+                ++stats.culled_pairs;
+                continue;
+              }
+              ++stats.pair_tests;
               Vec3 d = pixel_direction(axes, x, y, N);
               double lo, hi;
               LinearDepth depth;
               if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
-              ++out.stats.covered_pairs;
-              insert_piece(lists[size_t(y - ty0) * TS + (x - tx0)], Piece{lo, hi, ft->id, depth});
+              ++stats.covered_pairs;
+              PieceList& l = lists[k];
+              insert_piece(l, Piece{lo, hi, ft->id, depth});
+              if (opt.depth_culling && covers_segment(l)) sc.far[k] = farthest_depth(l);
             }
           }
         }
-        (void)delta;
-        // (4) tile results.
+        // Tile results: marks, witnesses, statistics.
         size_t bytes = 0;
-        std::vector<std::pair<uint32_t, Witness>> found;
-        std::vector<double> found_len;
         for (int y = ty0; y <= ty1; ++y)
           for (int x = tx0; x <= tx1; ++x) {
             PieceList& l = lists[size_t(y - ty0) * TS + (x - tx0)];
             bytes += l.capacity() * sizeof(Piece);
             if (l.empty()) continue;
-            ++out.stats.pixels_with_pieces;
-            out.stats.final_pieces += l.size();
-            out.stats.max_pieces_per_pixel = std::max<uint64_t>(out.stats.max_pieces_per_pixel, l.size());
+            ++stats.pixels_with_pieces;
+            stats.final_pieces += l.size();
+            stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
             for (const Piece& p : l) {
               double len = p.t1 - p.t0;
               if (!(len > opt.eps_len)) continue;
-              found.push_back({p.id, Witness{p.id, face, x, y, 0.5 * (p.t0 + p.t1)}});
-              found_len.push_back(len);
+              found.seen[p.id] = 1;
+              if (opt.want_witnesses) {
+                Witness w{p.id, face, x, y, 0.5 * (p.t0 + p.t1)};
+                if (better_witness(len, w, found.witness_len[p.id], found.witness[p.id])) {
+                  found.witness_len[p.id] = len;
+                  found.witness[p.id] = w;
+                }
+              }
             }
             if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
           }
-        out.stats.peak_tile_bytes = double(bytes);
-        // Best witness per id within the tile.
-        std::vector<size_t> order(found.size());
-        for (size_t k = 0; k < order.size(); ++k) order[k] = k;
-        std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-          if (found[a].first != found[b].first) return found[a].first < found[b].first;
-          return better_witness(found_len[a], found[a].second, found_len[b], found[b].second);
-        });
-        for (size_t k : order) {
-          if (!out.visible.empty() && out.visible.back() == found[k].first) continue;
-          out.visible.push_back(found[k].first);
-          if (opt.want_witnesses) {
-            out.witnesses.push_back(found[k].second);
-            out.witness_len.push_back(found_len[k]);
-          }
-        }
+        stats.peak_tile_bytes = double(bytes);
       }
     });
   }
 
-  // (4) reduce in tile order: the union of ids, the best witness per id.
-  std::vector<uint32_t> all;
-  for (const TileResult& tr : tile_results) {
-    all.insert(all.end(), tr.visible.begin(), tr.visible.end());
+  // (4) reduce: statistics in tile order; marks and witnesses over threads by a total order.
+  for (const SegmentStats& ts : tile_stats) {
     SegmentStats& s = result.stats;
-    s.pair_tests += tr.stats.pair_tests;
-    s.covered_pairs += tr.stats.covered_pairs;
-    s.final_pieces += tr.stats.final_pieces;
-    s.pixels_with_pieces += tr.stats.pixels_with_pieces;
-    s.max_pieces_per_pixel = std::max(s.max_pieces_per_pixel, tr.stats.max_pieces_per_pixel);
-    s.triangle_tiles += tr.stats.triangle_tiles;
-    s.culled_triangle_tiles += tr.stats.culled_triangle_tiles;
-    s.peak_tile_bytes = std::max(s.peak_tile_bytes, tr.stats.peak_tile_bytes);
+    s.pair_tests += ts.pair_tests;
+    s.culled_pairs += ts.culled_pairs;
+    s.covered_pairs += ts.covered_pairs;
+    s.final_pieces += ts.final_pieces;
+    s.pixels_with_pieces += ts.pixels_with_pieces;
+    s.max_pieces_per_pixel = std::max(s.max_pieces_per_pixel, ts.max_pieces_per_pixel);
+    s.triangle_tiles += ts.triangle_tiles;
+    s.culled_triangle_tiles += ts.culled_triangle_tiles;
+    s.peak_tile_bytes = std::max(s.peak_tile_bytes, ts.peak_tile_bytes);
   }
-  std::sort(all.begin(), all.end());
-  all.erase(std::unique(all.begin(), all.end()), all.end());
-  result.visible = std::move(all);
-  if (opt.want_witnesses) {
-    std::vector<int64_t> slot(ntri, -1);
-    for (size_t k = 0; k < result.visible.size(); ++k) slot[result.visible[k]] = int64_t(k);
-    result.witnesses.resize(result.visible.size());
-    std::vector<double> best(result.visible.size(), -1.0);
-    for (const TileResult& tr : tile_results)
-      for (size_t k = 0; k < tr.witnesses.size(); ++k) {
-        int64_t s = slot[tr.witnesses[k].tri];
-        if (best[s] < 0 || better_witness(tr.witness_len[k], tr.witnesses[k], best[s], result.witnesses[s])) {
-          best[s] = tr.witness_len[k];
-          result.witnesses[s] = tr.witnesses[k];
+  std::vector<uint8_t> seen(ntri, 0);
+  std::vector<double> best_len(opt.want_witnesses ? ntri : 0, -1.0);
+  std::vector<Witness> best(opt.want_witnesses ? ntri : 0);
+  for (const ThreadFound& f : found_by_thread) {
+    for (size_t t = 0; t < ntri; ++t) seen[t] |= f.seen[t];
+    if (opt.want_witnesses)
+      for (size_t t = 0; t < ntri; ++t)
+        if (f.witness_len[t] >= 0 && better_witness(f.witness_len[t], f.witness[t], best_len[t], best[t])) {
+          best_len[t] = f.witness_len[t];
+          best[t] = f.witness[t];
         }
-      }
   }
+  for (size_t t = 0; t < ntri; ++t)
+    if (seen[t]) {
+      result.visible.push_back(uint32_t(t));
+      if (opt.want_witnesses) result.witnesses.push_back(best[t]);
+    }
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

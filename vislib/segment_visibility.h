@@ -45,6 +45,7 @@ struct Witness {
 
 struct SegmentStats {
   uint64_t pair_tests = 0;         // (triangle, pixel) coverage evaluations
+  uint64_t culled_pairs = 0;       // (triangle, pixel) pairs skipped by per-pixel depth culling
   uint64_t covered_pairs = 0;      // of which gave a non-empty interval
   uint64_t final_pieces = 0;       // pieces in all final lists
   uint64_t pixels_with_pieces = 0;
