@@ -144,9 +144,7 @@ TEST(SegmentHardCases, H7_TJunctionLeaksNothingExactAndNothingAfterEpsLenWhenRou
     // Edge PQ of the big triangle is shared by two small triangles meeting at M on it.
     Vec3 P{-4, -1, 5}, Q{4, 1.3, 5}, M = (P + Q) * 0.5;
     if (rounded) M = M + Vec3{1e-15, -2e-15, 0};
-    Scene s = soup({{P, Q, Vec3{0, 8, 5}},           // above PQ
-                    {Q, P, Vec3{-4, -8, 5}}});       // placeholder, replaced below
-    s = soup({{P, Q, Vec3{0, 8, 5}}, {M, P, Vec3{-3, -8, 5}}, {Q, M, Vec3{-3, -8, 5}},
+    Scene s = soup({{P, Q, Vec3{0, 8, 5}}, {M, P, Vec3{-3, -8, 5}}, {Q, M, Vec3{-3, -8, 5}},
               {Q, Vec3{-3, -8, 5}, Vec3{6, -8, 5}}});
     uint32_t bg = uint32_t(s.triangle_count());
     vislib_test::add_quad(s, {-2, -2, 9}, {2, -2, 9}, {2, 2, 9}, {-2, 2, 9});
@@ -161,8 +159,11 @@ TEST(SegmentHardCases, H7_TJunctionLeaksNothingExactAndNothingAfterEpsLenWhenRou
     for (const auto& l : r.pieces)
       for (const auto& p : l)
         if (p.id >= bg) worst = std::max(worst, p.t1 - p.t0);
-    if (!rounded) EXPECT_EQ(worst, 0.0);
-    else EXPECT_LE(worst, 1e-12);
+    if (!rounded) {
+      EXPECT_EQ(worst, 0.0);
+    } else {
+      EXPECT_LE(worst, 1e-12);
+    }
   }
 }
 

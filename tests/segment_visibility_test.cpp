@@ -181,7 +181,9 @@ TEST(IntervalList, ResultDoesNotDependOnInsertionOrder) {
         best = &p;
     auto got = lookup(ref, t);
     ASSERT_EQ(bool(best), bool(got));
-    if (best && std::fabs(best->depth.at(t) - got->depth.at(t)) > 1e-12) EXPECT_EQ(got->id, best->id) << t;
+    if (best && std::fabs(best->depth.at(t) - got->depth.at(t)) > 1e-12) {
+      EXPECT_EQ(got->id, best->id) << t;
+    }
   }
 }
 
