@@ -177,9 +177,9 @@ TEST(SegmentHardCases, H8_InterpenetratingTrianglesSplitAtTheDepthCrossingInEith
     ASSERT_EQ(l.size(), 2u);
     EXPECT_EQ(l[0].id, 2u);
     EXPECT_EQ(l[0].t0, 0.0);
-    // The crossing (L0_j - L0_i)/(L1_i - L1_j) is 0.5 up to the rounding of the depth lines; the
-    // two pieces meet at one bit-identical t whatever the insertion order.
-    EXPECT_NEAR(l[0].t1, 0.5, 1e-15);
+    // The crossing from P = N_i D_j - N_j D_i (math note §3.4) is exactly 0.5 here; the slope and
+    // offset form (L0 = N0/Dn, L1 = -N1/Dn) gave 0.49999999999998934.
+    EXPECT_EQ(l[0].t1, 0.5);
     EXPECT_EQ(l[1].id, 1u);
     EXPECT_EQ(l[1].t0, l[0].t1);
     EXPECT_EQ(l[1].t1, 1.0);

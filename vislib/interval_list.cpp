@@ -50,6 +50,23 @@ void insert_piece(PieceList& list, const Piece& p) {
   size_t first = size_t(std::upper_bound(list.begin(), list.end(), s,
                                          [](double v, const Piece& q) { return v < q.t1; }) -
                         list.begin());
+  // Read-only pass first: most insertions (front-to-back order) are hidden everywhere and must
+  // leave the list untouched; find that out without rebuilding anything.
+  {
+    bool changes = false;
+    double cur = s;
+    for (size_t i = first; i < list.size() && list[i].t0 < f && !changes; ++i) {
+      const Piece& I = list[i];
+      if (cur < I.t0) {
+        changes = true;  // a gap the new interval fills
+        break;
+      }
+      double lo = std::max(cur, I.t0), hi = std::min(f, I.t1), tc;
+      changes = crossing(I, p, lo, hi, tc) || &front(I, p, 0.5 * (lo + hi)) == &p;
+      cur = hi;
+    }
+    if (!changes && cur >= f) return;
+  }
   size_t count;  // pieces now standing where list[first, i) stood
   if (first == list.size() || list[first].t0 >= f) {
     // Fast path: nothing overlaps; insert in the gap.
