@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "cli/load_scene.h"
 #include "vislib/file_util.h"
 #include "vislib/import.h"
 #include "vislib/region_visibility.h"
@@ -100,11 +101,7 @@ void write_json(const std::string& path, const json& j) {
 
 vislib::Scene load(const VisibilityArgs& a, double& seconds) {
   auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::string> warnings;
-  vislib::LoadOptions lo;
-  lo.states = a.states;
-  vislib::Scene scene = vislib::load_scene(a.scene, lo, &warnings);
-  for (const auto& w : warnings) warn(w);
+  vislib::Scene scene = load_scene_for_cli(a.scene, a.states);
   if (scene.sphere_count() > 0) warn(a.scene + ": spheres are not handled by the static kernel yet; ignored");
   if (scene.is_dynamic()) warn(a.scene + ": the scene is animated; the static kernel uses key state 0");
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -10,5 +10,5 @@ mkdir -p out
 echo "== pvs info data/city.glb"
 build/cli/pvs info data/city.glb
 echo "== pvs region data/city.glb (view rectangle at eye height; see docs/cli.md)"
-build/cli/pvs region data/city.glb --box 2,1.7,2,40,1.7,6 --runs 2 --res 256 --json out/region.json
+build/cli/pvs region data/city.glb --box -3,1.7,-20,3,1.7,20 --runs 2 --res 256 --json out/region.json
 echo "wrote out/region.json"
