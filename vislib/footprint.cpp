@@ -48,6 +48,21 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
   Vec3 q[12];
   count = std::min(count, 12);
   for (int i = 0; i < count; ++i) q[i] = {dot(axes.S, rel[i]), dot(axes.T, rel[i]), dot(axes.F, rel[i])};
+  // Quick reject: all points on the outer side of one plane of the face's frustum (near plane, or
+  // one of |u| <= 1, |w| <= 1 widened by a relative 1e-6), so the clipped hull misses the face.
+  {
+    const double g = 1.0 + 1e-6;
+    bool behind = true, right = true, left = true, up = true, down = true;
+    for (int i = 0; i < count; ++i) {
+      const double z = std::fabs(q[i].z) * g;
+      behind = behind && q[i].z < near;
+      right = right && q[i].x > z;
+      left = left && q[i].x < -z;
+      up = up && q[i].y > z;
+      down = down && q[i].y < -z;
+    }
+    if (behind || right || left || up || down) return Footprint{};
+  }
   Vec2 pts[kMaxFootprintPoints];
   int n = 0;
   for (int i = 0; i < count; ++i)

@@ -43,7 +43,7 @@ void push(PieceList& out, const Piece& src, double t0, double t1) {
 
 }  // namespace
 
-void insert_piece(PieceList& list, const Piece& p) {
+bool insert_piece(PieceList& list, const Piece& p) {
   assert(p.t0 < p.t1);
   const double s = p.t0, f = p.t1;
   // First piece ending after s (t1 increases along the list).
@@ -65,7 +65,7 @@ void insert_piece(PieceList& list, const Piece& p) {
       changes = crossing(I, p, lo, hi, tc) || &front(I, p, 0.5 * (lo + hi)) == &p;
       cur = hi;
     }
-    if (!changes && cur >= f) return;
+    if (!changes && cur >= f) return false;
   }
   size_t count;  // pieces now standing where list[first, i) stood
   if (first == list.size() || list[first].t0 >= f) {
@@ -111,6 +111,7 @@ void insert_piece(PieceList& list, const Piece& p) {
   };
   merge_at(first + count - 1);
   if (first > 0) merge_at(first - 1);
+  return true;
 }
 
 std::optional<Piece> lookup(const PieceList& list, double t) {

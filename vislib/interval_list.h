@@ -32,8 +32,9 @@ struct Piece {
 using PieceList = std::vector<Piece>;
 
 // Inserts the coverage interval `p` (p.t0 < p.t1) into `list` (sorted, disjoint, merged).
+// Returns false when the list is unchanged (p is hidden wherever it overlaps the list).
 // Not thread-safe for the same list; lists are per pixel.
-void insert_piece(PieceList& list, const Piece& p);
+bool insert_piece(PieceList& list, const Piece& p);
 
 // The piece covering t (t0 <= t < t1), if any.
 std::optional<Piece> lookup(const PieceList& list, double t);

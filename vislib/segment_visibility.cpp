@@ -260,8 +260,8 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
               if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
               ++stats.covered_pairs;
               PieceList& l = lists[k];
-              insert_piece(l, Piece{lo, hi, ft->id, depth});
-              if (opt.depth_culling && covers_segment(l)) sc.far[k] = farthest_depth(l);
+              if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling && covers_segment(l))
+                sc.far[k] = farthest_depth(l);
             }
           }
         }
