@@ -33,3 +33,68 @@ inline int solve_quadratic(double a, double b, double c, double r[2]) {
 }
 
 }  // namespace vislib
+
+namespace vislib {
+
+// c[0] + c[1] t + ... + c[deg] t^deg (Horner).
+inline double poly_eval(const double* c, int deg, double t) {
+  double r = c[deg];
+  for (int k = deg - 1; k >= 0; --k) r = r * t + c[k];
+  return r;
+}
+
+// Roots of c[0..deg] (deg <= 6) strictly inside (lo, hi), ascending, written to out (at most
+// deg). Degree <= 2: closed form (solve_quadratic; may include a double root). Higher: the roots
+// of the derivative cut (lo, hi) into monotone pieces, and each piece whose ends differ in sign is
+// bisected to the last bit (Yuksel, HPG 2022, math note §3.4). Leading zero coefficients are
+// dropped. Callers classify the pieces between roots by their midpoints.
+inline int poly_roots_in(const double* c_in, int deg, double lo, double hi, double* out) {
+  double c[7];
+  for (int k = 0; k <= deg; ++k) c[k] = c_in[k];
+  while (deg > 0 && c[deg] == 0) --deg;
+  if (deg <= 0) return 0;
+  int n = 0;
+  if (deg <= 2) {
+    double r[2];
+    int m = deg == 2 ? solve_quadratic(c[2], c[1], c[0], r) : solve_quadratic(0, c[1], c[0], r);
+    for (int k = 0; k < m; ++k)
+      if (r[k] > lo && r[k] < hi && (n == 0 || r[k] != out[n - 1])) out[n++] = r[k];
+    return n;
+  }
+  double d[6];
+  for (int k = 1; k <= deg; ++k) d[k - 1] = double(k) * c[k];
+  double pts[8];
+  int np = 0;
+  pts[np++] = lo;
+  np += poly_roots_in(d, deg - 1, lo, hi, pts + np);
+  pts[np++] = hi;
+  for (int k = 0; k + 1 < np; ++k) {
+    double a = pts[k], b = pts[k + 1];
+    double fa = poly_eval(c, deg, a), fb = poly_eval(c, deg, b);
+    if (fa == 0 && k > 0) {  // a critical point that is a root
+      if (n == 0 || out[n - 1] != a) out[n++] = a;
+      continue;
+    }
+    if (!((fa < 0 && fb > 0) || (fa > 0 && fb < 0))) continue;
+    for (int it = 0; it < 200; ++it) {
+      double m = 0.5 * (a + b);
+      if (m <= a || m >= b) break;
+      double fm = poly_eval(c, deg, m);
+      if (fm == 0) {
+        a = b = m;
+        break;
+      }
+      if ((fm < 0) == (fa < 0)) {
+        a = m;
+        fa = fm;
+      } else {
+        b = m;
+      }
+    }
+    double r = 0.5 * (a + b);
+    if (r > lo && r < hi && (n == 0 || out[n - 1] != r)) out[n++] = r;
+  }
+  return n;
+}
+
+}  // namespace vislib

@@ -115,6 +115,7 @@ struct FaceTriangle {
 
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
   assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
+  if (scene.sphere_count() > 0 || scene.is_dynamic()) return dynamic_segment_visibility(scene, v0, v1, opt);
   auto start = std::chrono::steady_clock::now();
   const int N = opt.resolution;
   const int TS = opt.tile_size;
@@ -280,7 +281,12 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
               if (!(len > opt.eps_len)) continue;
               found.seen[p.id] = 1;
               if (opt.want_witnesses) {
-                Witness w{p.id, face, x, y, 0.5 * (p.t0 + p.t1)};
+                Witness w;
+                w.tri = p.id;
+                w.face = face;
+                w.x = x;
+                w.y = y;
+                w.t = 0.5 * (p.t0 + p.t1);
                 if (better_witness(len, w, found.witness_len[p.id], found.witness[p.id])) {
                   found.witness_len[p.id] = len;
                   found.witness[p.id] = w;

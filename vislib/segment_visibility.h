@@ -23,6 +23,15 @@
 
 namespace vislib {
 
+// How animation time relates to the eye's motion in a dynamic scene (docs/visibility.md):
+//  Diagonal (the paper's mode): scene time tau and the segment parameter t advance together
+//    (tau = t), one space-time diagonal per state interval;
+//  Decoupled (what a VR user needs, any eye position at any time): the diagonal plus the boundary
+//    of the (t, tau) square: the eye fixed at each segment end while the scene animates, and the
+//    scene frozen at each key state while the eye moves. An approximation of the full square, as
+//    the perimeter is of a view rectangle.
+enum class DynamicMode { Diagonal, Decoupled };
+
 struct SegmentOptions {
   int resolution = 512;                   // N: each cube face is N x N pixels; must be >= 1
   double near = kDefaultNear;             // z_near > 0, view depth in scene units
@@ -32,15 +41,18 @@ struct SegmentOptions {
   bool want_pieces = false;               // keep every pixel's final list (memory: 6 N^2 lists)
   int tile_size = 32;                     // pixels per tile side (memory/parallelism grain)
   bool depth_culling = true;              // skip triangles behind a tile's fully covered pixels
-  size_t state = 0;                       // which key state of the scene to use
+  size_t state = 0;                       // static scenes: which key state to use
+  DynamicMode mode = DynamicMode::Diagonal;  // dynamic scenes (moving vertices or spheres)
 };
 
 // A pixel and a t at which `tri` is the first hit: the middle of its longest final piece
 // (ties: lowest face, then row, then column).
 struct Witness {
-  uint32_t tri = 0;
+  uint32_t tri = 0;        // triangle id, or sphere index when is_sphere
+  bool is_sphere = false;
   int face = 0, x = 0, y = 0;
-  double t = 0;
+  double t = 0;            // eye at v0 + t (v1 - v0)
+  double tau = 0;          // animation time in [0,1] (static scenes: 0)
 };
 
 struct SegmentStats {
@@ -59,17 +71,46 @@ struct SegmentStats {
   }
 };
 
+// Depth along a pixel ray in the dynamic kernel (math note §3.2, §4): a rational N(t)/D(t)
+// (cubic over quadratic; static triangles have degrees 1 and 0) or a sphere's near or far root.
+struct GeneralDepth {
+  enum Kind : uint8_t { Rational, SphereNear, SphereFar };
+  Kind kind = Rational;
+  // Rational: N0..N3 then D0..D2. Sphere: h0 h1 (d.w), m0 m1 m2 (|w|^2 - r^2), g0 g1 g2
+  // (r^2|d|^2 - |d x w|^2), then |d|^2.
+  double c[9] = {};
+  double at(double t) const;
+};
+// Crossings of two depths inside (lo, hi), pair in id order: exact polynomial roots of
+// P = N_i D_j - N_j D_i for two triangles; for a sphere, sign changes of the depth difference
+// sampled at 32 points and bisected (math note §4: may miss two crossings closer than 1/32 of the
+// overlap; pieces that short are below what the samples resolve).
+int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi, double* out);
+using GeneralPiece = PieceT<GeneralDepth>;
+
 struct SegmentResult {
   std::vector<uint32_t> visible;     // sorted triangle ids
+  std::vector<uint32_t> visible_spheres;  // sorted sphere indices (dynamic kernel)
   std::vector<Witness> witnesses;    // if requested: one per visible id, in id order
   // If requested: final list of pixel (face, x, y) at index (face * N + y) * N + x.
   std::vector<PieceList> pieces;
+  // If requested, for dynamic scenes in Diagonal mode (instead of `pieces`): same indexing; ids
+  // are triangle ids, and triangle_count + s for sphere s. t0, t1 are on the whole segment; each
+  // depth function stays in the local parameter of its state interval [t_k, t_k+1] (evaluate it
+  // at (t - t_k) / (t_k+1 - t_k), with t_k = k / (states - 1)).
+  std::vector<std::vector<GeneralPiece>> general_pieces;
   SegmentStats stats;
 };
 
-// Visibility of the scene's triangles (key state `options.state`) from the segment v0 -> v1.
-// Spheres are ignored here. Thread-safe (reads the scene only); parallel with TBB.
+// Visibility of the scene's triangles and spheres from the segment v0 -> v1. A static scene
+// without spheres takes the linear path (key state `options.state`); a scene with moving vertices
+// or spheres takes the dynamic kernel (dynamic_visibility.cpp; quadratic events only for what
+// moves) in `options.mode`. Thread-safe (reads the scene only); parallel with TBB.
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& options);
+
+// The dynamic kernel alone (also for static scenes, e.g. to compare both paths in tests).
+SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
+                                         const SegmentOptions& options);
 
 // ---- The steps, exposed for tests ----------------------------------------------------------
 
