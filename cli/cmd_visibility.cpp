@@ -29,6 +29,7 @@ struct VisibilityArgs {
   int tile = 32;
   int states = 1;
   std::string granularity = "triangle";
+  std::string mode = "diagonal";
   std::string json_out;
 };
 
@@ -50,8 +51,14 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
   cmd->add_option("--tile", a.tile, "Tile side in pixels (memory/parallelism grain)")
       ->check(CLI::Range(1, 4096))
       ->capture_default_str();
-  cmd->add_option("--states", a.states, "Key states to sample animations into (static kernel uses state 0)")
+  cmd->add_option("--states", a.states, "Key states to sample glTF animations into (dynamic scenes)")
       ->check(CLI::Range(1, 100000));
+  cmd->add_option("--mode", a.mode,
+                  "Dynamic scenes: 'diagonal' (animation time advances with the eye, the paper's mode) or "
+                  "'decoupled' (also the eye fixed at each end while the scene animates, and the scene "
+                  "frozen at each state while the eye moves)")
+      ->check(CLI::IsMember({"diagonal", "decoupled"}))
+      ->capture_default_str();
   cmd->add_option("--json", a.json_out, "Write the result as JSON to this file ('-' = stdout)")->required();
 }
 
@@ -61,6 +68,7 @@ vislib::SegmentOptions segment_options(const VisibilityArgs& a) {
   o.near = a.near;
   o.eps_len = a.eps_len;
   o.tile_size = a.tile;
+  o.mode = a.mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
   return o;
 }
 
@@ -87,8 +95,8 @@ json counts_json(const vislib::SegmentStats& s) {
 }
 
 std::vector<uint32_t> at_granularity(const vislib::Scene& scene, const std::vector<uint32_t>& tris,
-                                     const std::string& granularity) {
-  return granularity == "object" ? vislib::objects_of(scene, tris) : tris;
+                                     const std::vector<uint32_t>& spheres, const std::string& granularity) {
+  return granularity == "object" ? vislib::objects_of(scene, tris, spheres) : tris;
 }
 
 void write_json(const std::string& path, const json& j) {
@@ -102,8 +110,6 @@ void write_json(const std::string& path, const json& j) {
 vislib::Scene load(const VisibilityArgs& a, double& seconds) {
   auto t0 = std::chrono::steady_clock::now();
   vislib::Scene scene = load_scene_for_cli(a.scene, a.states);
-  if (scene.sphere_count() > 0) warn(a.scene + ": spheres are not handled by the static kernel yet; ignored");
-  if (scene.is_dynamic()) warn(a.scene + ": the scene is animated; the static kernel uses key state 0");
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return scene;
 }
@@ -153,19 +159,24 @@ void add_segment(CLI::App& app) {
               {"to", vec_json(v1)},
               {"orientation", mat_json(so.orientation)},
               {"granularity", a->granularity},
-              {"visible", at_granularity(scene, r.visible, a->granularity)},
+              {"mode", a->mode},
+              {"states", scene.state_count()},
+              {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
+              {"visible_spheres", r.visible_spheres},
               {"visible_triangles", r.visible.size()}};
     json w = json::array();
     for (const auto& x : r.witnesses)
-      w.push_back({{"tri", x.tri}, {"face", x.face}, {"x", x.x}, {"y", x.y}, {"t", x.t}});
+      w.push_back({{x.is_sphere ? "sphere" : "tri", x.tri}, {"face", x.face}, {"x", x.x}, {"y", x.y}, {"t", x.t},
+                   {"tau", x.tau}});
     j["witnesses"] = w;
     j["timings"] = {{"load_seconds", load_s}, {"visibility_seconds", r.stats.seconds}};
     j["counts"] = counts_json(r.stats);
     j["counts"]["scene_triangles"] = scene.triangle_count();
     j["counts"]["peak_rss_bytes"] = peak_rss_bytes();
     write_json(a->json_out, j);
-    std::fprintf(stderr, "pvs segment: %zu of %zu triangles visible (%.3f s, %.2f pieces/pixel)\n",
-                 r.visible.size(), scene.triangle_count(), r.stats.seconds, r.stats.pieces_per_pixel());
+    std::fprintf(stderr, "pvs segment: %zu of %zu triangles and %zu of %zu spheres visible (%.3f s, %.2f pieces/pixel)\n",
+                 r.visible.size(), scene.triangle_count(), r.visible_spheres.size(), scene.sphere_count(),
+                 r.stats.seconds, r.stats.pieces_per_pixel());
   });
 }
 
@@ -208,7 +219,8 @@ void add_region(CLI::App& app) {
         if (rec.segment != s) continue;
         runs_j.push_back({{"run", rec.run},
                           {"orientation", mat_json(rec.orientation)},
-                          {"visible", at_granularity(scene, rec.visible, a->granularity)},
+                          {"visible", at_granularity(scene, rec.visible, rec.visible_spheres, a->granularity)},
+                          {"visible_spheres", rec.visible_spheres},
                           {"timings", {{"visibility_seconds", rec.stats.seconds}}},
                           {"counts", counts_json(rec.stats)},
                           {"union_triangles_after", rec.union_size_after},
@@ -225,7 +237,10 @@ void add_region(CLI::App& app) {
               {"seed", ro.seed},
               {"granularity", a->granularity},
               {"segments", segs},
-              {"visible", at_granularity(scene, r.visible, a->granularity)},
+              {"mode", a->mode},
+              {"states", scene.state_count()},
+              {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
+              {"visible_spheres", r.visible_spheres},
               {"visible_triangles", r.visible.size()},
               {"timings", {{"load_seconds", load_s}, {"visibility_seconds", r.seconds}}},
               {"counts", {{"scene_triangles", scene.triangle_count()}, {"peak_rss_bytes", peak_rss_bytes()}}}};

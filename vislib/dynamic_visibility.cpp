@@ -55,32 +55,65 @@ int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, dou
     for (int k = 0; k < n && m < kMaxCrossings; ++k) out[m++] = r[k];
     return m;
   }
-  // A sphere is involved: sample the depth difference and bisect its sign changes.
-  const int K = 32;
-  auto f = [&](double t) { return i.at(t) - j.at(t); };
-  int m = 0;
-  double a = lo, fa = f(lo);
-  for (int k = 1; k <= K && m < kMaxCrossings; ++k) {
-    double b = k == K ? hi : lo + (hi - lo) * k / K, fb = f(b);
-    if ((fa < 0 && fb > 0) || (fa > 0 && fb < 0)) {
-      double x0 = a, x1 = b, f0 = fa;
-      for (int it = 0; it < 100; ++it) {
-        double xm = 0.5 * (x0 + x1);
-        if (xm <= x0 || xm >= x1) break;
-        double fm = f(xm);
-        if ((fm < 0) == (f0 < 0)) {
-          x0 = xm;
-          f0 = fm;
-        } else {
-          x1 = xm;
-        }
-      }
-      double r = 0.5 * (x0 + x1);
-      if (r > lo && r < hi && (m == 0 || out[m - 1] < r)) out[m++] = r;
-    }
-    a = b;
-    fa = fb;
+  if (i.kind != GeneralDepth::Rational && j.kind != GeneralDepth::Rational) {
+    // Two spheres that stay disjoint over the run keep their depth order (§4): no crossing.
+    // Centre difference o_i - o_j = w_j - w_i = a + t b; its minimum length over [0,1].
+    Vec3 a{j.c[9] - i.c[9], j.c[10] - i.c[10], j.c[11] - i.c[11]};
+    Vec3 b{j.c[12] - i.c[12], j.c[13] - i.c[13], j.c[14] - i.c[14]};
+    double bb = dot(b, b), tm = bb > 0 ? std::clamp(-dot(a, b) / bb, 0.0, 1.0) : 0.0;
+    Vec3 m = a + b * tm;
+    double rr = i.c[15] + j.c[15];
+    if (dot(m, m) > rr * rr * (1 + 1e-9)) return 0;
   }
+  // A sphere is involved. At a crossing the ray's point at the common depth lies on both
+  // surfaces, so the crossing times are among the roots of a polynomial (exact, no sampling):
+  //   sphere-sphere:   Q = den^2 m_i + 2 den num h_i + num^2 |d|^2   (degree 4), with
+  //                    den = 2 (h_i - h_j), num = m_j - m_i (lambda = num / den on the radical plane);
+  //   sphere-triangle: Q = D^2 m + 2 N D h + N^2 |d|^2               (degree 6), lambda = N / D.
+  // Extra roots (e.g. where the far root meets) only add cut points; each sub-piece's winner is
+  // decided at its midpoint.
+  double Q[7] = {};
+  auto mul = [](const double* a, int da, const double* b, int db, double* out) {
+    for (int x = 0; x <= da + db; ++x) out[x] = 0;
+    for (int x = 0; x <= da; ++x)
+      for (int y = 0; y <= db; ++y) out[x + y] += a[x] * b[y];
+  };
+  int deg;
+  if (i.kind != GeneralDepth::Rational && j.kind != GeneralDepth::Rational) {
+    double den[2] = {2 * (i.c[0] - j.c[0]), 2 * (i.c[1] - j.c[1])};
+    double num[3] = {j.c[2] - i.c[2], j.c[3] - i.c[3], j.c[4] - i.c[4]};
+    double hi_[2] = {i.c[0], i.c[1]}, mi[3] = {i.c[2], i.c[3], i.c[4]};
+    double den2[3], a[5], dn[4], b[5], nn[5];
+    mul(den, 1, den, 1, den2);
+    mul(den2, 2, mi, 2, a);
+    mul(den, 1, num, 2, dn);
+    mul(dn, 3, hi_, 1, b);
+    mul(num, 2, num, 2, nn);
+    for (int k = 0; k <= 4; ++k) Q[k] = a[k] + 2 * b[k] + nn[k] * i.c[8];
+    deg = 4;
+  } else {
+    const GeneralDepth& sp = i.kind == GeneralDepth::Rational ? j : i;
+    const GeneralDepth& tr = i.kind == GeneralDepth::Rational ? i : j;
+    const double* N = tr.c;
+    const double* D = tr.c + 4;
+    double h[2] = {sp.c[0], sp.c[1]}, m[3] = {sp.c[2], sp.c[3], sp.c[4]};
+    double D2[5], a[7], ND[6], b[7], NN[7];
+    mul(D, 2, D, 2, D2);
+    mul(D2, 4, m, 2, a);
+    mul(N, 3, D, 2, ND);
+    mul(ND, 5, h, 1, b);
+    mul(N, 3, N, 3, NN);
+    for (int k = 0; k <= 6; ++k) Q[k] = a[k] + 2 * b[k] + NN[k] * sp.c[8];
+    deg = 6;
+  }
+  double scale = 0;
+  for (int k = 0; k <= deg; ++k) scale = std::max(scale, std::fabs(Q[k]));
+  if (scale == 0) return 0;  // identical surfaces along this ray: ties go to the lower id
+  for (int k = 0; k <= deg; ++k) Q[k] /= scale;
+  double r[6];
+  int n = poly_roots_in(Q, deg, lo, hi, r);
+  int m = 0;
+  for (int k = 0; k < n && m < kMaxCrossings; ++k) out[m++] = r[k];
   return m;
 }
 
@@ -248,6 +281,11 @@ int sphere_coverage(const MovingSphere& sp, Vec3 d, double near, Interval* out) 
   base.c[6] = g[1];
   base.c[7] = g[2];
   base.c[8] = dd;
+  for (int k = 0; k < 3; ++k) {
+    base.c[9 + k] = sp.w0[k];
+    base.c[12 + k] = sp.w1[k];
+  }
+  base.c[15] = sp.r;
   int n = 0;
   for (int k = 0; k + 1 < np; ++k) {
     double a = pts[k], b = pts[k + 1];
@@ -277,19 +315,31 @@ int sphere_coverage(const MovingSphere& sp, Vec3 d, double near, Interval* out) 
 
 // Pixel bounds of a sphere seen from a moving eye (§5.2): the tangent-plane boxes at both ends,
 // and their bounding box (the projection of the swept capsule is the convex hull of the two end
-// projections, which the union of the two boxes does not always contain). Full face when the
-// sphere reaches the near plane at an end.
+// projections, which the union of the two boxes does not always contain). When the sphere reaches
+// the near plane at an end: the projection of its clipped bounding box.
 bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, double near, int n, int& x0,
                          int& x1, int& y0, int& y1) {
   double z0 = dot(ax.F, c0w), z1 = dot(ax.F, c1w);
   if (z0 + r <= near && z1 + r <= near) return false;  // the swept ball is behind the near plane
-  if (z0 - r <= near || z1 - r <= near) {               // it reaches the near plane: whole face
-    x0 = y0 = 0;
-    x1 = y1 = n - 1;
-    return true;
-  }
   double umin = INFINITY, umax = -INFINITY, wmin = INFINITY, wmax = -INFINITY;
+  if (z0 - r <= near || z1 - r <= near) {
+    // The swept ball reaches the near plane: bound it by the box around both end balls (face
+    // coordinates), clip the box at z >= near and project its 8 corners (a perspective image of a
+    // convex set in z > 0 is convex, so the corners give its extent).
+    Vec3 lo{std::min(dot(ax.S, c0w), dot(ax.S, c1w)) - r, std::min(dot(ax.T, c0w), dot(ax.T, c1w)) - r,
+            std::max(near, std::min(z0, z1) - r)};
+    Vec3 hi{std::max(dot(ax.S, c0w), dot(ax.S, c1w)) + r, std::max(dot(ax.T, c0w), dot(ax.T, c1w)) + r,
+            std::max(z0, z1) + r};
+    for (int k = 0; k < 8; ++k) {
+      double x = (k & 1) ? hi.x : lo.x, y = (k & 2) ? hi.y : lo.y, z = (k & 4) ? hi.z : lo.z;
+      umin = std::min(umin, x / z);
+      umax = std::max(umax, x / z);
+      wmin = std::min(wmin, y / z);
+      wmax = std::max(wmax, y / z);
+    }
+  }
   for (Vec3 cw : {c0w, c1w}) {
+    if (z0 - r <= near || z1 - r <= near) break;
     double cx = dot(ax.S, cw), cy = dot(ax.T, cw), cz = dot(ax.F, cw);
     double den = cz * cz - r * r;
     double su = std::sqrt(std::max(0.0, cx * cx + cz * cz - r * r));
@@ -351,10 +401,23 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
     return std::array<Vec3, 3>{P[ix[0]], P[ix[1]], P[ix[2]]};
   };
   std::vector<int> bbox(nprim * 4);
+  // Bounds of the view depth of every primitive over the run on this face: any hit of it at any s
+  // has zmin <= lambda <= zmax (the eye-relative triangle lies in the hull of its six eye-relative
+  // vertices; the sphere within r of its eye-relative centre, which moves linearly).
+  std::vector<double> zmin(nprim), zmax(nprim);
   std::vector<uint32_t> bin_start(tile_count + 1);
-  std::vector<uint32_t> bins;
-  tbb::enumerable_thread_specific<std::vector<std::vector<GeneralPiece>>> scratch(
-      [TS] { return std::vector<std::vector<GeneralPiece>>(size_t(TS) * TS); });
+  struct Binned {
+    uint32_t id;
+    double zmin;
+  };
+  std::vector<Binned> bins;
+  struct Scratch {
+    std::vector<std::vector<GeneralPiece>> lists;
+    std::vector<double> far;  // per pixel: farthest zmax over its pieces once they cover [0,1]
+  };
+  tbb::enumerable_thread_specific<Scratch> scratch([TS] {
+    return Scratch{std::vector<std::vector<GeneralPiece>>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS)};
+  });
 
   for (int face = 0; face < 6; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
@@ -366,10 +429,20 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
           auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
           Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0, a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
           ok = footprint_pixel_bounds(compute_footprint(rel, 6, axes, opt.near), N, b[0], b[1], b[2], b[3]);
+          double lo = INFINITY, hi = -INFINITY;
+          for (const Vec3& q : rel) {
+            lo = std::min(lo, dot(axes.F, q));
+            hi = std::max(hi, dot(axes.F, q));
+          }
+          zmin[p] = lo;
+          zmax[p] = hi;
         } else {
           size_t s = p - ntri;
-          ok = sphere_pixel_bounds(C0[s] - run.e0, C1[s] - run.e1, scene.sphere_radius[s], axes, opt.near, N, b[0],
-                                   b[1], b[2], b[3]);
+          double r = scene.sphere_radius[s];
+          ok = sphere_pixel_bounds(C0[s] - run.e0, C1[s] - run.e1, r, axes, opt.near, N, b[0], b[1], b[2], b[3]);
+          double z0 = dot(axes.F, C0[s] - run.e0), z1 = dot(axes.F, C1[s] - run.e1);
+          zmin[p] = std::min(z0, z1) - r;
+          zmax[p] = std::max(z0, z1) + r;
         }
         if (!ok) b[0] = 1, b[1] = 0;
       }
@@ -389,21 +462,52 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
         const int* b = &bbox[p * 4];
         if (b[0] > b[1]) continue;
         for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
-          for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx) bins[fill[ty * tiles_x + tx]++] = uint32_t(p);
+          for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx) bins[fill[ty * tiles_x + tx]++] = {uint32_t(p), zmin[p]};
       }
     }
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-      auto& lists = scratch.local();
+      Scratch& sc = scratch.local();
+      auto& lists = sc.lists;
       Found& found = found_by_thread.local();
       for (int tile = r.begin(); tile != r.end(); ++tile) {
         SegmentStats& stats = all_stats[size_t(face) * tile_count + tile];
         const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
         const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
+        const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
         for (auto& l : lists) l.clear();
+        std::fill(sc.far.begin(), sc.far.end(), INFINITY);
+        Binned* tb = bins.data() + bin_start[tile];
+        Binned* te = bins.data() + bin_start[tile + 1];
+        // Front to back by nearest possible depth (ties by id); exact depth culling as in the
+        // static kernel, with each piece's primitive's zmax as its farthest depth.
+        std::sort(tb, te, [](const Binned& a, const Binned& b) { return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id); });
+        auto update_far = [&](size_t k) {
+          const auto& l = lists[k];
+          if (!covers_segment(l)) return;
+          double f = -INFINITY;
+          for (const GeneralPiece& pc : l) f = std::max(f, zmax[pc.id]);
+          sc.far[k] = f;
+        };
         Interval iv[kMaxIntervals];
-        for (uint32_t k = bin_start[tile]; k < bin_start[tile + 1]; ++k) {
-          const uint32_t p = bins[k];
+        double tile_far = INFINITY;
+        int since_check = 0;
+        for (Binned* bp = tb; bp != te; ++bp) {
+          const uint32_t p = bp->id;
           ++stats.triangle_tiles;
+          if (opt.depth_culling) {
+            if (++since_check >= 16 || bp == tb) {
+              since_check = 0;
+              double f = -INFINITY;
+              for (int yy = 0; yy < th && f < INFINITY; ++yy)
+                for (int xx = 0; xx < tw; ++xx) f = std::max(f, sc.far[size_t(yy) * TS + xx]);
+              tile_far = f;
+            }
+            if (bp->zmin > tile_far) {
+              stats.culled_triangle_tiles += uint64_t(te - bp);
+              stats.triangle_tiles += uint64_t(te - bp) - 1;
+              break;
+            }
+          }
           const int* b = &bbox[size_t(p) * 4];
           const int y0 = std::max(ty0, b[2]), y1 = std::min(ty1, b[3]);
           if (p < ntri) {
@@ -418,11 +522,17 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
               x0 = std::max(x0, tx0);
               x1 = std::min(x1, tx1);
               for (int x = x0; x <= x1; ++x) {
+                const size_t k = size_t(y - ty0) * TS + (x - tx0);
+                if (opt.depth_culling && bp->zmin > sc.far[k]) {
+                  ++stats.culled_pairs;
+                  continue;
+                }
                 ++stats.pair_tests;
                 int n = moving_coverage(mt, pixel_direction(axes, x, y, N), axes.S, axes.T, opt.near, iv);
                 if (n) ++stats.covered_pairs;
-                auto& l = lists[size_t(y - ty0) * TS + (x - tx0)];
-                for (int i = 0; i < n; ++i) insert_piece(l, GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                bool changed = false;
+                for (int i = 0; i < n; ++i) changed |= insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                if (changed && opt.depth_culling) update_far(k);
               }
             }
           } else {
@@ -430,11 +540,17 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
             MovingSphere sp{run.e0 - C0[s], (run.e1 - run.e0) - (C1[s] - C0[s]), scene.sphere_radius[s]};
             for (int y = y0; y <= y1; ++y)
               for (int x = std::max(tx0, b[0]); x <= std::min(tx1, b[1]); ++x) {
+                const size_t k = size_t(y - ty0) * TS + (x - tx0);
+                if (opt.depth_culling && bp->zmin > sc.far[k]) {
+                  ++stats.culled_pairs;
+                  continue;
+                }
                 ++stats.pair_tests;
                 int n = sphere_coverage(sp, pixel_direction(axes, x, y, N), opt.near, iv);
                 if (n) ++stats.covered_pairs;
-                auto& l = lists[size_t(y - ty0) * TS + (x - tx0)];
-                for (int i = 0; i < n; ++i) insert_piece(l, GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                bool changed = false;
+                for (int i = 0; i < n; ++i) changed |= insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                if (changed && opt.depth_culling) update_far(k);
               }
           }
         }
@@ -539,6 +655,8 @@ SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, c
     s.pixels_with_pieces += ts.pixels_with_pieces;
     s.max_pieces_per_pixel = std::max(s.max_pieces_per_pixel, ts.max_pieces_per_pixel);
     s.triangle_tiles += ts.triangle_tiles;
+    s.culled_triangle_tiles += ts.culled_triangle_tiles;
+    s.culled_pairs += ts.culled_pairs;
     s.peak_tile_bytes = std::max(s.peak_tile_bytes, ts.peak_tile_bytes);
   }
   std::vector<uint8_t> seen(nprim, 0);

@@ -48,11 +48,27 @@ inline double poly_eval(const double* c, int deg, double t) {
 // of the derivative cut (lo, hi) into monotone pieces, and each piece whose ends differ in sign is
 // bisected to the last bit (Yuksel, HPG 2022, math note §3.4). Leading zero coefficients are
 // dropped. Callers classify the pieces between roots by their midpoints.
+// False when c[0..deg] certainly has no root in [lo, hi] (0 <= lo <= hi): interval Horner.
+inline bool poly_may_vanish(const double* c, int deg, double lo, double hi) {
+  double a = c[deg], b = c[deg];
+  for (int k = deg - 1; k >= 0; --k) {
+    double p0 = a * lo, p1 = a * hi, p2 = b * lo, p3 = b * hi;
+    a = std::fmin(std::fmin(p0, p1), std::fmin(p2, p3)) + c[k];
+    b = std::fmax(std::fmax(p0, p1), std::fmax(p2, p3)) + c[k];
+    // Widen by the rounding of this step (relative 4 ulp of the magnitudes involved).
+    double e = 4 * 2.2e-16 * (std::fabs(a) + std::fabs(b) + std::fabs(c[k]));
+    a -= e;
+    b += e;
+  }
+  return a <= 0 && b >= 0;
+}
+
 inline int poly_roots_in(const double* c_in, int deg, double lo, double hi, double* out) {
   double c[7];
   for (int k = 0; k <= deg; ++k) c[k] = c_in[k];
   while (deg > 0 && c[deg] == 0) --deg;
   if (deg <= 0) return 0;
+  if (deg > 2 && lo >= 0 && !poly_may_vanish(c, deg, lo, hi)) return 0;
   int n = 0;
   if (deg <= 2) {
     double r[2];
@@ -76,20 +92,28 @@ inline int poly_roots_in(const double* c_in, int deg, double lo, double hi, doub
       continue;
     }
     if (!((fa < 0 && fb > 0) || (fa > 0 && fb < 0))) continue;
+    // Safeguarded Newton: a Newton step from the bracket's better end when it stays inside the
+    // bracket, else bisection; the bracket shrinks every step, down to adjacent doubles.
+    double x = 0.5 * (a + b);
     for (int it = 0; it < 200; ++it) {
-      double m = 0.5 * (a + b);
-      if (m <= a || m >= b) break;
-      double fm = poly_eval(c, deg, m);
-      if (fm == 0) {
-        a = b = m;
+      double fx = poly_eval(c, deg, x);
+      if (fx == 0) {
+        a = b = x;
         break;
       }
-      if ((fm < 0) == (fa < 0)) {
-        a = m;
-        fa = fm;
+      if ((fx < 0) == (fa < 0)) {
+        a = x;
+        fa = fx;
       } else {
-        b = m;
+        b = x;
       }
+      double mid = 0.5 * (a + b);
+      if (mid <= a || mid >= b) break;
+      double dx = poly_eval(d, deg - 1, x);
+      double xn = dx != 0 ? x - fx / dx : mid;
+      x = (xn > a && xn < b) ? xn : mid;
+      if (it > 4 && !(xn > a && xn < b)) x = mid;
+      if (x == a || x == b) x = mid;
     }
     double r = 0.5 * (a + b);
     if (r > lo && r < hi && (n == 0 || out[n - 1] != r)) out[n++] = r;

@@ -43,7 +43,7 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
   RegionResult result;
   result.segments = perimeter_segments(box);
   const size_t total = result.segments.size() * size_t(options.runs);
-  std::vector<uint8_t> in_union(scene.triangle_count(), 0);
+  std::vector<uint8_t> in_union(scene.triangle_count(), 0), sphere_in_union(scene.sphere_count(), 0);
   size_t union_size = 0;
   for (size_t s = 0; s < result.segments.size(); ++s) {
     for (int k = 0; k < options.runs; ++k) {
@@ -55,12 +55,14 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
           in_union[id] = 1;
           ++union_size;
         }
+      for (uint32_t s : sr.visible_spheres) sphere_in_union[s] = 1;
       result.seconds += sr.stats.seconds;
       RunRecord rec;
       rec.segment = s;
       rec.run = k;
       rec.orientation = so.orientation;
       rec.visible = std::move(sr.visible);
+      rec.visible_spheres = std::move(sr.visible_spheres);
       rec.stats = sr.stats;
       rec.union_size_after = union_size;
       rec.seconds_after = result.seconds;
@@ -70,13 +72,17 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
   }
   for (uint32_t id = 0; id < in_union.size(); ++id)
     if (in_union[id]) result.visible.push_back(id);
+  for (uint32_t s = 0; s < sphere_in_union.size(); ++s)
+    if (sphere_in_union[s]) result.visible_spheres.push_back(s);
   return result;
 }
 
-std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles) {
+std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles,
+                                 const std::vector<uint32_t>& spheres) {
   std::vector<uint32_t> out;
-  out.reserve(triangles.size());
+  out.reserve(triangles.size() + spheres.size());
   for (uint32_t t : triangles) out.push_back(scene.triangle_object[t]);
+  for (uint32_t s : spheres) out.push_back(scene.sphere_object[s]);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;

@@ -41,6 +41,7 @@ struct RunRecord {
   int run = 0;
   Mat3 orientation;
   std::vector<uint32_t> visible;  // triangle ids of this run
+  std::vector<uint32_t> visible_spheres;  // sphere indices of this run
   SegmentStats stats;
   size_t union_size_after = 0;    // triangles in the union after this run
   double seconds_after = 0;       // cumulative kernel seconds after this run
@@ -50,6 +51,7 @@ struct RegionResult {
   std::vector<Segment> segments;
   std::vector<RunRecord> runs;     // segment-major, run-minor
   std::vector<uint32_t> visible;   // union of triangle ids, sorted
+  std::vector<uint32_t> visible_spheres;  // union of sphere indices, sorted
   double seconds = 0;
 };
 
@@ -58,7 +60,8 @@ struct RegionResult {
 RegionResult region_visibility(const Scene& scene, const Box3& box, const RegionOptions& options,
                                const std::function<void(size_t, size_t)>& progress = {});
 
-// Object ids (sorted) of the objects owning at least one of `triangles` (sorted or not).
-std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles);
+// Object ids (sorted) of the objects owning at least one of `triangles` or `spheres`.
+std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles,
+                                 const std::vector<uint32_t>& spheres = {});
 
 }  // namespace vislib
