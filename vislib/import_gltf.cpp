@@ -17,11 +17,21 @@
 // data URIs before tinygltf sees the file, and decode compressed bufferViews with meshoptimizer
 // into our own byte buffers (filters NONE/OCTAHEDRAL/QUATERNION/EXPONENTIAL).
 //
-// Animation (LoadOptions::states K > 1): translation/rotation/scale channels (LINEAR with slerp
-// for rotations, STEP, CUBICSPLINE as Hermite splines) are sampled at K evenly spaced times over
-// [0, latest key time] of the selected animations. Skinned meshes are deformed by linear-blend
-// skinning (JOINTS_0/WEIGHTS_0, inverse bind matrices) with the sampled joint transforms, also
-// for K = 1 (the rest pose of the joints). Morph targets are ignored (warning).
+// Animation (LoadOptions::states K > 1): translation/rotation/scale and morph "weights" channels
+// (LINEAR, with slerp for rotations; STEP; CUBICSPLINE as cubic Hermite splines through the value
+// element of each in-tangent/value/out-tangent triple, the tangents giving the slopes) are sampled
+// at K evenly spaced times over [0, latest key time] of the selected animations. Channels of
+// other paths (e.g. KHR_animation_pointer) are skipped with a warning.
+//
+// Morph targets (glTF 2.0 §3.7.2.2): the POSITION displacements of the targets (sparse accessors
+// included) are applied first, p = base + sum_i w_i * target_i in double, then skinning, then the
+// node transform. Weights: the mesh's `weights`, overridden by the node's `weights` (zeros if
+// neither is given), overridden in each state by a sampled "weights" channel. K = 1 is the rest
+// pose: default weights, the animation is not sampled. NORMAL/TANGENT targets do not move
+// geometry and are not read.
+//
+// Skinned meshes are deformed by linear-blend skinning (JOINTS_0/WEIGHTS_0, inverse bind
+// matrices) with the sampled joint transforms, also for K = 1 (the rest pose of the joints).
 #include <tiny_gltf.h>
 
 #include <meshoptimizer.h>
@@ -94,8 +104,9 @@ struct Bytes {
 
 struct Channel {
   int node = -1;
-  int path = 0;  // 0 translation, 1 rotation, 2 scale
+  int path = 0;  // 0 translation, 1 rotation, 2 scale, 3 morph weights
   int interp = 0;  // 0 LINEAR, 1 STEP, 2 CUBICSPLINE
+  size_t ncomp = 3;  // values per key element: 3, 4 (rotation) or the morph target count (weights)
   std::vector<double> times;
   std::vector<double> values;  // per key: ncomp values (CUBICSPLINE: in-tangent, value, out-tangent)
 };
@@ -106,6 +117,8 @@ struct Prim {
   std::vector<std::array<uint32_t, 3>> tris;
   std::vector<std::array<uint32_t, 4>> joints;  // empty unless skinned
   std::vector<std::array<double, 4>> weights;
+  // POSITION displacement of each vertex per morph target; a target without POSITION is empty.
+  std::vector<std::vector<Vec3>> targets;
 };
 
 struct Ctx {
@@ -337,8 +350,6 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
       ctx.warnings->push_back(ctx.path + ": " + where + ": no POSITION, skipped");
       continue;
     }
-    if (!prim.targets.empty())
-      ctx.warnings->push_back(ctx.path + ": " + where + ": morph targets ignored");
     Prim out;
     int nc;
     auto pos = read_accessor(ctx, pos_it->second, "POSITION of " + where, nc, {3});
@@ -402,13 +413,34 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
           out.weights[v][c] = w[4 * v + c];
         }
     }
+    for (size_t ti = 0; ti < prim.targets.size(); ++ti) {
+      auto t_it = prim.targets[ti].find("POSITION");
+      if (t_it == prim.targets[ti].end()) {
+        out.targets.emplace_back();
+        continue;
+      }
+      std::string what = "POSITION of morph target " + std::to_string(ti) + " of " + where;
+      auto d = read_accessor(ctx, t_it->second, what, nc, {3});
+      if (d.size() != 3 * nv)
+        ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what + "): " +
+                 std::to_string(d.size() / 3) + " elements, but POSITION has " + std::to_string(nv));
+      std::vector<Vec3> disp(nv);
+      for (size_t v = 0; v < nv; ++v) {
+        disp[v] = {d[3 * v], d[3 * v + 1], d[3 * v + 2]};
+        if (!is_finite(disp[v]))
+          ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what + "): vertex " +
+                   std::to_string(v) + " is not finite (NaN or inf)");
+      }
+      out.targets.push_back(std::move(disp));
+    }
     prims.push_back(std::move(out));
   }
   return prims;
 }
 
-// Reads the animation channels of the selected animations.
-std::vector<Channel> read_channels(Ctx& ctx, int which) {
+// Reads the animation channels of the selected animations. `node_targets[n]` is the morph target
+// count of node n's mesh (0 without a mesh), the number of weights a "weights" channel animates.
+std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t>& node_targets) {
   std::vector<Channel> out;
   const auto& anims = ctx.model.animations;
   if (which >= int(anims.size()))
@@ -424,9 +456,22 @@ std::vector<Channel> read_channels(Ctx& ctx, int which) {
       if (ch.target_path == "translation") c.path = 0;
       else if (ch.target_path == "rotation") c.path = 1;
       else if (ch.target_path == "scale") c.path = 2;
-      else continue;  // morph weights: not geometry we sample
+      else if (ch.target_path == "weights") c.path = 3;
+      else {
+        ctx.warnings->push_back(ctx.path + ": " + where + ": target path '" + ch.target_path +
+                                "' is not supported; channel ignored");
+        continue;
+      }
       if (ch.target_node < 0 || size_t(ch.target_node) >= ctx.model.nodes.size())
         ctx.fail(where + ": target node " + std::to_string(ch.target_node) + " does not exist");
+      if (c.path == 3) {
+        c.ncomp = node_targets[size_t(ch.target_node)];
+        if (c.ncomp == 0)
+          ctx.fail(where + ": animates the morph weights of node " + std::to_string(ch.target_node) +
+                   ", which has no mesh with morph targets");
+      } else {
+        c.ncomp = c.path == 1 ? 4 : 3;
+      }
       if (ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size())
         ctx.fail(where + ": sampler " + std::to_string(ch.sampler) + " does not exist");
       const auto& s = an.samplers[ch.sampler];
@@ -434,10 +479,17 @@ std::vector<Channel> read_channels(Ctx& ctx, int which) {
       c.interp = s.interpolation == "STEP" ? 1 : s.interpolation == "CUBICSPLINE" ? 2 : 0;
       int nc;
       c.times = read_accessor(ctx, s.input, "input of " + where, nc, {1});
-      c.values = read_accessor(ctx, s.output, "output of " + where, nc, {c.path == 1 ? 4 : 3});
-      size_t per_key = size_t(c.path == 1 ? 4 : 3) * (c.interp == 2 ? 3 : 1);
+      c.values = read_accessor(ctx, s.output, "output of " + where, nc,
+                               {c.path == 3 ? 1 : int(c.ncomp)});
+      size_t per_key = c.ncomp * (c.interp == 2 ? 3 : 1);
       if (c.times.empty() || c.values.size() != c.times.size() * per_key)
-        ctx.fail(where + ": output count does not match input count");
+        ctx.fail("accessor " + std::to_string(s.output) + " (output of " + where + "): " +
+                 std::to_string(c.values.size()) + " values, but " + std::to_string(c.times.size()) +
+                 " keys (accessor " + std::to_string(s.input) + ") need " +
+                 std::to_string(c.times.size() * per_key) +
+                 (c.path == 3 ? " (" + std::to_string(c.ncomp) + " morph weights per key" +
+                                    (c.interp == 2 ? ", times 3 for CUBICSPLINE)" : ")")
+                              : std::string()));
       for (double t : c.times)
         if (!std::isfinite(t)) ctx.fail(where + ": non-finite key time");
       c.node = ch.target_node;
@@ -447,35 +499,35 @@ std::vector<Channel> read_channels(Ctx& ctx, int which) {
   return out;
 }
 
-// Value of channel `c` at time t (n = 3 or 4 components).
+// Value of channel `c` at time t (c.ncomp components).
 void sample(const Channel& c, double t, double* v) {
-  int n = c.path == 1 ? 4 : 3;
+  const size_t n = c.ncomp;
   size_t keys = c.times.size();
-  size_t stride = size_t(n) * (c.interp == 2 ? 3 : 1), voff = c.interp == 2 ? size_t(n) : 0;
-  auto val = [&](size_t k, int i) { return c.values[k * stride + voff + size_t(i)]; };
+  size_t stride = n * (c.interp == 2 ? 3 : 1), voff = c.interp == 2 ? n : 0;
+  auto val = [&](size_t k, size_t i) { return c.values[k * stride + voff + i]; };
   size_t k = size_t(std::upper_bound(c.times.begin(), c.times.end(), t) - c.times.begin());
   if (k == 0 || k == keys) {
     size_t at = k == 0 ? 0 : keys - 1;
-    for (int i = 0; i < n; ++i) v[i] = val(at, i);
+    for (size_t i = 0; i < n; ++i) v[i] = val(at, i);
     return;
   }
   size_t k0 = k - 1;
   double t0 = c.times[k0], t1 = c.times[k], dt = t1 - t0;
   double s = dt > 0 ? (t - t0) / dt : 0;
   if (c.interp == 1) {
-    for (int i = 0; i < n; ++i) v[i] = val(k0, i);
+    for (size_t i = 0; i < n; ++i) v[i] = val(k0, i);
   } else if (c.interp == 2) {
     double s2 = s * s, s3 = s2 * s;
-    for (int i = 0; i < n; ++i) {
+    for (size_t i = 0; i < n; ++i) {
       double p0 = val(k0, i), p1 = val(k, i);
-      double m0 = dt * c.values[k0 * stride + 2 * size_t(n) + size_t(i)];  // out-tangent of k0
-      double m1 = dt * c.values[k * stride + size_t(i)];                   // in-tangent of k
+      double m0 = dt * c.values[k0 * stride + 2 * n + i];  // out-tangent of k0
+      double m1 = dt * c.values[k * stride + i];          // in-tangent of k
       v[i] = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 +
              (s3 - s2) * m1;
     }
-  } else if (n == 4) {  // slerp
+  } else if (c.path == 1) {  // slerp
     double a[4], b[4], d = 0;
-    for (int i = 0; i < 4; ++i) a[i] = val(k0, i), b[i] = val(k, i), d += a[i] * b[i];
+    for (size_t i = 0; i < 4; ++i) a[i] = val(k0, i), b[i] = val(k, i), d += a[i] * b[i];
     if (d < 0) {
       d = -d;
       for (double& x : b) x = -x;
@@ -486,9 +538,9 @@ void sample(const Channel& c, double t, double* v) {
       wa = std::sin((1 - s) * th) / sn;
       wb = std::sin(s * th) / sn;
     }
-    for (int i = 0; i < 4; ++i) v[i] = wa * a[i] + wb * b[i];
+    for (size_t i = 0; i < 4; ++i) v[i] = wa * a[i] + wb * b[i];
   } else {
-    for (int i = 0; i < n; ++i) v[i] = val(k0, i) + (val(k, i) - val(k0, i)) * s;
+    for (size_t i = 0; i < n; ++i) v[i] = val(k0, i) + (val(k, i) - val(k0, i)) * s;
   }
 }
 
@@ -641,6 +693,38 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       parent[c] = int(n);
     }
   }
+  // Morph target count of each mesh (every primitive must have the same, glTF 2.0 §3.7.2.2) and
+  // the default weights of each node: node `weights`, else mesh `weights`, else zeros.
+  std::vector<size_t> mesh_targets(model.meshes.size(), 0);
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const auto& mesh = model.meshes[m];
+    if (!mesh.primitives.empty()) mesh_targets[m] = mesh.primitives[0].targets.size();
+    for (size_t pi = 1; pi < mesh.primitives.size(); ++pi)
+      if (mesh.primitives[pi].targets.size() != mesh_targets[m])
+        ctx.fail("mesh " + std::to_string(m) + ": primitive " + std::to_string(pi) + " has " +
+                 std::to_string(mesh.primitives[pi].targets.size()) + " morph targets, primitive 0 has " +
+                 std::to_string(mesh_targets[m]));
+    if (!mesh.weights.empty() && mesh.weights.size() != mesh_targets[m])
+      ctx.fail("mesh " + std::to_string(m) + ": weights has " + std::to_string(mesh.weights.size()) +
+               " numbers, but the mesh has " + std::to_string(mesh_targets[m]) + " morph targets");
+  }
+  std::vector<size_t> node_targets(N, 0);
+  std::vector<std::vector<double>> rest_weights(N);
+  for (size_t n = 0; n < N; ++n) {
+    const auto& nd = model.nodes[n];
+    if (nd.mesh >= 0) node_targets[n] = mesh_targets[size_t(nd.mesh)];
+    if (!nd.weights.empty() && nd.weights.size() != node_targets[n])
+      ctx.fail("node " + std::to_string(n) + ": weights has " + std::to_string(nd.weights.size()) +
+               " numbers, but its mesh has " + std::to_string(node_targets[n]) + " morph targets");
+    if (!nd.weights.empty())
+      rest_weights[n] = nd.weights;
+    else if (nd.mesh >= 0 && !model.meshes[size_t(nd.mesh)].weights.empty())
+      rest_weights[n] = model.meshes[size_t(nd.mesh)].weights;
+    else
+      rest_weights[n].assign(node_targets[n], 0.0);
+    for (double w : rest_weights[n])
+      if (!std::isfinite(w)) ctx.fail("node " + std::to_string(n) + ": non-finite morph weight");
+  }
   for (size_t n = 0; n < N; ++n) {  // cycle check: walking up must end within N steps
     size_t steps = 0;
     for (int p = parent[n]; p != -1; p = parent[p])
@@ -673,18 +757,23 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
 
   // Animation channels and sample times.
   std::vector<Channel> channels;
-  if (options.states > 1 || options.animation >= 0) channels = read_channels(ctx, options.animation);
+  if (options.states > 1 || options.animation >= 0) channels = read_channels(ctx, options.animation, node_targets);
   double t_end = 0;
   for (const auto& c : channels) t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
   size_t K = options.states > 1 && !channels.empty() ? size_t(options.states) : 1;
 
-  // World matrices of all nodes in each state.
+  // World matrices and morph weights of all nodes in each state.
   std::vector<std::vector<Mat4>> world(K, std::vector<Mat4>(N));
+  std::vector<std::vector<std::vector<double>>> morph_weights(K, rest_weights);
   for (size_t k = 0; k < K; ++k) {
     std::vector<Trs> local = rest;
     if (K > 1) {
       double t = t_end * double(k) / double(K - 1);
       for (const auto& c : channels) {
+        if (c.path == 3) {
+          sample(c, t, morph_weights[k][size_t(c.node)].data());
+          continue;
+        }
         if (local[c.node].has_matrix) continue;  // animated nodes must use TRS (glTF 2.0 §5.25)
         sample(c, t, c.path == 0 ? local[c.node].t : c.path == 1 ? local[c.node].r : local[c.node].s);
       }
@@ -737,14 +826,27 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
         for (size_t k = 0; k < K; ++k) joint_m[k][j] = world[k][jn] * inv;
       }
     }
+    std::vector<Vec3> morphed;
     for (const Prim& p : mesh_cache[nd.mesh]) {
       size_t base = scene.positions[0].size();
       if (base + p.local.size() >= UINT32_MAX) ctx.fail("too many vertices for 32-bit indices");
       for (size_t k = 0; k < K; ++k) {
         auto& out = scene.positions[k];
+        // Morph first (base + sum_i w_i * target_i), then skin, then the node transform.
+        const std::vector<Vec3>* local = &p.local;
+        if (!p.targets.empty()) {
+          const auto& w = morph_weights[k][size_t(n)];
+          morphed = p.local;
+          for (size_t ti = 0; ti < p.targets.size(); ++ti) {
+            if (w[ti] == 0 || p.targets[ti].empty()) continue;
+            for (size_t v = 0; v < morphed.size(); ++v) morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
+          }
+          local = &morphed;
+        }
         for (size_t v = 0; v < p.local.size(); ++v) {
+          const Vec3 lv = (*local)[v];
           if (!skinned || p.joints.empty()) {
-            out.push_back(transform(world[k][n], p.local[v]));
+            out.push_back(transform(world[k][n], lv));
             continue;
           }
           Vec3 acc{0, 0, 0};
@@ -756,10 +858,10 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
             if (j >= joint_m[k].size())
               ctx.fail("mesh " + std::to_string(nd.mesh) + ": joint index " + std::to_string(j) +
                        " out of range of skin " + std::to_string(nd.skin));
-            acc = acc + transform(joint_m[k][j], p.local[v]) * w;
+            acc = acc + transform(joint_m[k][j], lv) * w;
             wsum += w;
           }
-          out.push_back(wsum > 0 ? acc * (1.0 / wsum) : transform(world[k][n], p.local[v]));
+          out.push_back(wsum > 0 ? acc * (1.0 / wsum) : transform(world[k][n], lv));
         }
       }
       for (auto t : p.tris) {
