@@ -174,27 +174,6 @@ std::string hex64(uint64_t v) {
 
 // ---- Set codecs -------------------------------------------------------------------------------
 
-void append_run_length(std::string& out, const std::vector<uint32_t>& ids) {
-  // Runs of consecutive ids: (zeros before the run, run length - 1); zeros before a run that is
-  // not the first are counted minus one (there is at least one).
-  std::vector<std::pair<uint32_t, uint32_t>> runs;
-  size_t i = 0;
-  uint64_t prev_end = 0;  // one past the previous run
-  while (i < ids.size()) {
-    size_t j = i;
-    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1) ++j;
-    uint32_t zeros = uint32_t(ids[i] - prev_end - (runs.empty() ? 0 : 1));
-    runs.push_back({zeros, uint32_t(j - i)});
-    prev_end = uint64_t(ids[j]) + 1;
-    i = j + 1;
-  }
-  put_varint(out, uint32_t(runs.size()));
-  for (auto [z, l] : runs) {
-    put_varint(out, z);
-    put_varint(out, l);
-  }
-}
-
 // Decodes a SortedDelta or RunLength payload from `c`, consuming exactly what it needs. At most
 // `limit` ids are produced (more is an error) and all are < universe.
 std::vector<uint32_t> decode_set(Cursor& c, Encoding e, uint32_t universe, uint64_t limit) {
@@ -251,6 +230,27 @@ void append_sorted_delta(std::string& out, const std::vector<uint32_t>& ids) {
   for (uint32_t id : ids) {
     put_varint(out, uint32_t(id - next));
     next = uint64_t(id) + 1;
+  }
+}
+
+void append_run_length(std::string& out, const std::vector<uint32_t>& ids) {
+  // Runs of consecutive ids: (zeros before the run, run length - 1); zeros before a run that is
+  // not the first are counted minus one (there is at least one).
+  std::vector<std::pair<uint32_t, uint32_t>> runs;
+  size_t i = 0;
+  uint64_t prev_end = 0;  // one past the previous run
+  while (i < ids.size()) {
+    size_t j = i;
+    while (j + 1 < ids.size() && ids[j + 1] == ids[j] + 1) ++j;
+    uint32_t zeros = uint32_t(ids[i] - prev_end - (runs.empty() ? 0 : 1));
+    runs.push_back({zeros, uint32_t(j - i)});
+    prev_end = uint64_t(ids[j]) + 1;
+    i = j + 1;
+  }
+  put_varint(out, uint32_t(runs.size()));
+  for (auto [z, l] : runs) {
+    put_varint(out, z);
+    put_varint(out, l);
   }
 }
 

@@ -218,6 +218,9 @@ uint64_t fnv1a64(const void* data, size_t size, uint64_t hash = kFnvOffsetBasis)
 
 // Appends `ids` (sorted, unique) as SortedDelta payload (count, first, gaps - 1).
 void append_sorted_delta(std::string& out, const std::vector<uint32_t>& ids);
+// Appends `ids` (sorted, unique) as RunLength payload (run count, then per run: zeros before it
+// (minus one after the first run), length - 1).
+void append_run_length(std::string& out, const std::vector<uint32_t>& ids);
 // Decodes a whole SortedDelta payload (no bytes may remain); ids must stay < universe.
 // Throws FormatError with offsets relative to `base_offset`.
 std::vector<uint32_t> decode_sorted_delta(std::string_view payload, uint32_t universe,
