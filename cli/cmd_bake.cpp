@@ -26,7 +26,7 @@ using nlohmann::json;
 struct BakeArgs {
   std::string scene, output, checkpoint, json_out;
   std::string box, grid, eye, shard = "0/1";
-  bool walkable = false, resume = false, no_headroom = false;
+  bool walkable = false, resume = false, no_headroom = false, dry_run = false;
   double cell_size = 0, max_slope = 45;
   int resolution = 512, runs = 1, threads = 0, tile = 32;
   uint64_t seed = 1;
@@ -180,6 +180,7 @@ void add_bake(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--resume", a->resume, "Continue an interrupted bake from its checkpoint");
   cmd->add_option("--checkpoint", a->checkpoint, "Checkpoint file (default OUTPUT.ckpt)");
+  cmd->add_flag("--dry-run", a->dry_run, "Place the cells, print their count and stop");
   cmd->add_option("--json", a->json_out, "Write a bake report (timings per cell, sizes) as JSON ('-' = stdout)");
   cmd->callback([a] {
     vislib::Shard shard = parse_shard(a->shard);
@@ -204,6 +205,13 @@ void add_bake(CLI::App& app) {
     if (n == 0) {
       std::fprintf(stderr, "pvs: error: no view cells (no walkable floor in the scene%s)\n", a->box.empty() ? "" : " within --box");
       throw Exit{2};
+    }
+    if (a->dry_run) {
+      std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell\n", n,
+                  cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
+                  (n + shard.count - 1 - shard.index) / shard.count, shard.index, shard.count,
+                  vislib::cell_boundary_segments(vislib::to_box3(cells.layout.view_region(0))).size(), a->runs);
+      return;
     }
     if (a->resume && !file_exists(checkpoint))
       std::fprintf(stderr, "pvs bake: no checkpoint %s: starting from the beginning\n", checkpoint.c_str());

@@ -161,8 +161,9 @@ void print_summary(const std::string& path, const json& j) {
     std::printf("    %-26s %8llu cells %12llu bytes\n", name.c_str(), m["cells"].get<unsigned long long>(),
                 m["bytes"].get<unsigned long long>());
   const json& b = j["bytes_per_cell"];
-  std::printf("  bytes per cell: %.1f chosen; if every cell were sorted-delta %.1f, run-length %.1f, "
-              "best of the two %.1f; raw bitset %.0f, raw u32 list %.1f\n",
+  std::printf("  bytes per cell (blocks: encoding byte, payload, CRC): %.1f chosen; if every cell were "
+              "sorted-delta %.1f, run-length %.1f, best of the two %.1f; uncompressed payload: bitset %.0f, "
+              "u32 list %.1f\n",
               b["chosen"].get<double>(), b["all_sorted_delta"].get<double>(), b["all_run_length"].get<double>(),
               b["best_without_delta"].get<double>(), b["raw_bitset"].get<double>(), b["raw_u32_list"].get<double>());
   if (j.contains("visible")) {
