@@ -113,8 +113,9 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     w.require_headroom = !a.no_headroom;
     w.clip = box;
     vislib::Box3 r = box ? *box : scene.bounds();
-    if (!r.empty() && (r.max.x - r.min.x) / w.cell_size * ((r.max.z - r.min.z) / w.cell_size) > 1e8)
-      throw CLI::ValidationError("--cell-size", "more than 10^8 columns: use a larger cell size or a --box");
+    auto columns = [&](double extent) { return std::max(1.0, std::ceil(extent / w.cell_size)); };
+    if (!r.empty() && columns(r.max.x - r.min.x) * columns(r.max.z - r.min.z) > 1e7)
+      throw CLI::ValidationError("--cell-size", "more than 10^7 columns: use a larger cell size or a --box");
     return vislib::walkable_cells(scene, w);
   }
   if (!box) throw CLI::ValidationError("--box", "give --box with --grid or --cell-size, or --walkable");
@@ -123,13 +124,13 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     auto g = parse_doubles(a.grid, "--grid", 3);
     for (double v : g)
       if (!(v >= 1 && v == std::floor(v) && v <= 1e6)) throw CLI::ValidationError("--grid", "expected three integers >= 1");
-    if (g[0] * g[1] * g[2] > 1e8) throw CLI::ValidationError("--grid", "more than 10^8 cells");
+    if (g[0] * g[1] * g[2] > 1e7) throw CLI::ValidationError("--grid", "more than 10^7 cells");
     return vislib::grid_cells(*box, uint32_t(g[0]), uint32_t(g[1]), uint32_t(g[2]), eye);
   }
   if (!(a.cell_size > 0)) throw CLI::ValidationError("--grid", "give --grid nx,ny,nz or --cell-size S with --box");
   double count = 1;
   for (int k = 0; k < 3; ++k) count *= std::max(1.0, std::ceil((box->max[k] - box->min[k]) / a.cell_size));
-  if (count > 1e8) throw CLI::ValidationError("--cell-size", "more than 10^8 cells");
+  if (count > 1e7) throw CLI::ValidationError("--cell-size", "more than 10^7 cells");
   return vislib::grid_cells_by_size(*box, a.cell_size, eye);
 }
 
