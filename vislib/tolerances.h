@@ -17,4 +17,14 @@ constexpr double kFootprintMargin = 1e-6;
 // not count; a typical headset near plane.
 constexpr double kDefaultNear = 0.01;
 
+// Walkable cells (view_cells.h): a floor piece (the part of a floor triangle inside a column)
+// smaller than this fraction of the column's area (cell_size^2) does not make a cell; removes
+// zero-area slivers of triangles that only touch the column's border. Errs towards fewer cells.
+constexpr double kMinFloorAreaFraction = 1e-9;
+
+// Walkable cells: heights closer than this fraction of cell_size count as the same height in the
+// headroom test (a building's bottom face lying on the ground covers it). Errs towards keeping
+// cells (a surface just above the floor may be taken for the floor itself).
+constexpr double kFloorHeightTolerance = 1e-6;
+
 }  // namespace vislib

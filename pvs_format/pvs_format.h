@@ -1,0 +1,229 @@
+// pvs_format.h: writing and reading PVS files (potentially visible sets per view cell), format
+// version 1, specified byte for byte in docs/pvs-format.md.
+//
+// This library depends on the C++ standard library only (house style, "Which way the arrows
+// point"): an engine embeds it to load a PVS without vislib or its dependencies. It knows nothing
+// of scenes: it stores a 64-bit scene fingerprint computed by the caller (vislib's is
+// scene_fingerprint() in vislib/scene_fingerprint.h, its byte stream is in the format document).
+//
+// Errors: a malformed, truncated, corrupted or too new file throws pvs::FormatError carrying the
+// byte offset where the problem was found and what is wrong. The reader never crashes or reads
+// out of bounds on any input (a libFuzzer target checks this: fuzz/pvs_reader_fuzz.cpp).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace pvs {
+
+// The version this library writes, and the newest it reads.
+constexpr uint32_t kFormatVersion = 1;
+// The eight magic bytes that open every PVS file ("\x89PVS\r\n\x1a\n", PNG-style: a text-mode
+// transfer or a 7-bit channel damages them visibly).
+constexpr char kMagic[8] = {'\x89', 'P', 'V', 'S', '\r', '\n', '\x1a', '\n'};
+constexpr size_t kHeaderSize = 64;
+constexpr size_t kIndexEntrySize = 16;
+
+// A malformed file. `offset` is the byte offset (from the start of the file) where the reader
+// found the problem; `what()` is "byte <offset>: <problem>".
+class FormatError : public std::runtime_error {
+ public:
+  FormatError(uint64_t offset, const std::string& problem);
+  uint64_t offset() const { return offset_; }
+  const std::string& problem() const { return problem_; }
+
+ private:
+  uint64_t offset_;
+  std::string problem_;
+};
+
+enum class Granularity : uint8_t { Triangle = 0, Object = 1 };
+enum class LayoutKind : uint8_t { Grid = 0, Boxes = 1 };
+
+// How one cell's block is encoded (the first byte of the block).
+enum class Encoding : uint8_t {
+  SortedDelta = 0,  // count, first id, gaps - 1 as LEB128 varints
+  RunLength = 1,    // runs of consecutive ids: (zeros before, length - 1) varint pairs
+  Delta = 2,        // symmetric difference with an earlier cell, itself SortedDelta or RunLength
+  Absent = 3,       // no data: the cell belongs to another shard (partial files only)
+};
+const char* encoding_name(Encoding e);
+
+// Axis-aligned box; y is up (the glTF convention of vislib scenes).
+struct Box {
+  double min[3] = {0, 0, 0};
+  double max[3] = {0, 0, 0};
+};
+bool operator==(const Box& a, const Box& b);
+
+// Where the cells are. Grid: the box split into nx * ny * nz equal cells, cell id
+// x + nx * (y + ny * z); a cell's view region spans its x and z range and the eye band
+// [bottom + eye_lo, bottom + eye_hi] above the cell's bottom face. Boxes: one box per cell, which
+// is both the cell and its view region (vislib's walkable cells: the eye band above a floor).
+struct CellLayout {
+  LayoutKind kind = LayoutKind::Grid;
+  Box grid_box;
+  uint32_t nx = 1, ny = 1, nz = 1;
+  double eye_lo = 0, eye_hi = 0;
+  std::vector<Box> boxes;
+
+  uint32_t cell_count() const;  // nx * ny * nz (grid, must fit 32 bits) or boxes.size()
+  // The lookup box of cell `cell` (< cell_count()): grid cell (i, j, k) spans
+  // [min + (max - min) * i / n, min + (max - min) * (i + 1) / n] on each axis, in double, in that
+  // order of operations (the last cell ends exactly at max).
+  Box cell_box(uint32_t cell) const;
+  // The view region of cell `cell`: for a grid, the cell box with y replaced by the eye band;
+  // for a box list, the box itself.
+  Box view_region(uint32_t cell) const;
+  // The first cell (in id order) whose lookup box contains p (boundaries inclusive), if any.
+  // Grid: O(1); box list: a linear scan.
+  std::optional<uint32_t> find_cell(const double p[3]) const;
+};
+bool operator==(const CellLayout& a, const CellLayout& b);
+
+// Everything of a file except the visible sets.
+struct FileInfo {
+  uint32_t version = kFormatVersion;
+  bool partial = false;         // some cells are Absent (a shard of a bake)
+  uint64_t scene_fingerprint = 0;
+  uint32_t universe = 0;        // number of ids at this granularity (scene triangles or objects)
+  Granularity granularity = Granularity::Triangle;
+  uint8_t max_delta_depth = 8;  // longest chain of Delta references a cell may need
+  CellLayout layout;
+  std::string metadata;         // free text, by convention JSON with the bake settings
+};
+
+// ---- Writing --------------------------------------------------------------------------------
+
+// One cell's visible ids (sorted, unique, each < universe), or nullopt for an absent cell.
+using CellSet = std::optional<std::vector<uint32_t>>;
+
+struct WriteStats {
+  uint64_t file_bytes = 0, header_bytes = 0, layout_bytes = 0, index_bytes = 0, block_bytes = 0;
+};
+
+// Returns the bytes of a PVS file. Each present cell is encoded with the smallest of: sorted-delta
+// varints, run-length runs, or a Delta against one candidate earlier cell (grid: the previous cell
+// along x, y and z; box list: the previous cell and the earlier cell whose box centre is nearest,
+// searched among the 4096 previous cells), with the difference itself sorted-delta or run-length,
+// never making a chain longer than info.max_delta_depth. Ties go to the first of that order.
+// Deterministic: same arguments, same bytes.
+// Preconditions: cells.size() == info.layout.cell_count(); every set sorted, unique, ids <
+// info.universe; some cell absent only if info.partial; layout boxes finite with min <= max;
+// grid nx, ny, nz >= 1; eye_lo <= eye_hi. Violations throw std::invalid_argument.
+std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells,
+                      WriteStats* stats = nullptr);
+
+// ---- Reading --------------------------------------------------------------------------------
+
+struct IndexEntry {
+  uint64_t offset = 0;  // of the block, from the start of the file
+  uint32_t size = 0;    // bytes of the block, encoding byte and checksum included
+  uint32_t count = 0;   // number of visible ids of the cell (0 when absent)
+};
+
+struct ReadOptions {
+  // If set, a file whose scene fingerprint differs is rejected (FormatError at byte 24).
+  std::optional<uint64_t> expected_fingerprint;
+  // Files claiming more ids than this are rejected, so that no input can make the reader allocate
+  // more than 4 bytes x this per decoded set. 2^27 ids = 512 MiB.
+  uint32_t max_universe = 1u << 27;
+  // False skips the CRC32C comparisons (everything else is still checked). Only for the fuzzer,
+  // which could otherwise never get past a checksum to the parsing behind it.
+  bool verify_checksums = true;
+};
+
+// Details of one block, for inspection.
+struct BlockInfo {
+  Encoding encoding = Encoding::SortedDelta;
+  Encoding inner = Encoding::SortedDelta;  // Delta only: how the difference is encoded
+  uint32_t reference = 0;                  // Delta only: the cell the difference is against
+  uint32_t size = 0;                       // bytes, as in the index
+};
+
+// Reads a PVS file from a memory buffer or from a file on disk. Opening reads and checks the
+// header, the layout section and the index (O(cells) bytes); a cell's block is read and checked
+// (CRC32C) only when asked for, by seeking, plus the blocks of the earlier cells a Delta chain
+// refers to (at most max_delta_depth more). verify() reads and checks every block.
+// Not thread-safe: use one Reader per thread.
+class Reader {
+ public:
+  // `bytes` is copied.
+  static Reader from_memory(std::string_view bytes, const ReadOptions& options = {});
+  // Throws FormatError(0, "cannot open ...") if the file cannot be opened.
+  static Reader from_file(const std::string& path, const ReadOptions& options = {});
+
+  Reader(Reader&&) noexcept;
+  Reader& operator=(Reader&&) noexcept;
+  ~Reader();
+
+  const FileInfo& info() const { return info_; }
+  uint32_t cell_count() const { return uint32_t(index_.size()); }
+  uint64_t file_size() const { return file_size_; }
+  const IndexEntry& entry(uint32_t cell) const { return index_.at(cell); }
+  // Offsets of the sections: the layout section starts at kHeaderSize, the index at
+  // index_offset(), the first block at blocks_offset().
+  uint64_t index_offset() const { return index_offset_; }
+  uint64_t blocks_offset() const { return blocks_offset_; }
+
+  bool is_absent(uint32_t cell);
+  // The visible ids of cell `cell` (< cell_count()), sorted. Throws FormatError on a corrupt
+  // block (or one of its references) and if the cell is absent.
+  std::vector<uint32_t> read_cell(uint32_t cell);
+  // The encoding of the cell's block (reads and checks that block only).
+  BlockInfo block_info(uint32_t cell);
+  // Reads and checks every block.
+  void verify();
+
+  struct Source;  // implementation detail: the memory buffer or the open file
+
+ private:
+  Reader() = default;
+  void open(const ReadOptions& options);
+  std::string read_block(uint32_t cell);
+  std::vector<uint32_t> decode_cell(uint32_t cell, int depth);
+
+  std::unique_ptr<Source> source_;
+  FileInfo info_;
+  std::vector<IndexEntry> index_;
+  bool verify_checksums_ = true;
+  uint64_t file_size_ = 0, index_offset_ = 0, blocks_offset_ = 0;
+};
+
+// Joins partial files (shards of one bake) into one complete file: every other header field,
+// the layout and the metadata must be equal in all of them, and every cell must be present in at
+// least one (a cell present in several must have the same ids everywhere). The result is what
+// write_pvs gives for the full set of cells, so byte-identical to an unsharded bake. Throws
+// FormatError (offset 0 when the problem is a mismatch between files) naming the shard by its
+// position in `shards`.
+std::string merge_pvs(std::vector<Reader>& shards);
+
+// ---- Building blocks (also used by vislib's checkpoint file) --------------------------------
+
+// CRC32C (Castagnoli, reflected polynomial 0x82F63B78, initial value and final xor 0xFFFFFFFF).
+// crc32c("123456789") == 0xE3069283. Chain by passing the previous result as `crc`.
+uint32_t crc32c(const void* data, size_t size, uint32_t crc = 0);
+
+// FNV-1a 64-bit over bytes (offset basis 0xcbf29ce484222325, prime 0x100000001b3); chain by
+// passing the previous result as `hash`. Used by vislib for the scene fingerprint.
+constexpr uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ull;
+uint64_t fnv1a64(const void* data, size_t size, uint64_t hash = kFnvOffsetBasis);
+
+// Appends `ids` (sorted, unique) as SortedDelta payload (count, first, gaps - 1).
+void append_sorted_delta(std::string& out, const std::vector<uint32_t>& ids);
+// Appends `ids` (sorted, unique) as RunLength payload (run count, then per run: zeros before it
+// (minus one after the first run), length - 1).
+void append_run_length(std::string& out, const std::vector<uint32_t>& ids);
+// Decodes a whole SortedDelta payload (no bytes may remain); ids must stay < universe.
+// Throws FormatError with offsets relative to `base_offset`.
+std::vector<uint32_t> decode_sorted_delta(std::string_view payload, uint32_t universe,
+                                          uint64_t base_offset = 0);
+
+}  // namespace pvs

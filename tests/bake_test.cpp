@@ -1,0 +1,214 @@
+// Tests of the bake (library): byte-identical output for any thread count, shards merged into
+// the same bytes, resume from a checkpoint (including one torn at any byte), refusal of another
+// bake's checkpoint, and the scene fingerprint and subset the PVS relies on.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <filesystem>
+
+#include "tests/test_support.h"
+#include "vislib/bake.h"
+#include "vislib/checkpoint.h"
+#include "vislib/error.h"
+#include "vislib/file_util.h"
+#include "vislib/generate.h"
+#include "vislib/scene_fingerprint.h"
+#include "vislib/scene_subset.h"
+
+using namespace vislib;
+using vislib_test::temp_dir;
+
+namespace {
+
+Scene small_city() {
+  CityOptions o;
+  o.blocks_x = o.blocks_z = 2;
+  return generate_city(o);
+}
+
+ViewCells small_grid() {
+  Box3 box;
+  box.extend({-30, 0, -30});
+  box.extend({30, 3, 30});
+  return grid_cells(box, 3, 1, 3, EyeBand{1.5, 1.8});
+}
+
+BakeSettings settings() {
+  BakeSettings s;
+  s.region.segment.resolution = 24;
+  s.region.runs = 1;
+  s.region.seed = 3;
+  return s;
+}
+
+std::string bake_bytes(const Scene& scene, const ViewCells& cells, const BakeSettings& s, const std::string& path,
+                       Shard shard = {}, int threads = 0) {
+  std::unique_ptr<tbb::global_control> limit;
+  if (threads) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  bake(scene, cells, s, shard, {path, path + ".ckpt", false});
+  EXPECT_FALSE(std::filesystem::exists(path + ".ckpt")) << "the checkpoint must be gone after success";
+  return read_file(path);
+}
+
+}  // namespace
+
+TEST(Bake, OutputIsByteIdenticalForOneAndTwoThreads) {
+  Scene scene = small_city();
+  std::string dir = temp_dir("bake_threads");
+  std::string one = bake_bytes(scene, small_grid(), settings(), dir + "/one.pvs", {}, 1);
+  std::string two = bake_bytes(scene, small_grid(), settings(), dir + "/two.pvs", {}, 2);
+  EXPECT_EQ(one, two);
+  pvs::Reader r = pvs::Reader::from_memory(one);
+  EXPECT_EQ(r.cell_count(), 9u);
+  EXPECT_EQ(r.info().universe, scene.triangle_count());
+  EXPECT_EQ(r.info().scene_fingerprint, scene_fingerprint(scene));
+  // Each cell holds what bake_cell computes.
+  for (uint32_t c = 0; c < 9; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, r.info().layout, c, settings()));
+}
+
+TEST(Bake, ShardsMergeIntoTheSingleBakeByteForByte) {
+  Scene scene = small_city();
+  std::string dir = temp_dir("bake_shards");
+  std::string whole = bake_bytes(scene, small_grid(), settings(), dir + "/whole.pvs");
+  std::vector<pvs::Reader> shards;
+  for (uint32_t i = 0; i < 4; ++i) {
+    std::string bytes = bake_bytes(scene, small_grid(), settings(), dir + "/s" + std::to_string(i) + ".pvs", {i, 4});
+    shards.push_back(pvs::Reader::from_memory(bytes));
+    EXPECT_TRUE(shards.back().info().partial);
+  }
+  std::swap(shards[0], shards[3]);  // order does not matter
+  EXPECT_EQ(pvs::merge_pvs(shards), whole);
+}
+
+TEST(Bake, ObjectGranularityStoresObjectsOfTheVisibleTriangles) {
+  Scene scene = small_city();
+  BakeSettings s = settings();
+  s.granularity = Granularity::Object;
+  std::string dir = temp_dir("bake_objects");
+  pvs::Reader r = pvs::Reader::from_memory(bake_bytes(scene, small_grid(), s, dir + "/o.pvs"));
+  EXPECT_EQ(r.info().granularity, pvs::Granularity::Object);
+  EXPECT_EQ(r.info().universe, scene.objects.size());
+  EXPECT_EQ(r.read_cell(4), objects_of(scene, bake_cell(scene, r.info().layout, 4, settings())));
+}
+
+TEST(Bake, ResumeFromACheckpointGivesTheSameBytes) {
+  Scene scene = small_city();
+  ViewCells cells = small_grid();
+  std::string dir = temp_dir("bake_resume");
+  std::string whole = bake_bytes(scene, cells, settings(), dir + "/whole.pvs");
+  // A checkpoint as a killed bake leaves it: some cells done, a torn record at the end.
+  pvs::FileInfo info = bake_file_info(scene, cells, settings());
+  std::string ckpt = dir + "/resumed.pvs.ckpt";
+  {
+    Checkpoint cp(ckpt, bake_key(info, {}), 9, false);
+    for (uint32_t c : {4u, 0u, 7u}) cp.append(c, bake_cell(scene, cells.layout, c, settings()));
+  }
+  std::string bytes = read_file(ckpt);
+  write_file_atomic(ckpt, bytes + bytes.substr(24, 7));  // half a record
+  BakeReport rep = bake(scene, cells, settings(), {}, {dir + "/resumed.pvs", ckpt, true});
+  EXPECT_EQ(rep.resumed, 3u);
+  EXPECT_EQ(rep.baked, 6u);
+  EXPECT_EQ(read_file(dir + "/resumed.pvs"), whole);
+  EXPECT_FALSE(std::filesystem::exists(ckpt));
+}
+
+TEST(Bake, CheckpointOfAnotherBakeIsRefused) {
+  Scene scene = small_city();
+  std::string dir = temp_dir("bake_other");
+  std::string ckpt = dir + "/x.pvs.ckpt";
+  { Checkpoint cp(ckpt, 12345, 9, false); }
+  try {
+    bake(scene, small_grid(), settings(), {}, {dir + "/x.pvs", ckpt, true});
+    FAIL() << "resumed another bake's checkpoint";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another bake"), std::string::npos) << e.what();
+  }
+  // A shard's checkpoint is another bake too.
+  pvs::FileInfo info = bake_file_info(scene, small_grid(), settings());
+  EXPECT_NE(bake_key(info, {0, 2}), bake_key(info, {1, 2}));
+  EXPECT_NE(bake_key(info, {0, 1}), bake_key(info, {0, 2}));
+}
+
+TEST(Checkpoint, TornAtAnyByteKeepsEveryCompleteRecord) {
+  std::string dir = temp_dir("checkpoint_torn");
+  std::string path = dir + "/c.ckpt";
+  std::vector<std::vector<uint32_t>> sets = {{1, 2, 3}, {}, {7, 100, 4000}, {5}};
+  std::vector<size_t> ends;  // file size after each record
+  {
+    Checkpoint cp(path, 99, 10, false);
+    ends.push_back(std::filesystem::file_size(path));
+    for (uint32_t i = 0; i < sets.size(); ++i) {
+      cp.append(2 * i, sets[i]);
+      ends.push_back(std::filesystem::file_size(path));
+    }
+  }
+  const std::string full = read_file(path);
+  for (size_t n = 0; n <= full.size(); ++n) {
+    write_file_atomic(path, full.substr(0, n));
+    std::vector<std::optional<std::vector<uint32_t>>> got;
+    Checkpoint cp(path, 99, 10, true, &got, 5000);
+    size_t complete = 0;
+    while (complete + 1 < ends.size() && ends[complete + 1] <= n) ++complete;
+    if (n < ends[0]) complete = 0;
+    EXPECT_EQ(cp.recovered_records(), complete) << "cut at " << n;
+    for (size_t i = 0; i < complete; ++i) EXPECT_EQ(got[2 * i], sets[i]) << "cut at " << n;
+    // Appending after the cut continues a valid file.
+    cp.append(9, {42});
+    std::vector<std::optional<std::vector<uint32_t>>> again;
+    Checkpoint reread(path, 99, 10, true, &again, 5000);
+    EXPECT_EQ(reread.recovered_records(), complete + 1) << "cut at " << n;
+    EXPECT_EQ(again[9], (std::vector<uint32_t>{42}));
+  }
+}
+
+TEST(Checkpoint, DamagedRecordEndsTheValidPart) {
+  std::string dir = temp_dir("checkpoint_damaged");
+  std::string path = dir + "/c.ckpt";
+  {
+    Checkpoint cp(path, 5, 4, false);
+    cp.append(0, {1});
+    cp.append(1, {2});
+  }
+  std::string f = read_file(path);
+  f[f.size() - 6] ^= 0x10;  // inside the second record
+  write_file_atomic(path, f);
+  std::vector<std::optional<std::vector<uint32_t>>> got;
+  Checkpoint cp(path, 5, 4, true, &got);
+  EXPECT_EQ(cp.recovered_records(), 1u);
+  EXPECT_TRUE(got[0]);
+  EXPECT_FALSE(got[1]);
+  EXPECT_GT(cp.discarded_bytes(), 0u);
+}
+
+TEST(SceneFingerprint, ChangesWithAnyVertexIndexOrObjectButNotWithNames) {
+  Scene a = small_city();
+  uint64_t f = scene_fingerprint(a);
+  EXPECT_EQ(scene_fingerprint(small_city()), f);
+  Scene b = a;
+  b.positions[0][17].y = std::nextafter(b.positions[0][17].y, 1e9);
+  EXPECT_NE(scene_fingerprint(b), f);
+  b = a;
+  std::swap(b.triangles[3][0], b.triangles[3][1]);
+  EXPECT_NE(scene_fingerprint(b), f);
+  b = a;
+  b.triangle_object[5] = (b.triangle_object[5] + 1) % uint32_t(b.objects.size());
+  EXPECT_NE(scene_fingerprint(b), f);
+  b = a;
+  b.objects[0].name = "renamed";
+  EXPECT_EQ(scene_fingerprint(b), f);
+}
+
+TEST(SceneSubset, KeepsExactlyTheSetAtEachGranularity) {
+  Scene s = small_city();
+  std::vector<uint32_t> tris = {0, 5, 300, 301};
+  Scene t = scene_subset(s, tris, Granularity::Triangle);
+  ASSERT_EQ(t.triangle_count(), 4u);
+  for (size_t i = 0; i < tris.size(); ++i) EXPECT_EQ(t.corners(uint32_t(i)), s.corners(tris[i]));
+  std::vector<uint32_t> objs = objects_of(s, tris);
+  Scene o = scene_subset(s, objs, Granularity::Object);
+  EXPECT_EQ(o.objects.size(), objs.size());
+  size_t expect = 0;
+  for (uint32_t obj : s.triangle_object) expect += std::binary_search(objs.begin(), objs.end(), obj);
+  EXPECT_EQ(o.triangle_count(), expect);
+  EXPECT_EQ(o.objects[0].name, s.objects[objs[0]].name);
+}
