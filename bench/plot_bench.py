@@ -98,8 +98,12 @@ def main(argv):
     fig, axes = plt.subplots(3, 1, figsize=(7.5, 9), sharex=True)
     colours = {"segment": "tab:blue", "point": "tab:orange"}
     names = {"segment": "from-segment", "point": "from-point"}
+    rows_all = [r for r in qual if float(r["seconds"]) > 0]
+    finite_psnr = [float(r["psnr"]) for r in rows_all if math.isfinite(float(r["psnr"]))]
+    # Identical frames have infinite PSNR: drawn on a line above the largest finite value.
+    psnr_inf = (max(finite_psnr) if finite_psnr else 40.0) + 8.0
     for method in ("segment", "point"):
-        rows = [r for r in qual if r["method"] == method and float(r["seconds"]) > 0]
+        rows = [r for r in rows_all if r["method"] == method]
         if not rows:
             continue
         t = [float(r["seconds"]) for r in rows]
@@ -108,17 +112,21 @@ def main(argv):
         ssim = [float(r["ssim"]) for r in rows]
         c = colours[method]
         axes[0].plot(t, eps, marker="o", ms=3, color=c, label=names[method])
-        finite = [(a, b) for a, b in zip(t, psnr) if math.isfinite(b)]
-        if finite:
-            axes[1].plot([a for a, _ in finite], [b for _, b in finite], marker="o", ms=3, color=c,
-                         label=names[method])
+        axes[1].plot(t, [p if math.isfinite(p) else psnr_inf for p in psnr], color=c, lw=1,
+                     label=names[method])
+        axes[1].scatter(t, [p if math.isfinite(p) else psnr_inf for p in psnr], s=12, color=c,
+                        marker="o")
         axes[2].plot(t, ssim, marker="o", ms=3, color=c, label=names[method])
     for ax in axes:
         ax.axvline(t_eq, color="grey", ls="--", lw=0.8)
         ax.grid(alpha=0.3)
         ax.set_xscale("log")
-    axes[0].set_ylabel("pixel error ε [%]")
+    axes[0].set_ylabel("pixel error ε [%] (mean)")
+    axes[0].set_yscale("symlog", linthresh=1e-3)
     axes[0].set_ylim(bottom=0)
+    axes[1].axhline(psnr_inf, color="black", lw=0.6, ls=":")
+    axes[1].annotate("identical frames (PSNR = ∞)", xy=(0.01, psnr_inf), xycoords=("axes fraction", "data"),
+                     xytext=(0, 3), textcoords="offset points", fontsize=8)
     axes[1].set_ylabel("PSNR [dB] (pooled MSE)")
     axes[2].set_ylabel("SSIM (mean)")
     axes[2].set_xlabel("seconds (cumulative, log scale); dashed: from-segment total")

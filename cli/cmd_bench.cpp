@@ -331,6 +331,10 @@ void run(BenchArgs& a) {
                 {"plots", plots}};
   vislib::write_file_atomic((fs::path(a.out) / "bench.json").string(), j.dump(1) + "\n");
 
+  if (!et.within_measured)
+    warn("from-point stopped (" + std::to_string(r.options.point_runs) + " runs, " +
+         cell(r.point.growth.back().seconds) + " s) before the from-segment time " + cell(et.seconds) +
+         " s: equal_time_share is a lower bound; raise --point-runs");
   auto pct = [](double v) { return 100.0 * v; };
   std::fprintf(stderr,
                "pvs bench: from-segment %zu triangles in %.2f s (%zu segments x %d runs); "
