@@ -36,7 +36,9 @@ struct BenchArgs {
 };
 
 // Finite numbers as numbers, +-inf and NaN as null (JSON has no infinities).
-json num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+json num(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
 // CSV cells: "inf" / "nan" for non-finite values (Python's float() reads both).
 std::string cell(double v) {
   if (std::isnan(v)) return "nan";
@@ -45,18 +47,26 @@ std::string cell(double v) {
   std::snprintf(buf, sizeof buf, "%.10g", v);
   return buf;
 }
-json vec_json(vislib::Vec3 v) { return json::array({v.x, v.y, v.z}); }
+json vec_json(vislib::Vec3 v) {
+  return json::array({v.x, v.y, v.z});
+}
 
 json quality_json(const vislib::QualitySummary& q) {
-  return {{"epsilon", num(q.epsilon_mean)}, {"epsilon_max", num(q.epsilon_max)},
-          {"psnr", num(q.psnr)},            {"psnr_min", num(q.psnr_min)},
-          {"ssim", num(q.ssim_mean)},       {"ssim_min", num(q.ssim_min)},
+  return {{"epsilon", num(q.epsilon_mean)},
+          {"epsilon_max", num(q.epsilon_max)},
+          {"psnr", num(q.psnr)},
+          {"psnr_min", num(q.psnr_min)},
+          {"ssim", num(q.ssim_mean)},
+          {"ssim_min", num(q.ssim_min)},
           {"missed_pixels", q.missed_pixels}};
 }
 
 json set_json(const vislib::SetComparison& c) {
-  return {{"size", c.size}, {"reference_size", c.reference_size}, {"common", c.common},
-          {"missed", c.missed}, {"extra", c.extra}};
+  return {{"size", c.size},
+          {"reference_size", c.reference_size},
+          {"common", c.common},
+          {"missed", c.missed},
+          {"extra", c.extra}};
 }
 
 json method_json(const vislib::Checkpoint& c, const vislib::SetComparison& vs_reference) {
@@ -74,7 +84,8 @@ std::string csv_growth(const vislib::MethodRun& m, size_t segments, bool segment
   s << (segment_method ? "runs,pass,segment,seconds,found\n" : "runs,seconds,found\n");
   for (const auto& g : m.growth) {
     s << g.runs << ',';
-    if (segment_method) s << (g.runs - 1) / int(segments) << ',' << (g.runs - 1) % int(segments) << ',';
+    if (segment_method)
+      s << (g.runs - 1) / int(segments) << ',' << (g.runs - 1) % int(segments) << ',';
     s << cell(g.seconds) << ',' << g.found << '\n';
   }
   return s.str();
@@ -131,23 +142,28 @@ std::vector<std::string> make_plots(const BenchArgs& a) {
   const std::string script = find_plot_script(a.plot_script);
   const std::string manual = "python3-with-matplotlib bench/plot_bench.py " + shell_quote(a.out);
   if (script.empty()) {
-    warn("plots skipped: bench/plot_bench.py not found (give --plot-script); the CSV files are "
-         "written, plot them later with: " + manual);
+    warn(
+        "plots skipped: bench/plot_bench.py not found (give --plot-script); the CSV files are "
+        "written, plot them later with: " +
+        manual);
     return {};
   }
   if (::access(a.python.c_str(), X_OK) != 0) {
-    warn("plots skipped: " + a.python + " is not an executable Python (give --python); later run: " +
-         a.python + " " + shell_quote(script) + " " + shell_quote(a.out));
+    warn("plots skipped: " + a.python +
+         " is not an executable Python (give --python); later run: " + a.python + " " +
+         shell_quote(script) + " " + shell_quote(a.out));
     return {};
   }
-  const std::string cmd = shell_quote(a.python) + " " + shell_quote(script) + " " + shell_quote(a.out);
+  const std::string cmd =
+      shell_quote(a.python) + " " + shell_quote(script) + " " + shell_quote(a.out);
   std::fflush(stderr);
   const int status = std::system(cmd.c_str());
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   if (code == 3) {
     warn("plots skipped: matplotlib is missing for " + a.python +
          " (Debian: apt-get install python3-matplotlib); the CSV and JSON files are complete. "
-         "Later run: " + cmd);
+         "Later run: " +
+         cmd);
     return {};
   }
   if (code != 0) {
@@ -184,7 +200,8 @@ void run(BenchArgs& a) {
   vislib::Scene scene = load_scene_for_cli(a.scene);
   if (scene.sphere_count() > 0) warn(a.scene + ": spheres are ignored by the bench");
   if (scene.is_dynamic()) warn(a.scene + ": the scene is animated; the bench uses key state 0");
-  const double load_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double load_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::fprintf(stderr, "pvs bench: %s: %zu triangles (loaded in %.2f s)\n", a.scene.c_str(),
                scene.triangle_count(), load_s);
   fs::create_directories(a.out);
@@ -195,7 +212,8 @@ void run(BenchArgs& a) {
   auto progress = [&](const std::string& stage, size_t done, size_t total) {
     const auto now = std::chrono::steady_clock::now();
     const bool first = stage != last_stage, final = done == total;
-    if (!first && !final && std::chrono::duration<double>(now - last_print).count() < (tty ? 0.2 : 5.0))
+    if (!first && !final &&
+        std::chrono::duration<double>(now - last_print).count() < (tty ? 0.2 : 5.0))
       return;
     last_print = now;
     if (first && tty && !last_stage.empty()) std::fprintf(stderr, "\n");
@@ -206,7 +224,8 @@ void run(BenchArgs& a) {
   };
   t0 = std::chrono::steady_clock::now();
   const vislib::BenchResult r = vislib::run_bench(scene, a.o, progress);
-  const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double total_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // CSV.
   vislib::write_file_atomic((fs::path(a.out) / "growth_segment.csv").string(),
@@ -260,7 +279,8 @@ void run(BenchArgs& a) {
                                vislib::error_heat_map(t, r.segment_missed[i]));
       vislib::write_rgb8_image(file("_point_heat.png"), t.width, t.height,
                                vislib::error_heat_map(t, r.point_missed[i]));
-      frames.push_back("frames/" + v + "_{truth,truth_depth,segment,point,segment_heat,point_heat}");
+      frames.push_back("frames/" + v +
+                       "_{truth,truth_depth,segment,point,segment_heat,point_heat}");
     }
   }
 
@@ -310,6 +330,7 @@ void run(BenchArgs& a) {
                         {"point_runs", num(eq.point_runs)},
                         {"point_seconds", num(eq.point_seconds)},
                         {"time_ratio", num(eq.time_ratio)},
+                        {"time_ratio_lower_bound", num(eq.time_ratio_lower_bound)},
                         {"rate_coefficient", num(eq.rate_coefficient)},
                         {"rate_exponent", num(eq.rate_exponent)},
                         {"fit_points", eq.fit_points},
@@ -325,16 +346,17 @@ void run(BenchArgs& a) {
                   {"point_calibration_seconds_per_run", num(r.calibration_seconds_per_run)},
                   {"quality_seconds", r.quality_seconds},
                   {"total_seconds", total_s}};
-  j["files"] = {{"csv", {"growth_segment.csv", "growth_point.csv", "quality.csv",
-                         "quality_views.csv", "views.csv"}},
-                {"frames", frames},
-                {"plots", plots}};
+  j["files"] = {
+      {"csv",
+       {"growth_segment.csv", "growth_point.csv", "quality.csv", "quality_views.csv", "views.csv"}},
+      {"frames", frames},
+      {"plots", plots}};
   vislib::write_file_atomic((fs::path(a.out) / "bench.json").string(), j.dump(1) + "\n");
 
   if (!et.within_measured)
     warn("from-point stopped (" + std::to_string(r.options.point_runs) + " runs, " +
-         cell(r.point.growth.back().seconds) + " s) before the from-segment time " + cell(et.seconds) +
-         " s: equal_time_share is a lower bound; raise --point-runs");
+         cell(r.point.growth.back().seconds) + " s) before the from-segment time " +
+         cell(et.seconds) + " s: equal_time_share is a lower bound; raise --point-runs");
   auto pct = [](double v) { return 100.0 * v; };
   std::fprintf(stderr,
                "pvs bench: from-segment %zu triangles in %.2f s (%zu segments x %d runs); "
@@ -345,12 +367,16 @@ void run(BenchArgs& a) {
     std::fprintf(stderr, "pvs bench: equal quality: from-point needs %.2f s (%.0f runs), %.2fx\n",
                  eq.point_seconds, eq.point_runs, eq.time_ratio);
   else
-    std::fprintf(stderr, "pvs bench: equal quality not reached in %d from-point runs (%zu of %zu); %s%s\n",
-                 r.options.point_runs, r.point.set.size(), eq.target,
-                 eq.finite && std::isfinite(eq.time_ratio)
-                     ? ("extrapolated ratio " + cell(eq.time_ratio) + "x; ").c_str()
-                     : "",
-                 eq.note.c_str());
+    std::fprintf(stderr,
+                 "pvs bench: equal quality not reached in %d from-point runs (%zu of %zu "
+                 "triangles): measured ratio > %.2fx; %s\n",
+                 r.options.point_runs, r.point.set.size(), eq.target, eq.time_ratio_lower_bound,
+                 std::isnan(eq.time_ratio) ? eq.note.c_str()
+                 : !std::isfinite(eq.time_ratio)
+                     ? "the extrapolation never gets there (see bench.json)"
+                     : ("extrapolated ratio " + cell(eq.time_ratio) +
+                        "x (power-law fit of the discovery rate)")
+                           .c_str());
   std::fprintf(stderr,
                "pvs bench: at equal time: segment eps %.3f%% PSNR %s SSIM %.5f | point eps %.3f%% "
                "PSNR %s SSIM %.5f\npvs bench: wrote %s/bench.json (total %.1f s)\n",
@@ -389,7 +415,8 @@ void add_bench(CLI::App& app) {
                   "Automatic --point-runs: this multiple of the from-segment seconds")
       ->check(CLI::Range(1.0, 1000.0))
       ->capture_default_str();
-  cmd->add_option("--max-point-runs", a->o.max_point_runs, "Upper bound of the automatic --point-runs")
+  cmd->add_option("--max-point-runs", a->o.max_point_runs,
+                  "Upper bound of the automatic --point-runs")
       ->check(CLI::Range(2, 10000000))
       ->capture_default_str();
   cmd->add_option("--res", a->o.resolution, "Cube face resolution N of both methods")
@@ -408,8 +435,10 @@ void add_bench(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-frames", a->no_frames, "Do not write the equal-time frames and heat maps");
   cmd->add_flag("--no-plots", a->no_plots, "Do not run the plotting script");
-  cmd->add_option("--python", a->python, "Python with matplotlib for the plots")->capture_default_str();
-  cmd->add_option("--plot-script", a->plot_script, "Path of bench/plot_bench.py (default: found "
+  cmd->add_option("--python", a->python, "Python with matplotlib for the plots")
+      ->capture_default_str();
+  cmd->add_option("--plot-script", a->plot_script,
+                  "Path of bench/plot_bench.py (default: found "
                   "from the build tree)");
   cmd->callback([a] { run(*a); });
 }

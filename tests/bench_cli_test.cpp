@@ -50,9 +50,9 @@ TEST(BenchCli, SmallCityWritesJsonWithTheRequiredKeys) {
   EXPECT_LE(j["segment"]["ssim"].get<double>(), 1.0);
   EXPECT_EQ(j["settings"]["point_runs"], 16);
   EXPECT_EQ(j["settings"]["perimeter_segments"], 4);
-  for (const char* f : {"growth_segment.csv", "growth_point.csv", "quality.csv",
-                        "quality_views.csv", "views.csv", "frames/view0_truth.png",
-                        "frames/view0_truth_depth.exr", "frames/view1_point_heat.png"})
+  for (const char* f :
+       {"growth_segment.csv", "growth_point.csv", "quality.csv", "quality_views.csv", "views.csv",
+        "frames/view0_truth.png", "frames/view0_truth_depth.exr", "frames/view1_point_heat.png"})
     EXPECT_TRUE(fs::exists(dir + "/b/" + f)) << f;
   // growth_point.csv: header and one row per run.
   std::ifstream csv(dir + "/b/growth_point.csv");
@@ -75,10 +75,10 @@ TEST(BenchCli, PythonWithoutMatplotlibSkipsOnlyThePlots) {
   vislib::write_file_atomic(python, "#!/bin/sh\nexec /usr/bin/python3 -S \"$@\"\n");
   fs::permissions(python, fs::perms::owner_all);
   std::string out;
-  ASSERT_EQ(run_pvs("bench " + city + kSmall + " --no-frames --python " + python + " --out " + dir +
-                        "/b",
-                    &out),
-            0)
+  ASSERT_EQ(
+      run_pvs("bench " + city + kSmall + " --no-frames --python " + python + " --out " + dir + "/b",
+              &out),
+      0)
       << out;
   EXPECT_NE(out.find("matplotlib"), std::string::npos) << out;
   EXPECT_NE(out.find("python3-matplotlib"), std::string::npos) << out;
@@ -96,7 +96,8 @@ TEST(BenchCli, BadOptionsExitWithCode2) {
   const std::string city = small_city(dir);
   EXPECT_EQ(run_pvs("bench " + city + " --box 1,2,3 --out " + dir + "/b", &out), 2) << out;
   EXPECT_NE(out.find("--box"), std::string::npos) << out;
-  EXPECT_EQ(run_pvs("bench " + city + " --box 0,0,0,1,1,1 --frame 8x8 --out " + dir + "/b", &out), 2)
+  EXPECT_EQ(run_pvs("bench " + city + " --box 0,0,0,1,1,1 --frame 8x8 --out " + dir + "/b", &out),
+            2)
       << out;
   EXPECT_EQ(run_pvs("bench --help", &out), 0);
   EXPECT_NE(out.find("--segment-runs"), std::string::npos);

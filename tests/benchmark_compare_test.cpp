@@ -1,10 +1,11 @@
 // Tests of vislib/benchmark_compare.h: test views, the equal-quality comparison and its
 // extrapolation, and one small run of the whole comparison.
+#include "vislib/benchmark_compare.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "vislib/benchmark_compare.h"
 #include "vislib/generate.h"
 
 using namespace vislib;

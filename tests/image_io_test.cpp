@@ -1,4 +1,6 @@
 // Tests of vislib/image_io.h: PNG and EXR round trips, atomic writes, bad input.
+#include "vislib/image_io.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -6,7 +8,6 @@
 
 #include "tests/test_support.h"
 #include "vislib/error.h"
-#include "vislib/image_io.h"
 
 using namespace vislib;
 

@@ -1,9 +1,10 @@
 // Tests of vislib/metrics.h against hand-computed values on tiny images.
+#include "vislib/metrics.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "vislib/metrics.h"
 #include "vislib/random.h"
 
 using namespace vislib;
@@ -77,7 +78,7 @@ TEST(Metrics, PixelErrorCountsOnlyFartherDepthsBeyondTheTolerance) {
   test.depth[2] = 8.0f;        // nearer (cannot happen for a subset, but is not a miss)
   test.depth[3] = float(10.0 * (1 + 0.5 * kPixelErrorDepthTolerance));  // within tolerance
   test.depth[4] = float(10.0 * (1 + 2.0 * kPixelErrorDepthTolerance));  // beyond tolerance
-  test.depth[15] = INFINITY;   // background in both
+  test.depth[15] = INFINITY;                                            // background in both
   const auto m = missed_pixels(truth, test);
   std::vector<uint8_t> expected(16, 0);
   expected[0] = expected[1] = expected[4] = 1;

@@ -1,4 +1,6 @@
 // Tests of vislib/render.h: camera convention, analytic depth, shading, subset frames, determinism.
+#include "vislib/render.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -7,7 +9,6 @@
 #include "tests/scene_builders.h"
 #include "vislib/generate.h"
 #include "vislib/point_visibility.h"
-#include "vislib/render.h"
 
 using namespace vislib;
 using vislib_test::add_quad;

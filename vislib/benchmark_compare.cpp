@@ -39,7 +39,8 @@ Vec3 view_direction(int a, int b, double yaw_deg, double pitch_deg) {
 std::vector<uint32_t> set_after(const std::vector<uint32_t>& first_run, int runs) {
   std::vector<uint32_t> ids;
   for (size_t t = 0; t < first_run.size(); ++t)
-    if (first_run[t] != MethodRun::kNever && first_run[t] < uint32_t(runs)) ids.push_back(uint32_t(t));
+    if (first_run[t] != MethodRun::kNever && first_run[t] < uint32_t(runs))
+      ids.push_back(uint32_t(t));
   return ids;
 }
 
@@ -132,8 +133,8 @@ QualitySummary summarize(const std::vector<FrameQuality>& views) {
   s.epsilon_mean = eps / n;
   s.ssim_mean = ssim / n;
   mse /= n;
-  s.psnr = mse == 0 ? std::numeric_limits<double>::infinity()
-                    : 10.0 * std::log10(255.0 * 255.0 / mse);
+  s.psnr =
+      mse == 0 ? std::numeric_limits<double>::infinity() : 10.0 * std::log10(255.0 * 255.0 / mse);
   return s;
 }
 
@@ -155,6 +156,7 @@ EqualQuality equal_quality(const std::vector<size_t>& union_size,
       return q;
     }
   q.extrapolated = true;
+  q.time_ratio_lower_bound = elapsed_seconds[m - 1] / segment_seconds;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   q.point_runs = q.point_seconds = q.time_ratio = nan;
   // Log-spaced run counts over the upper half (log scale) of [1, m].
@@ -269,7 +271,8 @@ BenchResult run_bench(const Scene& scene, const BenchOptions& options,
         assert(rec.segment == s && rec.run == int(k));
         const uint32_t order = uint32_t(k * S + s);
         for (uint32_t id : rec.visible)
-          if (r.segment.first_run[id] == MethodRun::kNever) r.segment.first_run[id] = order, ++found;
+          if (r.segment.first_run[id] == MethodRun::kNever)
+            r.segment.first_run[id] = order, ++found;
         seconds += rec.stats.seconds;
         r.segment.growth.push_back({int(order) + 1, seconds, found});
       }
@@ -364,8 +367,10 @@ BenchResult run_bench(const Scene& scene, const BenchOptions& options,
     if (c.runs == et.point_runs) et.point = c;
   if (options.keep_frames) {
     r.truth_frames = truth;
-    eval.evaluate(r.segment.first_run, int(S * K), seg_seconds, &r.segment_frames, &r.segment_missed);
-    eval.evaluate(r.point.first_run, et.point_runs, et.point_seconds, &r.point_frames, &r.point_missed);
+    eval.evaluate(r.segment.first_run, int(S * K), seg_seconds, &r.segment_frames,
+                  &r.segment_missed);
+    eval.evaluate(r.point.first_run, et.point_runs, et.point_seconds, &r.point_frames,
+                  &r.point_missed);
   }
 
   // Equal quality.

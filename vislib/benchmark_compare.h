@@ -44,7 +44,7 @@ struct BenchOptions {
   Box3 box;                      // view region; must not be empty (flat along y = view rectangle)
   int segment_runs = 2;          // K cube orientations per perimeter segment, >= 1
   int point_runs = 0;            // M from-point viewpoints, >= 0; 0 = automatic (below)
-  double point_time_factor = 3;  // automatic M: about this multiple of the from-segment seconds, >= 1
+  double point_time_factor = 3;  // automatic M: this multiple of from-segment's seconds, >= 1
   int max_point_runs = 100000;   // upper bound of the automatic M, >= 1
   int calibration_runs = 5;      // automatic M: from-point runs timed first (discarded), >= 2
   int resolution = 512;          // cube face resolution N of both methods, >= 1
@@ -59,7 +59,8 @@ struct BenchOptions {
 
 // The test views. Walk: the path runs along the horizontal axis a (x or z) on which the box is
 // longer (x on ties), b being the other; view i of V, s = (i + 0.5)/V, stands at
-//   a = min_a + (0.1 + 0.8 s) ext_a,  b = mid_b + 0.3 ext_b sin(2 pi s),  y = mid_y + 0.25 ext_y sin(4 pi s)
+//   a = min_a + (0.1 + 0.8 s) ext_a,  b = mid_b + 0.3 ext_b sin(2 pi s),
+//   y = mid_y + 0.25 ext_y sin(4 pi s)
 // (inside the box) and looks at yaw i * 137.5 degrees (the golden angle, so the views cover all
 // headings) from +a towards +b, pitch uniform in [-15, 15] degrees. Random: position uniform in
 // the box, yaw uniform, pitch uniform in [-15, 15] degrees. Up is +Y; frame size, field of view
@@ -67,9 +68,9 @@ struct BenchOptions {
 std::vector<Camera> bench_views(const BenchOptions& options);
 
 struct GrowthPoint {
-  int runs = 0;         // runs done (from-segment: pass-major order)
-  double seconds = 0;   // cumulative seconds after those runs
-  size_t found = 0;     // triangles in the union
+  int runs = 0;        // runs done (from-segment: pass-major order)
+  double seconds = 0;  // cumulative seconds after those runs
+  size_t found = 0;    // triangles in the union
 };
 
 // Frame quality of one set over all test views.
@@ -93,25 +94,26 @@ struct Checkpoint {
 };
 
 struct MethodRun {
-  std::vector<GrowthPoint> growth;       // after every run
-  std::vector<Checkpoint> checkpoints;   // in increasing runs
-  std::vector<uint32_t> set;             // final union, sorted
+  std::vector<GrowthPoint> growth;      // after every run
+  std::vector<Checkpoint> checkpoints;  // in increasing runs
+  std::vector<uint32_t> set;            // final union, sorted
   // Per triangle: the run index (0-based, in growth order) that first found it, or kNever.
   std::vector<uint32_t> first_run;
   static constexpr uint32_t kNever = std::numeric_limits<uint32_t>::max();
 };
 
 struct EqualTime {
-  double seconds = 0;               // the from-segment total seconds
-  int point_runs = 0;               // from-point runs finished within `seconds` (0: none)
-  double point_seconds = 0;         // their elapsed seconds
-  size_t segment_found = 0;         // |S|
-  size_t point_found = 0;           // |P|
+  double seconds = 0;                 // the from-segment total seconds
+  int point_runs = 0;                 // from-point runs finished within `seconds` (0: none)
+  double point_seconds = 0;           // their elapsed seconds
+  size_t segment_found = 0;           // |S|
+  size_t point_found = 0;             // |P|
   size_t point_found_of_segment = 0;  // |P ∩ S|
-  double share = 0;                 // |P| / |S| (the paper's 83%)
-  double overlap_share = 0;         // |P ∩ S| / |S|
-  bool within_measured = true;      // false: from-point stopped before `seconds` (then P = its final set)
-  Checkpoint segment, point;        // frame quality of S and P
+  double share = 0;                   // |P| / |S| (the paper's 83%)
+  double overlap_share = 0;           // |P ∩ S| / |S|
+  // False when from-point stopped before `seconds` (then P is its final set: a lower bound).
+  bool within_measured = true;
+  Checkpoint segment, point;  // frame quality of S and P
 };
 
 struct EqualQuality {
@@ -123,6 +125,8 @@ struct EqualQuality {
   double point_runs = 0;       // runs needed (measured: an integer; extrapolated: real)
   double point_seconds = 0;    // seconds needed (extrapolated: point_runs * mean seconds per run)
   double time_ratio = 0;       // point_seconds / segment_seconds (+inf when not finite)
+  // Not reached: the measured bound time_ratio > (seconds of all M runs) / segment_seconds.
+  double time_ratio_lower_bound = 0;
   // Extrapolation: new triangles per run ~ rate_coefficient * runs^(-rate_exponent), fitted by
   // least squares in log-log space to the discovery rates between log-spaced run counts over the
   // upper half (in log scale) of the measured runs; `fit_points` rates entered the fit.
@@ -139,7 +143,7 @@ EqualQuality equal_quality(const std::vector<size_t>& union_size,
                            double segment_seconds);
 
 struct BenchResult {
-  BenchOptions options;                 // as run (point_runs = the M actually used)
+  BenchOptions options;  // as run (point_runs = the M actually used)
   std::vector<Camera> views;
   std::vector<uint32_t> frame_triangles;  // union of the triangle ids of the ground-truth frames
   std::vector<Segment> segments;          // perimeter segments
@@ -151,11 +155,11 @@ struct BenchResult {
   // visible from the region, as far as float ray casts and pixel-centre sampling tell).
   std::vector<uint32_t> reference;
   SetComparison segment_vs_reference, point_vs_reference, point_equal_time_vs_reference;
-  double bvh_build_seconds = 0;        // Embree scene build (used by from-point and the frames)
-  double truth_seconds = 0;            // rendering the ground-truth frames
-  double point_seconds_per_run = 0;    // mean over the M runs
+  double bvh_build_seconds = 0;            // Embree scene build (used by from-point and the frames)
+  double truth_seconds = 0;                // rendering the ground-truth frames
+  double point_seconds_per_run = 0;        // mean over the M runs
   double calibration_seconds_per_run = 0;  // automatic M only
-  double quality_seconds = 0;          // rendering and comparing the checkpoint frames
+  double quality_seconds = 0;              // rendering and comparing the checkpoint frames
   // Equal-time frames per view (when keep_frames): ground truth, from S, from P, missed masks.
   std::vector<Frame> truth_frames, segment_frames, point_frames;
   std::vector<std::vector<uint8_t>> segment_missed, point_missed;

@@ -1,9 +1,9 @@
 // image_io.cpp: OpenImageIO behind the four functions of image_io.h.
 #include "vislib/image_io.h"
 
+#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
 #include <cassert>
 #include <cstdio>
 #include <stdexcept>
@@ -49,8 +49,8 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, int& width
 void write_rgb8_image(const std::string& path, int width, int height,
                       const std::vector<uint8_t>& rgb) {
   assert(width >= 1 && height >= 1 && rgb.size() == 3 * size_t(width) * size_t(height));
-  write_image(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8),
-              OIIO::TypeDesc::UINT8, rgb.data());
+  write_image(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8), OIIO::TypeDesc::UINT8,
+              rgb.data());
 }
 
 void write_float_image(const std::string& path, int width, int height,
@@ -70,7 +70,8 @@ std::vector<uint8_t> read_rgb8_image(const std::string& path, int& width, int& h
     throw InputError(path, "cannot decode image: " + in->geterror());
   std::vector<uint8_t> rgb(size_t(width) * size_t(height) * 3);
   for (size_t p = 0; p < size_t(width) * size_t(height); ++p)
-    for (int k = 0; k < 3; ++k) rgb[3 * p + size_t(k)] = all[p * size_t(nc) + size_t(nc >= 3 ? k : 0)];
+    for (int k = 0; k < 3; ++k)
+      rgb[3 * p + size_t(k)] = all[p * size_t(nc) + size_t(nc >= 3 ? k : 0)];
   return rgb;
 }
 

@@ -113,8 +113,8 @@ double ssim_luminance(int width, int height, const std::vector<uint8_t>& a_rgb,
               exy += gk * hxy[o];
         }
         const double vx = exx - mx * mx, vy = eyy - my * my, cxy = exy - mx * my;
-        total += ((2.0 * mx * my + c1) * (2.0 * cxy + c2)) /
-                 ((mx * mx + my * my + c1) * (vx + vy + c2));
+        total +=
+            ((2.0 * mx * my + c1) * (2.0 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
       }
       row_sum[r] = total;
     }
@@ -136,8 +136,10 @@ FrameQuality frame_quality(const Frame& truth, const Frame& test) {
   return q;
 }
 
-SetComparison compare_sets(const std::vector<uint32_t>& set, const std::vector<uint32_t>& reference) {
-  assert(std::is_sorted(set.begin(), set.end()) && std::is_sorted(reference.begin(), reference.end()));
+SetComparison compare_sets(const std::vector<uint32_t>& set,
+                           const std::vector<uint32_t>& reference) {
+  assert(std::is_sorted(set.begin(), set.end()) &&
+         std::is_sorted(reference.begin(), reference.end()));
   SetComparison c;
   c.size = set.size();
   c.reference_size = reference.size();

@@ -69,7 +69,8 @@ struct SetComparison {
   size_t missed = 0;          // |reference \ set|: reference triangles the set lacks
   size_t extra = 0;           // |set \ reference|: set triangles not in the reference
 };
-SetComparison compare_sets(const std::vector<uint32_t>& set, const std::vector<uint32_t>& reference);
+SetComparison compare_sets(const std::vector<uint32_t>& set,
+                           const std::vector<uint32_t>& reference);
 
 // An error heat map: RGB image of `frame`'s size with the pixels where `missed` is non-zero in
 // pure red (255, 0, 0) and every other pixel darkened to 30% of frame.rgb (floor(0.3 v), so at

@@ -17,7 +17,9 @@ struct CameraBasis {
   double sx_scale, sy_scale;
 };
 
-Vec3 normalized(Vec3 v) { return v * (1.0 / length(v)); }
+Vec3 normalized(Vec3 v) {
+  return v * (1.0 / length(v));
+}
 
 CameraBasis basis(const Camera& c) {
   assert(is_finite(c.forward) && length(c.forward) > 0);
@@ -70,12 +72,24 @@ std::array<uint8_t, 3> object_colour(uint32_t object) {
   const double p = val * (1 - sat), q = val * (1 - sat * frac), t = val * (1 - sat * (1 - frac));
   double rgb[3];
   switch (sector) {
-    case 0: rgb[0] = val, rgb[1] = t, rgb[2] = p; break;
-    case 1: rgb[0] = q, rgb[1] = val, rgb[2] = p; break;
-    case 2: rgb[0] = p, rgb[1] = val, rgb[2] = t; break;
-    case 3: rgb[0] = p, rgb[1] = q, rgb[2] = val; break;
-    case 4: rgb[0] = t, rgb[1] = p, rgb[2] = val; break;
-    default: rgb[0] = val, rgb[1] = p, rgb[2] = q; break;
+    case 0:
+      rgb[0] = val, rgb[1] = t, rgb[2] = p;
+      break;
+    case 1:
+      rgb[0] = q, rgb[1] = val, rgb[2] = p;
+      break;
+    case 2:
+      rgb[0] = p, rgb[1] = val, rgb[2] = t;
+      break;
+    case 3:
+      rgb[0] = p, rgb[1] = q, rgb[2] = val;
+      break;
+    case 4:
+      rgb[0] = t, rgb[1] = p, rgb[2] = val;
+      break;
+    default:
+      rgb[0] = val, rgb[1] = p, rgb[2] = q;
+      break;
   }
   return {to_byte(rgb[0]), to_byte(rgb[1]), to_byte(rgb[2])};
 }
@@ -91,33 +105,35 @@ Frame render_frame(const Scene& scene, const EmbreeScene& rt, const Camera& came
   frame.rgb.assign(3 * n, 0);
   frame.depth.assign(n, std::numeric_limits<float>::infinity());
   frame.tri.assign(n, kNoHit);
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    std::vector<Vec3> dirs(w);
-    std::vector<Hit> hits(w);
-    for (int y = rows.begin(); y != rows.end(); ++y) {
-      for (int x = 0; x < camera.width; ++x) dirs[size_t(x)] = ray(b, camera, x, y);
-      rt.first_hits_among(camera.eye, dirs.data(), w, camera.z_near, allowed, hits.data());
-      for (size_t x = 0; x < w; ++x) {
-        const size_t p = size_t(y) * w + x;
-        uint8_t* out = &frame.rgb[3 * p];
-        const Hit& h = hits[x];
-        if (h.tri == kNoHit) {
-          out[0] = kRenderBackground[0], out[1] = kRenderBackground[1], out[2] = kRenderBackground[2];
-          continue;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+        std::vector<Vec3> dirs(w);
+        std::vector<Hit> hits(w);
+        for (int y = rows.begin(); y != rows.end(); ++y) {
+          for (int x = 0; x < camera.width; ++x) dirs[size_t(x)] = ray(b, camera, x, y);
+          rt.first_hits_among(camera.eye, dirs.data(), w, camera.z_near, allowed, hits.data());
+          for (size_t x = 0; x < w; ++x) {
+            const size_t p = size_t(y) * w + x;
+            uint8_t* out = &frame.rgb[3 * p];
+            const Hit& h = hits[x];
+            if (h.tri == kNoHit) {
+              out[0] = kRenderBackground[0], out[1] = kRenderBackground[1],
+              out[2] = kRenderBackground[2];
+              continue;
+            }
+            const double len = length(dirs[x]);
+            frame.tri[p] = h.tri;
+            frame.depth[p] = float(h.lambda * len);
+            const auto c = scene.corners(h.tri, 0);
+            const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
+            const double nl = length(normal);
+            const double lambert = nl > 0 ? std::fabs(dot(normal, dirs[x])) / (nl * len) : 0.0;
+            const double shade = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
+            const auto albedo = object_colour(scene.triangle_object[h.tri]);
+            for (int k = 0; k < 3; ++k) out[k] = to_byte(double(albedo[size_t(k)]) / 255.0 * shade);
+          }
         }
-        const double len = length(dirs[x]);
-        frame.tri[p] = h.tri;
-        frame.depth[p] = float(h.lambda * len);
-        const auto c = scene.corners(h.tri, 0);
-        const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
-        const double nl = length(normal);
-        const double lambert = nl > 0 ? std::fabs(dot(normal, dirs[x])) / (nl * len) : 0.0;
-        const double shade = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
-        const auto albedo = object_colour(scene.triangle_object[h.tri]);
-        for (int k = 0; k < 3; ++k) out[k] = to_byte(double(albedo[size_t(k)]) / 255.0 * shade);
-      }
-    }
-  });
+      });
   return frame;
 }
 

@@ -5,7 +5,8 @@
 // Camera convention. f = forward/|forward|, r = (f x up)/|f x up|, u = r x f. Pixel (x, y) of a
 // W x H frame (x = column from the left, y = row from the top, row-major index y*W + x) looks
 // along the pixel centre
-//   d = f + sx*r + sy*u,  sx = ((2x+1)/W - 1) * tan(vfov/2) * W/H,  sy = (1 - (2y+1)/H) * tan(vfov/2)
+//   d = f + sx*r + sy*u,  sx = ((2x+1)/W - 1) * tan(vfov/2) * W/H,  sy = (1 - (2y+1)/H) *
+//   tan(vfov/2)
 // (not normalised: f.d = 1, so Embree's hit distance along d is the view depth, as in cubemap.h).
 // A hit counts at view depth > z_near (a rasteriser's near plane).
 //
@@ -38,10 +39,10 @@ constexpr double kRenderAmbient = 0.1;
 constexpr std::array<uint8_t, 3> kRenderBackground = {150, 170, 195};
 
 struct Camera {
-  Vec3 eye;                  // world position
-  Vec3 forward{0, 0, -1};    // view direction; must be finite and non-zero
-  Vec3 up{0, 1, 0};          // must not be parallel to forward
-  double vfov_degrees = 90;  // vertical field of view, in (0, 180)
+  Vec3 eye;                       // world position
+  Vec3 forward{0, 0, -1};         // view direction; must be finite and non-zero
+  Vec3 up{0, 1, 0};               // must not be parallel to forward
+  double vfov_degrees = 90;       // vertical field of view, in (0, 180)
   int width = 640, height = 480;  // pixels, each >= 1
   double z_near = kDefaultNear;   // near plane: view depth (scene units), > 0
 };
