@@ -331,6 +331,7 @@ void run(BenchArgs& a) {
                         {"point_seconds", num(eq.point_seconds)},
                         {"time_ratio", num(eq.time_ratio)},
                         {"time_ratio_lower_bound", num(eq.time_ratio_lower_bound)},
+                        {"time_ratio_range", {num(eq.time_ratio_low), num(eq.time_ratio_high)}},
                         {"rate_coefficient", num(eq.rate_coefficient)},
                         {"rate_exponent", num(eq.rate_exponent)},
                         {"fit_points", eq.fit_points},
@@ -366,17 +367,20 @@ void run(BenchArgs& a) {
   if (eq.reached)
     std::fprintf(stderr, "pvs bench: equal quality: from-point needs %.2f s (%.0f runs), %.2fx\n",
                  eq.point_seconds, eq.point_runs, eq.time_ratio);
-  else
+  else {
+    std::string detail = eq.note;
+    if (!std::isnan(eq.time_ratio) && !std::isfinite(eq.time_ratio))
+      detail = "the extrapolation never gets there (see bench.json)";
+    else if (std::isfinite(eq.time_ratio))
+      detail = "extrapolated ratio " + cell(eq.time_ratio) +
+               "x (power-law fit of the discovery rate; " + cell(eq.time_ratio_low) + " to " +
+               cell(eq.time_ratio_high) + "x over three fit windows)";
     std::fprintf(stderr,
                  "pvs bench: equal quality not reached in %d from-point runs (%zu of %zu "
                  "triangles): measured ratio > %.2fx; %s\n",
                  r.options.point_runs, r.point.set.size(), eq.target, eq.time_ratio_lower_bound,
-                 std::isnan(eq.time_ratio) ? eq.note.c_str()
-                 : !std::isfinite(eq.time_ratio)
-                     ? "the extrapolation never gets there (see bench.json)"
-                     : ("extrapolated ratio " + cell(eq.time_ratio) +
-                        "x (power-law fit of the discovery rate)")
-                           .c_str());
+                 detail.c_str());
+  }
   std::fprintf(stderr,
                "pvs bench: at equal time: segment eps %.3f%% PSNR %s SSIM %.5f | point eps %.3f%% "
                "PSNR %s SSIM %.5f\npvs bench: wrote %s/bench.json (total %.1f s)\n",

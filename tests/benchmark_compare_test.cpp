@@ -90,6 +90,11 @@ TEST(BenchmarkCompare, EqualQualityExtrapolatesAPowerLawGrowth) {
   EXPECT_NEAR(q.point_seconds, 0.01 * q.point_runs, 1e-9);
   EXPECT_NEAR(q.time_ratio, q.point_seconds / 5.0, 1e-12);
   EXPECT_FALSE(q.note.empty());
+  EXPECT_DOUBLE_EQ(q.time_ratio_lower_bound, 0.01 * m / 5.0);
+  // An exact power law: every fit window gives about the same answer.
+  EXPECT_LE(q.time_ratio_low, q.time_ratio);
+  EXPECT_GE(q.time_ratio_high, q.time_ratio);
+  EXPECT_LT(q.time_ratio_high / q.time_ratio_low, 1.1);
   // Beyond the asymptote the fit never gets there.
   const EqualQuality never = equal_quality(found, t, size_t(A + 1000), 5.0);
   EXPECT_FALSE(never.finite);

@@ -138,6 +138,57 @@ QualitySummary summarize(const std::vector<FrameQuality>& views) {
   return s;
 }
 
+namespace {
+
+struct RateFit {
+  bool ok = false;
+  double c = 0, p = 0;  // new triangles per run ~ c * runs^-p
+  int points = 0;
+};
+
+// Least-squares fit of log(rate) against log(runs) for the discovery rates between 9 log-spaced
+// run counts over [m^lower, m] (m = union_size.size()); rates of zero are left out.
+RateFit fit_discovery_rate(const std::vector<size_t>& union_size, double lower) {
+  const size_t m = union_size.size();
+  std::vector<size_t> ns;
+  const int steps = 8;
+  for (int j = 0; j <= steps; ++j) {
+    const double e = lower + (1 - lower) * double(j) / steps;
+    const size_t n = std::min(size_t(std::llround(std::pow(double(m), e))), m);
+    if (n >= 1 && (ns.empty() || n > ns.back())) ns.push_back(n);
+  }
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  RateFit f;
+  for (size_t j = 0; j + 1 < ns.size(); ++j) {
+    const double gain = double(union_size[ns[j + 1] - 1]) - double(union_size[ns[j] - 1]);
+    if (gain <= 0) continue;
+    const double rate = gain / double(ns[j + 1] - ns[j]);
+    const double x = std::log(std::sqrt(double(ns[j]) * double(ns[j + 1]))), y = std::log(rate);
+    sx += x, sy += y, sxx += x * x, sxy += x * y, ++f.points;
+  }
+  const double k = double(f.points), det = k * sxx - sx * sx;
+  if (f.points < 2 || !(det > 0)) return f;
+  const double slope = (k * sxy - sx * sy) / det;
+  f.c = std::exp((sy - slope * sx) / k);
+  f.p = -slope;
+  f.ok = true;
+  return f;
+}
+
+// Runs n at which f(n) = f(m) + integral_m^n c x^-p dx reaches `target`; +inf when the fitted
+// growth levels off below it.
+double runs_to_reach(const std::vector<size_t>& union_size, size_t target, const RateFit& f) {
+  const double dm = double(union_size.size());
+  const double need = double(target) - double(union_size.back());
+  if (std::fabs(1 - f.p) < 1e-9) return dm * std::exp(need / f.c);
+  if (f.p < 1) return std::pow(std::pow(dm, 1 - f.p) + need * (1 - f.p) / f.c, 1 / (1 - f.p));
+  const double base = std::pow(dm, 1 - f.p) - need * (f.p - 1) / f.c;
+  if (!(base > 0)) return std::numeric_limits<double>::infinity();
+  return std::pow(base, -1 / (f.p - 1));
+}
+
+}  // namespace
+
 EqualQuality equal_quality(const std::vector<size_t>& union_size,
                            const std::vector<double>& elapsed_seconds, size_t target,
                            double segment_seconds) {
@@ -159,60 +210,38 @@ EqualQuality equal_quality(const std::vector<size_t>& union_size,
   q.time_ratio_lower_bound = elapsed_seconds[m - 1] / segment_seconds;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   q.point_runs = q.point_seconds = q.time_ratio = nan;
-  // Log-spaced run counts over the upper half (log scale) of [1, m].
-  std::vector<size_t> ns;
-  const int steps = 8;
-  for (int j = 0; j <= steps; ++j) {
-    const double e = 0.5 + 0.5 * double(j) / steps;
-    const size_t n = size_t(std::llround(std::pow(double(m), e)));
-    if (n >= 1 && (ns.empty() || n > ns.back())) ns.push_back(std::min(n, m));
-  }
-  double sx = 0, sy = 0, sxx = 0, sxy = 0;
-  int k = 0;
-  for (size_t j = 0; j + 1 < ns.size(); ++j) {
-    const double gain = double(union_size[ns[j + 1] - 1]) - double(union_size[ns[j] - 1]);
-    if (gain <= 0) continue;
-    const double rate = gain / double(ns[j + 1] - ns[j]);
-    const double x = std::log(std::sqrt(double(ns[j]) * double(ns[j + 1]))), y = std::log(rate);
-    sx += x, sy += y, sxx += x * x, sxy += x * y, ++k;
-  }
-  q.fit_points = k;
-  const double det = double(k) * sxx - sx * sx;
-  if (k < 2 || !(det > 0)) {
+  const double per_run = elapsed_seconds[m - 1] / double(m);
+  const RateFit fit = fit_discovery_rate(union_size, 0.5);
+  q.fit_points = fit.points;
+  if (!fit.ok) {
     q.note = "from-point did not reach the from-segment set size in " + std::to_string(m) +
              " runs, and its growth has fewer than two positive rates to extrapolate from";
     return q;
   }
-  const double slope = (double(k) * sxy - sx * sy) / det;
-  const double intercept = (sy - slope * sx) / double(k);
-  const double c = std::exp(intercept), p = -slope;
-  q.rate_coefficient = c;
-  q.rate_exponent = p;
-  // f(n) = f(m) + integral_m^n c x^-p dx; solve f(n) = target.
-  const double need = double(target) - double(union_size[m - 1]);
-  const double dm = double(m);
-  double n;
-  if (std::fabs(1 - p) < 1e-9) {
-    n = dm * std::exp(need / c);
-  } else if (p < 1) {
-    n = std::pow(std::pow(dm, 1 - p) + need * (1 - p) / c, 1 / (1 - p));
-  } else {
-    const double base = std::pow(dm, 1 - p) - need * (p - 1) / c;
-    if (!(base > 0)) {
-      q.finite = false;
-      q.time_ratio = std::numeric_limits<double>::infinity();
-      q.point_runs = q.point_seconds = std::numeric_limits<double>::infinity();
-      q.note = "extrapolated: the fitted from-point growth levels off at " +
-               std::to_string(double(union_size[m - 1]) + c / (p - 1) * std::pow(dm, 1 - p)) +
-               " triangles, below the from-segment set size";
-      return q;
-    }
-    n = std::pow(base, -1 / (p - 1));
-  }
+  q.rate_coefficient = fit.c;
+  q.rate_exponent = fit.p;
+  const double n = runs_to_reach(union_size, target, fit);
   q.point_runs = n;
-  q.point_seconds = n * (elapsed_seconds[m - 1] / dm);
+  q.point_seconds = n * per_run;
   q.time_ratio = q.point_seconds / segment_seconds;
   q.finite = std::isfinite(q.time_ratio);
+  // Sensitivity: the same extrapolation from fits over the upper 3/4 and upper 1/4 (log scale).
+  q.time_ratio_low = q.time_ratio_high = q.time_ratio;
+  for (double lower : {0.25, 0.75}) {
+    const RateFit f = fit_discovery_rate(union_size, lower);
+    const double r = f.ok ? runs_to_reach(union_size, target, f) * per_run / segment_seconds
+                          : std::numeric_limits<double>::quiet_NaN();
+    if (std::isnan(r)) continue;
+    q.time_ratio_low = std::min(q.time_ratio_low, r);
+    q.time_ratio_high = std::max(q.time_ratio_high, r);
+  }
+  if (!q.finite) {
+    q.note = "extrapolated: the fitted from-point growth levels off at " +
+             std::to_string(double(union_size[m - 1]) +
+                            fit.c / (fit.p - 1) * std::pow(double(m), 1 - fit.p)) +
+             " triangles, below the from-segment set size";
+    return q;
+  }
   q.note = "extrapolated: from-point did not reach the from-segment set size in " +
            std::to_string(m) + " runs; runs needed from a power-law fit of its discovery rate, " +
            "seconds = runs x mean seconds per run";

@@ -127,6 +127,9 @@ struct EqualQuality {
   double time_ratio = 0;       // point_seconds / segment_seconds (+inf when not finite)
   // Not reached: the measured bound time_ratio > (seconds of all M runs) / segment_seconds.
   double time_ratio_lower_bound = 0;
+  // Extrapolated: the smallest and largest ratio from fits over the upper 3/4, 1/2 and 1/4 (log
+  // scale) of the runs, a measure of how much the estimate depends on the fit window.
+  double time_ratio_low = 0, time_ratio_high = 0;
   // Extrapolation: new triangles per run ~ rate_coefficient * runs^(-rate_exponent), fitted by
   // least squares in log-log space to the discovery rates between log-spaced run counts over the
   // upper half (in log scale) of the measured runs; `fit_points` rates entered the fit.
