@@ -122,7 +122,9 @@ def main(argv):
         ax.grid(alpha=0.3)
         ax.set_xscale("log")
     axes[0].set_ylabel("pixel error ε [%] (mean)")
-    axes[0].set_yscale("symlog", linthresh=1e-3)
+    # Linear below the smallest non-zero error (about one pixel), logarithmic above.
+    positive = [100 * float(r["epsilon"]) for r in rows_all if float(r["epsilon"]) > 0]
+    axes[0].set_yscale("symlog", linthresh=min(positive) if positive else 1e-3)
     axes[0].set_ylim(bottom=0)
     axes[1].axhline(psnr_inf, color="black", lw=0.6, ls=":")
     axes[1].annotate("identical frames (PSNR = ∞)", xy=(0.01, psnr_inf), xycoords=("axes fraction", "data"),
