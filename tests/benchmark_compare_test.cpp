@@ -153,3 +153,29 @@ TEST(BenchmarkCompare, SmallRunIsConsistent) {
   EXPECT_EQ(r.segment_vs_reference.extra, 0u);
   EXPECT_EQ(r.point_vs_reference.extra, 0u);
 }
+
+TEST(BenchmarkCompare, RepeatedRunGivesTheSameSetsAndQuality) {
+  CityOptions co;
+  co.blocks_x = co.blocks_z = 2;
+  const Scene s = generate_city(co);
+  BenchOptions o;
+  o.box = box({-3, 1.5, -10}, {3, 1.9, 10});
+  o.segment_runs = 1;
+  o.point_runs = 6;
+  o.resolution = 32;
+  o.views = 2;
+  o.width = 32, o.height = 24;
+  o.keep_frames = false;
+  const BenchResult a = run_bench(s, o), b = run_bench(s, o);
+  EXPECT_EQ(a.segment.set, b.segment.set);
+  EXPECT_EQ(a.point.set, b.point.set);
+  EXPECT_EQ(a.point.first_run, b.point.first_run);
+  ASSERT_EQ(a.segment.checkpoints.size(), b.segment.checkpoints.size());
+  for (size_t i = 0; i < a.segment.checkpoints.size(); ++i) {
+    EXPECT_EQ(a.segment.checkpoints[i].quality.missed_pixels,
+              b.segment.checkpoints[i].quality.missed_pixels);
+    EXPECT_EQ(a.segment.checkpoints[i].quality.ssim_mean,
+              b.segment.checkpoints[i].quality.ssim_mean);
+  }
+  EXPECT_EQ(a.segments.size(), 12u);  // a box with a height band: twelve edges
+}
