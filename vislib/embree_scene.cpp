@@ -49,6 +49,20 @@ struct ExcludeContext {
   uint32_t exclude;
 };
 
+// An intersect context carrying a per-triangle mask of the triangles that may be hit.
+struct AllowContext {
+  RTCIntersectContext base;
+  const uint8_t* allowed;
+};
+
+void allow_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* ctx = reinterpret_cast<const AllowContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    if (!ctx->allowed[RTCHitN_primID(args->hit, args->N, i)]) args->valid[i] = 0;
+  }
+}
+
 void exclude_filter(const RTCFilterFunctionNArguments* args) {
   const auto* ctx = reinterpret_cast<const ExcludeContext*>(args->context);
   for (unsigned i = 0; i < args->N; ++i) {
@@ -163,13 +177,20 @@ Hit EmbreeScene::first_hit_excluding(Vec3 eye_world, Vec3 dir, double tnear,
 
 void EmbreeScene::first_hits(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear,
                              Hit* out) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  first_hits_among(eye_world, dirs, count, tnear, nullptr, out);
+}
+
+void EmbreeScene::first_hits_among(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear,
+                                   const uint8_t* allowed, Hit* out) const {
+  AllowContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  ctx.base.filter = allowed ? &allow_filter : nullptr;
+  ctx.allowed = allowed;
   const Vec3 org = eye_world - impl_->origin;
   std::vector<RTCRayHit> rays(count);
   for (size_t i = 0; i < count; ++i) rays[i] = make_ray(org, dirs[i], tnear);
-  rtcIntersect1M(impl_->scene, &ctx, rays.data(), unsigned(count), sizeof(RTCRayHit));
+  rtcIntersect1M(impl_->scene, &ctx.base, rays.data(), unsigned(count), sizeof(RTCRayHit));
   for (size_t i = 0; i < count; ++i) out[i] = to_hit(rays[i]);
   impl_->check();
 }

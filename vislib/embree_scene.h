@@ -70,6 +70,14 @@ class EmbreeScene {
   // deterministic (the result does not depend on which thread runs the call).
   void first_hits(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear, Hit* out) const;
 
+  // As first_hits, but only triangles t with allowed[t] != 0 can be hit: an intersect-context
+  // filter on the same BVH and the same ray stream, so the answer is first_hits restricted to the
+  // allowed triangles (a ray whose first hit is allowed gets exactly that hit, lambda included).
+  // `allowed` must hold triangle_count() bytes, or be null (then identical to first_hits).
+  // Thread-safe; deterministic.
+  void first_hits_among(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear,
+                        const uint8_t* allowed, Hit* out) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -54,47 +54,50 @@ namespace {
 // Runs the K viewpoints given by `viewpoint(i)` and records the growth of the union.
 template <class ViewpointFn>
 SampledVisibility sample_union(const EmbreeScene& scene, const PointSampling& opt,
-                               ViewpointFn viewpoint) {
+                               ViewpointFn viewpoint, const SamplingProgress& progress) {
   assert(opt.runs >= 1);
   using clock = std::chrono::steady_clock;
   const auto start = clock::now();
   SampledVisibility out;
-  std::vector<uint8_t> seen(scene.triangle_count(), 0);
+  std::vector<uint32_t> seen(scene.triangle_count(), 0);  // 0 = not yet, else 1 + first run
   size_t count = 0;
   for (int i = 0; i < opt.runs; ++i) {
     const Vec3 eye = viewpoint(i);
     const Mat3 R = opt.random_orientation ? random_orientation(Rng::derive(opt.seed, uint64_t(i)))
                                           : opt.R;
     for (uint32_t id : point_visible_set(scene, eye, R, opt.n, opt.z_near))
-      if (!seen[id]) seen[id] = 1, ++count;
+      if (!seen[id]) seen[id] = uint32_t(i) + 1, ++count;
     out.viewpoints.push_back(eye);
     out.union_size.push_back(count);
     out.elapsed_seconds.push_back(std::chrono::duration<double>(clock::now() - start).count());
+    if (progress) progress(size_t(i) + 1, size_t(opt.runs));
   }
   out.ids.reserve(count);
+  out.first_run.reserve(count);
   for (size_t id = 0; id < seen.size(); ++id)
-    if (seen[id]) out.ids.push_back(uint32_t(id));
+    if (seen[id]) out.ids.push_back(uint32_t(id)), out.first_run.push_back(seen[id] - 1);
   return out;
 }
 
 }  // namespace
 
 SampledVisibility sample_segment(const EmbreeScene& scene, Vec3 v0, Vec3 v1,
-                                 const PointSampling& opt) {
+                                 const PointSampling& opt, const SamplingProgress& progress) {
   return sample_union(scene, opt, [&](int i) {
     const double t = opt.runs == 1 ? 0.5 : double(i) / double(opt.runs - 1);
     return lerp(v0, v1, t);
-  });
+  }, progress);
 }
 
-SampledVisibility sample_box(const EmbreeScene& scene, const Box3& box, const PointSampling& opt) {
+SampledVisibility sample_box(const EmbreeScene& scene, const Box3& box, const PointSampling& opt,
+                             const SamplingProgress& progress) {
   assert(!box.empty());
   Rng rng(opt.seed);
   return sample_union(scene, opt, [&](int) {
     Vec3 p;
     for (int k = 0; k < 3; ++k) p[k] = rng.uniform(box.min[k], box.max[k]);
     return p;
-  });
+  }, progress);
 }
 
 }  // namespace vislib

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "vislib/cubemap.h"
@@ -47,17 +48,22 @@ struct PointSampling {
 // non-reproducible field).
 struct SampledVisibility {
   std::vector<uint32_t> ids;              // sorted unique union
+  std::vector<uint32_t> first_run;        // first_run[j]: the run that first found ids[j]
   std::vector<Vec3> viewpoints;           // viewpoint of run i (world)
   std::vector<size_t> union_size;         // |union| after run i
   std::vector<double> elapsed_seconds;    // after run i
 };
 
+// Called after each run with (runs done, runs in all), from the calling thread; may be empty.
+using SamplingProgress = std::function<void(size_t done, size_t total)>;
+
 // K viewpoints evenly along v0->v1: t_i = i/(K-1) (both ends included; K = 1 gives t = 0.5).
 SampledVisibility sample_segment(const EmbreeScene& scene, Vec3 v0, Vec3 v1,
-                                 const PointSampling& opt);
+                                 const PointSampling& opt, const SamplingProgress& progress = {});
 
 // K viewpoints uniformly at random in `box` (must not be empty), drawn in order from
 // Rng(opt.seed) (x, y, z per viewpoint). Same seed, same viewpoints and union.
-SampledVisibility sample_box(const EmbreeScene& scene, const Box3& box, const PointSampling& opt);
+SampledVisibility sample_box(const EmbreeScene& scene, const Box3& box, const PointSampling& opt,
+                             const SamplingProgress& progress = {});
 
 }  // namespace vislib
