@@ -24,7 +24,7 @@ using namespace vislib;
 
 namespace {
 
-const int kN = 256;
+const int kN = 128;
 
 // Icosphere of `subdiv` subdivisions around the origin, radius 1.
 void icosphere(int subdiv, std::vector<Vec3>& verts, std::vector<std::array<uint32_t, 3>>& tris) {
@@ -83,14 +83,14 @@ const Scenes& scenes() {
   static const Scenes s = [] {
     Scenes x;
     SphereOptions so;
-    so.count = 1000;
-    so.states = 5;
+    so.count = 300;
+    so.states = 3;
     so.seed = 1;
     x.spheres = generate_spheres(so);
-    x.tessellated = tessellate(x.spheres, 2);  // 320 triangles per sphere
+    x.tessellated = tessellate(x.spheres, 1);  // 80 triangles per sphere
     GrassOptions g;
     g.size = 20;
-    g.target_triangles = 200000;
+    g.target_triangles = 50000;
     g.states = 10;
     g.seed = 1;
     x.grass = generate_grass(g);
@@ -149,6 +149,7 @@ int table() {
     std::sort(obj.begin(), obj.end());
     vt = size_t(std::unique(obj.begin(), obj.end()) - obj.begin());
   });
+  std::setvbuf(stdout, nullptr, _IONBF, 0);
   std::printf("spheres: %zu spheres x %zu states, N=%d: direct %.3f s (%zu visible), tessellated "
               "(%zu triangles) %.3f s (%zu spheres visible): speedup %.1fx\n",
               s.spheres.sphere_count(), s.spheres.state_count(), kN, ts, vs, s.tessellated.triangle_count(), tt, vt,
