@@ -5,14 +5,19 @@
 #include <map>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "pvs_format/pvs_format.h"
+#include "vislib/embree_scene.h"
 #include "vislib/error.h"
 #include "vislib/file_util.h"
+#include "vislib/image_io.h"
+#include "vislib/metrics.h"
+#include "vislib/render.h"
 #include "vislib/scene_fingerprint.h"
 #include "vislib/scene_subset.h"
 #include "vislib/view_cells.h"
@@ -24,7 +29,8 @@ namespace {
 using nlohmann::json;
 
 struct InspectArgs {
-  std::string file, at, scene, gltf;
+  std::string file, at, scene, gltf, render_dir;
+  std::string frame = "640x480";
   int64_t cell = -1;
   bool json_out = false;
   int max_ids = 40;
@@ -179,6 +185,50 @@ void print_summary(const std::string& path, const json& j) {
     std::printf("    %3d-%3d%% %8u %s\n", 10 * i, 10 * (i + 1), hist[i], std::string(size_t(40.0 * hist[i] / most + 0.5), '#').c_str());
 }
 
+// Renders, from the centre of a cell's view region, the full-scene frame, the frame of the
+// cell's visible set and the error heat map in 4 horizontal directions; returns the metrics.
+json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids, vislib::Granularity g,
+                 vislib::Vec3 eye, const std::string& dir, int width, int height) {
+  std::filesystem::create_directories(dir);
+  std::vector<uint32_t> tris = ids;
+  if (g == vislib::Granularity::Object) {
+    std::vector<uint8_t> keep(scene.objects.size(), 0);
+    for (uint32_t o : ids) keep[o] = 1;
+    tris.clear();
+    for (uint32_t t = 0; t < scene.triangle_count(); ++t)
+      if (keep[scene.triangle_object[t]]) tris.push_back(t);
+  }
+  std::vector<uint8_t> mask = vislib::triangle_mask(scene.triangle_count(), tris);
+  vislib::EmbreeScene rt(scene, 0.0, eye);
+  json views = json::array();
+  const vislib::Vec3 dirs[4] = {{1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, 0, -1}};
+  for (int k = 0; k < 4; ++k) {
+    vislib::Camera cam;
+    cam.eye = eye;
+    cam.forward = dirs[k];
+    cam.width = width;
+    cam.height = height;
+    vislib::Frame truth = vislib::render_frame(scene, rt, cam);
+    vislib::Frame test = vislib::render_frame(scene, rt, cam, mask.data());
+    vislib::FrameQuality q = vislib::frame_quality(truth, test);
+    std::string base = dir + "/view" + std::to_string(k);
+    vislib::write_rgb8_image(base + "_full.png", width, height, truth.rgb);
+    vislib::write_rgb8_image(base + "_pvs.png", width, height, test.rgb);
+    vislib::write_rgb8_image(base + "_heat.png", width, height,
+                             vislib::error_heat_map(test, vislib::missed_pixels(truth, test)));
+    views.push_back({{"eye", {eye.x, eye.y, eye.z}},
+                     {"forward", {dirs[k].x, dirs[k].y, dirs[k].z}},
+                     {"epsilon", q.epsilon},
+                     {"missed_pixels", q.missed_pixels},
+                     {"psnr", std::isfinite(q.psnr) ? json(q.psnr) : json(nullptr)},
+                     {"ssim", q.ssim},
+                     {"full", base + "_full.png"},
+                     {"pvs", base + "_pvs.png"},
+                     {"heat_map", base + "_heat.png"}});
+  }
+  return {{"views", views}, {"width", width}, {"height", height}};
+}
+
 void add_inspect(CLI::App& app) {
   auto a = std::make_shared<InspectArgs>();
   CLI::App* cmd = app.add_subcommand(
@@ -190,6 +240,11 @@ void add_inspect(CLI::App& app) {
   cmd->add_flag("--json", a->json_out, "Print JSON instead of text (all visible ids of a cell)");
   cmd->add_option("--scene", a->scene, "The scene the PVS was baked for (checked by its fingerprint)");
   cmd->add_option("--export-gltf", a->gltf, "With --scene and a cell: write the scene reduced to the cell's set (.glb)");
+  cmd->add_option("--render", a->render_dir,
+                  "With --scene and a cell: render from the --at point (else the centre of the cell's view "
+                  "region), in 4 horizontal directions, the full-scene frame, the PVS frame and the error heat map into this folder, "
+                  "with epsilon/PSNR/SSIM");
+  cmd->add_option("--frame", a->frame, "Frame size WxH for --render")->capture_default_str();
   cmd->add_option("--max-ids", a->max_ids, "Text output: print at most this many ids of a cell")->capture_default_str();
   cmd->callback([a] {
     pvs::ReadOptions opt;
@@ -202,6 +257,13 @@ void add_inspect(CLI::App& app) {
       if (a->scene.empty()) throw CLI::ValidationError("--export-gltf", "needs --scene");
       if (a->cell < 0 && a->at.empty()) throw CLI::ValidationError("--export-gltf", "needs --cell or --at");
     }
+    if (!a->render_dir.empty()) {
+      if (a->scene.empty()) throw CLI::ValidationError("--render", "needs --scene");
+      if (a->cell < 0 && a->at.empty()) throw CLI::ValidationError("--render", "needs --cell or --at");
+    }
+    int fw = 0, fh = 0;
+    if (std::sscanf(a->frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 || fh > 8192)
+      throw CLI::ValidationError("--frame", "expected WxH with 11 <= W, H <= 8192, got '" + a->frame + "'");
     try {
       pvs::Reader r = pvs::Reader::from_file(a->file, opt);
       const pvs::FileInfo& info = r.info();
@@ -258,6 +320,14 @@ void add_inspect(CLI::App& app) {
           vislib::write_file_atomic(a->gltf, vislib::scene_to_glb(sub));
           j["export_gltf"] = a->gltf;
         }
+        if (!a->render_dir.empty()) {
+          // The viewpoint: the --at point, else the centre of the cell's view region.
+          pvs::Box region = info.layout.view_region(c);
+          vislib::Vec3 eye{(region.min[0] + region.max[0]) / 2, (region.min[1] + region.max[1]) / 2,
+                           (region.min[2] + region.max[2]) / 2};
+          if (!a->at.empty()) eye = parse_vec3(a->at, "--at");
+          j["render"] = render_cell(scene, ids, g, eye, a->render_dir, fw, fh);
+        }
       }
       if (a->json_out) {
         j["visible"] = ids;
@@ -284,6 +354,11 @@ void add_inspect(CLI::App& app) {
       if (int(ids.size()) > a->max_ids) std::printf(" ... (%zu more; --json lists all)", ids.size() - a->max_ids);
       std::printf("\n");
       if (!a->gltf.empty()) std::printf("  wrote %s\n", a->gltf.c_str());
+      if (j.contains("render"))
+        for (const auto& v : j["render"]["views"])
+          std::printf("  view %s: epsilon %.3g, PSNR %s dB, SSIM %.6f -> %s\n", v["forward"].dump().c_str(),
+                      v["epsilon"].get<double>(), v["psnr"].is_null() ? "inf" : std::to_string(v["psnr"].get<double>()).c_str(),
+                      v["ssim"].get<double>(), v["heat_map"].get<std::string>().c_str());
     } catch (const pvs::FormatError& e) {
       throw vislib::InputError(a->file, e.what());
     }

@@ -1,14 +1,22 @@
 #!/usr/bin/env bash
 # README Quick start (a): install what is missing, build, and run the main job on the default
-# scene shipped in data/: its statistics, then from-region visibility of a street-level view
-# rectangle (the PVS bake, issue 5, will replace the second step).
+# scene shipped in data/: bake its PVS (walkable view cells over the streets around the centre),
+# then summarise the file and inspect one cell, with frames of the full scene against the cell's
+# visible set (ε, PSNR, SSIM) in out/render/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
 mkdir -p out
+PVS=build/cli/pvs
 echo "== pvs info data/city.glb"
-build/cli/pvs info data/city.glb
-echo "== pvs region data/city.glb (view rectangle at eye height; see docs/cli.md)"
-build/cli/pvs region data/city.glb --box -3,1.7,-20,3,1.7,20 --runs 2 --res 256 --json out/region.json
-echo "wrote out/region.json"
+$PVS info data/city.glb
+echo "== pvs bake data/city.glb -> out/city.pvs"
+$PVS bake data/city.glb --walkable --cell-size 24 --box -120,-1,-120,120,1,120 --res 128 --runs 1 \
+  --json out/city.bake.json -o out/city.pvs
+echo "== pvs inspect out/city.pvs"
+$PVS inspect out/city.pvs
+echo "== pvs inspect out/city.pvs --at 0,1.6,0 (the cell at the centre crossing)"
+$PVS inspect out/city.pvs --scene data/city.glb --at 0,1.6,0 --max-ids 20 --render out/render \
+  --export-gltf out/cell.glb
+echo "Done: out/city.pvs (the PVS), out/render/ (frames and heat maps), out/cell.glb (the cell's visible set)."

@@ -6,4 +6,4 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 BUILD_DIR=${BUILD_DIR:-build} bash scripts/build.sh "$@"
 cd "${BUILD_DIR:-build}"
-ctest --output-on-failure -j "$(nproc)" --timeout 1500
+ctest --output-on-failure -j "$(nproc)" --timeout 1500 2>&1 | tee ctest.log
