@@ -527,6 +527,12 @@ struct MemorySource : Reader::Source {
   std::string read(uint64_t offset, size_t n) override { return bytes.substr(size_t(offset), n); }
 };
 
+struct ViewSource : Reader::Source {
+  std::string_view bytes;
+  uint64_t size() const override { return bytes.size(); }
+  std::string read(uint64_t offset, size_t n) override { return std::string(bytes.substr(size_t(offset), n)); }
+};
+
 struct FileSource : Reader::Source {
   std::ifstream in;
   uint64_t bytes = 0;
@@ -550,6 +556,15 @@ Reader::~Reader() = default;
 Reader Reader::from_memory(std::string_view bytes, const ReadOptions& options) {
   auto src = std::make_unique<MemorySource>();
   src->bytes.assign(bytes.data(), bytes.size());
+  Reader r;
+  r.source_ = std::move(src);
+  r.open(options);
+  return r;
+}
+
+Reader Reader::from_view(std::string_view bytes, const ReadOptions& options) {
+  auto src = std::make_unique<ViewSource>();
+  src->bytes = bytes;
   Reader r;
   r.source_ = std::move(src);
   r.open(options);

@@ -157,6 +157,9 @@ class Reader {
  public:
   // `bytes` is copied.
   static Reader from_memory(std::string_view bytes, const ReadOptions& options = {});
+  // `bytes` is not copied: it must stay valid and unchanged for the life of the Reader (a
+  // memory-mapped file, as the runtime loader uses). Blocks are read from it on demand.
+  static Reader from_view(std::string_view bytes, const ReadOptions& options = {});
   // Throws FormatError(0, "cannot open ...") if the file cannot be opened.
   static Reader from_file(const std::string& path, const ReadOptions& options = {});
 

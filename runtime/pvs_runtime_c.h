@@ -1,0 +1,94 @@
+/* pvs_runtime_c.h: the C API of the PVS runtime loader (runtime/pvs_runtime.h), for engines that
+ * are not written in C++. Same functions, an opaque handle, error codes; no exception ever
+ * crosses this boundary. docs/runtime.md documents it; examples/engine_loop.c uses it.
+ *
+ * Errors: every function returns a pvs_rt_status. On failure, pvs_rt_last_error() returns a
+ * message naming the file and the problem (for a malformed file, "byte N: ..."). The message is
+ * per thread and stays valid until the next failing call of this API on the same thread.
+ *
+ * Thread-safety: a handle must not be used by two threads at once; distinct handles may. */
+#ifndef PVS_RUNTIME_C_H
+#define PVS_RUNTIME_C_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct pvs_rt pvs_rt; /* an open, memory-mapped PVS file */
+
+typedef enum pvs_rt_status {
+  PVS_RT_OK = 0,
+  PVS_RT_INVALID_ARGUMENT = 1,  /* a null pointer, a cell id >= cell_count, margin < 0 */
+  PVS_RT_IO = 2,                /* the file cannot be opened, sized or memory-mapped */
+  PVS_RT_FORMAT = 3,            /* not a PVS file, truncated, corrupt (checksum), too new, ... */
+  PVS_RT_FINGERPRINT = 4,       /* a valid PVS, but baked for another scene */
+  PVS_RT_NOT_FOUND = 5,         /* no cell contains the position */
+  PVS_RT_BUFFER_TOO_SMALL = 6,  /* *count holds the capacity needed */
+  PVS_RT_ABSENT = 7,            /* the cell has no data in this (partial) file */
+  PVS_RT_OUT_OF_MEMORY = 8,
+  PVS_RT_INTERNAL = 9
+} pvs_rt_status;
+
+typedef struct pvs_rt_info {
+  uint32_t format_version;
+  uint32_t cell_count;
+  uint32_t universe;          /* ids are < universe */
+  uint32_t granularity;       /* 0: triangle ids, 1: object ids */
+  uint32_t layout;            /* 0: grid, 1: box list */
+  uint32_t partial;           /* 1 if some cells may be absent */
+  uint64_t scene_fingerprint;
+  uint64_t file_size;
+} pvs_rt_info;
+
+/* Opens `path` memory-mapped and checks header, layout and index. If check_fingerprint is
+ * nonzero, a file whose scene fingerprint differs from expected_fingerprint is rejected with
+ * PVS_RT_FINGERPRINT. On success *out is a handle to release with pvs_rt_close; on failure *out
+ * is set to NULL. */
+pvs_rt_status pvs_rt_open(const char* path, int check_fingerprint, uint64_t expected_fingerprint,
+                          pvs_rt** out);
+/* Releases the handle (NULL is allowed). */
+void pvs_rt_close(pvs_rt* handle);
+
+/* The file's header fields. */
+pvs_rt_status pvs_rt_get_info(const pvs_rt* handle, pvs_rt_info* out);
+
+/* The cell containing position (x, y, z; y up; boundaries inclusive, lowest id wins), or
+ * PVS_RT_NOT_FOUND. */
+pvs_rt_status pvs_rt_find_cell(const pvs_rt* handle, const double position[3], uint32_t* cell);
+
+/* The lookup box of the cell (min and max corners, scene units, y up). */
+pvs_rt_status pvs_rt_cell_box(const pvs_rt* handle, uint32_t cell, double min[3], double max[3]);
+
+/* The cells whose boxes come within `margin` (>= 0) of cell's box, sorted, without `cell`.
+ * Writes at most `capacity` ids to `out`; *count receives the number of neighbours. If it
+ * exceeds capacity, returns PVS_RT_BUFFER_TOO_SMALL (27 is always enough for margin 0 on a grid). */
+pvs_rt_status pvs_rt_neighbours(const pvs_rt* handle, uint32_t cell, double margin, uint32_t* out,
+                                size_t capacity, size_t* count);
+
+/* Number of visible ids of the cell, from the index (no block read): the capacity that
+ * pvs_rt_visible_ids needs. */
+pvs_rt_status pvs_rt_visible_count(const pvs_rt* handle, uint32_t cell, uint32_t* count);
+
+/* The cell's visible ids (triangle or object ids, as pvs_rt_info.granularity says), sorted.
+ * *count receives their number; PVS_RT_BUFFER_TOO_SMALL if it exceeds capacity (nothing
+ * written). PVS_RT_FORMAT if the block is corrupt, PVS_RT_ABSENT for an absent cell. */
+pvs_rt_status pvs_rt_visible_ids(pvs_rt* handle, uint32_t cell, uint32_t* out, size_t capacity,
+                                 size_t* count);
+
+/* Asks the OS to page in the cell's block (returns immediately). */
+pvs_rt_status pvs_rt_prefetch(pvs_rt* handle, uint32_t cell);
+
+/* The message of the last failing call on this thread ("" if none). */
+const char* pvs_rt_last_error(void);
+
+/* A short name of a status code ("ok", "format", ...). */
+const char* pvs_rt_status_name(pvs_rt_status status);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PVS_RUNTIME_C_H */
