@@ -1,0 +1,168 @@
+// Tests of the near-far reference renderer (vislib/near_far_render.h) and of `pvs view`.
+#include "vislib/near_far_render.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "scene_builders.h"
+#include "test_support.h"
+#include "vislib/metrics.h"
+
+namespace {
+
+using vislib::Vec3;
+using vislib_test::add_quad;
+
+std::vector<uint32_t> all_ids(const vislib::Scene& s) {
+  std::vector<uint32_t> ids(s.triangle_count());
+  for (uint32_t t = 0; t < ids.size(); ++t) ids[t] = t;
+  return ids;
+}
+
+// The pixel (column, row) where point p projects in `cam` (render.h's camera convention).
+std::pair<double, double> project(const vislib::Camera& cam, Vec3 p) {
+  Vec3 f = cam.forward * (1.0 / length(cam.forward));
+  Vec3 r = cross(f, cam.up);
+  r = r * (1.0 / length(r));
+  Vec3 u = cross(r, f);
+  Vec3 d = p - cam.eye;
+  const double t = std::tan(cam.vfov_degrees * M_PI / 360.0);
+  const double sx = dot(d, r) / dot(d, f) / (t * cam.width / cam.height), sy = dot(d, u) / dot(d, f) / t;
+  return {(sx + 1) * cam.width / 2 - 0.5, (1 - sy) * cam.height / 2 - 0.5};
+}
+
+// The lowest (largest row) pixel showing triangle `tri`, ties: the mean column of that row.
+std::pair<double, double> lowest_pixel(const vislib::Frame& f, uint32_t tri) {
+  for (int y = f.height - 1; y >= 0; --y) {
+    double sum = 0;
+    int n = 0;
+    for (int x = 0; x < f.width; ++x)
+      if (f.tri[size_t(y) * f.width + x] == tri) sum += x, ++n;
+    if (n) return {sum / n, y};
+  }
+  return {-1e9, -1e9};
+}
+
+TEST(NearFarRender, EverythingNearEqualsTheFullFrame) {
+  vislib::Scene s;
+  add_quad(s, {-3, -1, -6}, {3, -1, -6}, {3, 2, -6}, {-3, 2, -6});
+  add_quad(s, {-1, 0, -4}, {1, 0, -4}, {1, 1, -3}, {-1, 1, -3});
+  add_quad(s, {-6, -1, -9}, {-2, -1, -12}, {-2, 3, -12}, {-6, 3, -9});
+  vislib::Camera cam;
+  cam.eye = {0.2, 0.5, 0.1};
+  cam.forward = {0, 0, -1};
+  cam.width = 96, cam.height = 64;
+  vislib::EmbreeScene rt(s, 0.0, cam.eye);
+  const vislib::Frame truth = vislib::render_frame(s, rt, cam);
+  vislib::NearFarSettings set;
+  set.centre = {0, 0.5, 0};
+  set.r1 = 100, set.r2 = 200, set.env_size = 64;
+  vislib::RegionCounts rc;
+  const vislib::Frame nf = vislib::render_near_far(s, rt, all_ids(s), cam, set, &rc);
+  EXPECT_EQ(rc.near, s.triangle_count());
+  EXPECT_EQ(rc.intermediate + rc.far + rc.env_map, 0u);
+  const vislib::FrameQuality q = vislib::frame_quality(truth, nf);
+  EXPECT_EQ(q.epsilon, 0.0);
+  EXPECT_EQ(q.ssim, 1.0);
+  EXPECT_EQ(truth.rgb, nf.rgb);
+  EXPECT_EQ(truth.tri, nf.tri);
+  const vislib::ObjectCompletion c = vislib::object_completion(s, truth, nf);
+  EXPECT_EQ(c.objects, 3u);
+  EXPECT_EQ(c.ovc, 1.0);
+  EXPECT_EQ(c.ofc, 1.0);
+}
+
+// A far triangle whose lowest vertex P lies exactly on the r2 cylinder, seen from an eye 2 units
+// off O's axis.
+struct R2Fixture {
+  vislib::Scene s;
+  vislib::Camera cam;
+  vislib::NearFarSettings set;
+  Vec3 p{0, 1.5, -20};
+  R2Fixture() {
+    s = vislib_test::soup({{p, {3, 6, -22}, {-3, 6, -22}}});
+    cam.eye = {2, 1.5, 0};
+    cam.forward = {-0.1, 0.1, -1};
+    cam.width = 160, cam.height = 120;
+    set.centre = {0, 1.5, 0};
+    set.r1 = 5, set.r2 = 20, set.env_size = 1024;
+  }
+};
+
+TEST(NearFarRender, VertexOnR2ThroughCylinderLookupLandsAtItsTruePixel) {
+  R2Fixture f;
+  f.set.lookup = vislib::EnvironmentLookup::CylinderR2;
+  vislib::EmbreeScene rt(f.s, 0.0, f.cam.eye);
+  const vislib::Frame truth = vislib::render_frame(f.s, rt, f.cam);
+  vislib::RegionCounts rc;
+  const vislib::Frame nf = vislib::render_near_far(f.s, rt, {0}, f.cam, f.set, &rc);
+  EXPECT_EQ(rc.far, 1u);
+  EXPECT_EQ(rc.env_map, 1u);
+  const auto want = project(f.cam, f.p);
+  const auto got_truth = lowest_pixel(truth, 0), got = lowest_pixel(nf, 0);
+  // The lowest pixel centre inside a sharp tip lies up to ~2 pixels from the tip's projection.
+  EXPECT_NEAR(got_truth.first, want.first, 2.0);
+  EXPECT_NEAR(got_truth.second, want.second, 2.0);
+  EXPECT_NEAR(got.first, got_truth.first, 1.0);
+  EXPECT_NEAR(got.second, got_truth.second, 1.0);
+}
+
+TEST(NearFarRender, VertexOnR2ThroughEyeDirectionLookupLandsWhereOSeesIt) {
+  // The paper's lookup: P appears from U in the direction O sees it, i.e. at U + (P - O), which is
+  // where Eq. 1 morphs an intermediate vertex on r2.
+  R2Fixture f;
+  vislib::EmbreeScene rt(f.s, 0.0, f.cam.eye);
+  const vislib::Frame nf = vislib::render_near_far(f.s, rt, {0}, f.cam, f.set);
+  // Ground truth of this lookup: the full frame of the scene translated by U - O.
+  vislib::Scene moved = f.s;
+  for (auto& v : moved.positions[0]) v = v + (f.cam.eye - f.set.centre);
+  vislib::EmbreeScene rt_moved(moved, 0.0, f.cam.eye);
+  const vislib::Frame truth = vislib::render_frame(moved, rt_moved, f.cam);
+  const auto want = project(f.cam, f.cam.eye + (f.p - f.set.centre));
+  const auto got_truth = lowest_pixel(truth, 0), got = lowest_pixel(nf, 0);
+  EXPECT_NEAR(got_truth.first, want.first, 2.0);
+  EXPECT_NEAR(got_truth.second, want.second, 2.0);
+  EXPECT_NEAR(got.first, got_truth.first, 1.0);
+  EXPECT_NEAR(got.second, got_truth.second, 1.0);
+}
+
+TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
+  using vislib_test::run_pvs;
+  const std::string dir = vislib_test::temp_dir("pvs_view");
+  std::string out;
+  ASSERT_EQ(run_pvs("generate city --blocks 2,2 -o " + dir + "/city.glb", &out), 0) << out;
+  ASSERT_EQ(run_pvs("bake " + dir + "/city.glb --box -10,0,-10,10,3,10 --grid 2,1,2 --eye-height 1.5,1.8 --res 32 -o " +
+                        dir + "/city.pvs",
+                    &out),
+            0)
+      << out;
+  ASSERT_EQ(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/city.glb --at 5,1.6,5 --look 40,1.6,5 "
+                    "--near-far 10,30 --grow --rings 4 --frame 96x64 -o " + dir + "/v.png --json " + dir + "/v.json",
+                    &out),
+            0)
+      << out;
+  for (const char* name : {"/v.png", "/v_truth.png", "/v_heat.png", "/v_nomorph.png"})
+    EXPECT_TRUE(std::ifstream(dir + name).good()) << name;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir + "/v.json"));
+  for (const char* key : {"psnr", "ssim", "epsilon", "ovc", "ofc", "triangles", "without_morph", "continuity"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  for (const char* key : {"near", "intermediate", "far", "visible"}) EXPECT_TRUE(j["triangles"].contains(key)) << key;
+  EXPECT_EQ(j["triangles"]["near"].get<size_t>() + j["triangles"]["intermediate"].get<size_t>() +
+                j["triangles"]["far"].get<size_t>(),
+            j["triangles"]["visible"].get<size_t>());
+  EXPECT_GE(j["ssim"].get<double>(), -1.0);
+  EXPECT_LE(j["ssim"].get<double>(), 1.0);
+  EXPECT_TRUE(j["without_morph"].contains("ssim"));
+  // A PVS of another scene is rejected.
+  ASSERT_EQ(run_pvs("generate city --blocks 2,2 --seed 9 -o " + dir + "/other.glb", &out), 0) << out;
+  EXPECT_NE(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/other.glb --at 5,1.6,5 --look 40,1.6,5 "
+                    "--near-far 10,30 --frame 32x32 -o " + dir + "/w.png",
+                    &out),
+            0)
+      << out;
+}
+
+}  // namespace
