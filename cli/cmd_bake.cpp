@@ -32,6 +32,8 @@ struct BakeArgs {
   uint64_t seed = 1;
   double near = vislib::kDefaultNear, eps_len = vislib::kDefaultEpsLen;
   std::string granularity = "triangle";
+  std::string mode = "diagonal";
+  int states = 1;
 };
 
 std::string format_duration(double s) {
@@ -172,7 +174,12 @@ void add_bake(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--tile", a->tile, "Kernel tile side in pixels")->check(CLI::Range(1, 4096))->capture_default_str();
-  cmd->add_option("--granularity", a->granularity, "Store triangle ids or object ids")
+  cmd->add_option("--states", a->states, "Key states to sample glTF animations into (dynamic scenes)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option("--mode", a->mode, "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
+      ->check(CLI::IsMember({"diagonal", "decoupled"}))
+      ->capture_default_str();
+  cmd->add_option("--granularity", a->granularity, "Store triangle ids (spheres after them) or object ids")
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
   cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores); never changes the output")
@@ -197,7 +204,7 @@ void add_bake(CLI::App& app) {
       throw Exit{2};
     }
     auto t0 = std::chrono::steady_clock::now();
-    vislib::Scene scene = load_scene_for_cli(a->scene, 1);
+    vislib::Scene scene = load_scene_for_cli(a->scene, a->states);
     if (scene.sphere_count() > 0) warn(a->scene + ": spheres are not handled by the static kernel; ignored");
     if (scene.triangle_count() >= 0xFFFFFFFFull) throw vislib::InputError(a->scene, "more than 2^32-1 triangles");
     vislib::ViewCells cells = make_cells(*a, scene);
@@ -228,6 +235,7 @@ void add_bake(CLI::App& app) {
     s.region.runs = a->runs;
     s.region.seed = a->seed;
     s.granularity = a->granularity == "object" ? vislib::Granularity::Object : vislib::Granularity::Triangle;
+    s.region.segment.mode = a->mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
     vislib::BakeFiles files{a->output, checkpoint, a->resume};
     vislib::BakeReport r = vislib::bake(scene, cells, s, shard, files, progress_printer());
 

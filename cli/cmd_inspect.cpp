@@ -34,6 +34,7 @@ struct InspectArgs {
   int64_t cell = -1;
   bool json_out = false;
   int max_ids = 40;
+  int states = 1;
 };
 
 json box_json(const pvs::Box& b) {
@@ -239,6 +240,8 @@ void add_inspect(CLI::App& app) {
   cmd->add_option("--at", a->at, "Show the cell containing the point x,y,z")->excludes(cell_opt);
   cmd->add_flag("--json", a->json_out, "Print JSON instead of text (all visible ids of a cell)");
   cmd->add_option("--scene", a->scene, "The scene the PVS was baked for (checked by its fingerprint)");
+  cmd->add_option("--states", a->states, "With --scene: key states to sample animations into (as for the bake)")
+      ->check(CLI::Range(1, 100000));
   cmd->add_option("--export-gltf", a->gltf, "With --scene and a cell: write the scene reduced to the cell's set (.glb)");
   cmd->add_option("--render", a->render_dir,
                   "With --scene and a cell: render from the --at point (else the centre of the cell's view "
@@ -250,7 +253,7 @@ void add_inspect(CLI::App& app) {
     pvs::ReadOptions opt;
     vislib::Scene scene;
     if (!a->scene.empty()) {
-      scene = load_scene_for_cli(a->scene, 1);
+      scene = load_scene_for_cli(a->scene, a->states);
       opt.expected_fingerprint = vislib::scene_fingerprint(scene);
     }
     if (!a->gltf.empty()) {

@@ -24,7 +24,9 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const B
   pvs::FileInfo info;
   info.scene_fingerprint = scene_fingerprint(scene);
   info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object : pvs::Granularity::Triangle;
-  info.universe = uint32_t(settings.granularity == Granularity::Object ? scene.objects.size() : scene.triangle_count());
+  // Triangle granularity: triangle ids, then sphere s as triangle_count + s.
+  info.universe = uint32_t(settings.granularity == Granularity::Object ? scene.objects.size()
+                                                                        : scene.triangle_count() + scene.sphere_count());
   info.layout = cells.layout;
   const SegmentOptions& s = settings.region.segment;
   nlohmann::json m = {{"generator", "vislib pvs bake"},
@@ -36,6 +38,8 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const B
                       {"runs", settings.region.runs},
                       {"seed", settings.region.seed},
                       {"state", s.state},
+                      {"states", scene.state_count()},
+                      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
                       {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
   info.metadata = m.dump();
   return info;
@@ -55,7 +59,10 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
                                 const BakeSettings& settings, double* seconds) {
   CellVisibility v = cell_visibility(scene, layout, cell, settings.region);
   if (seconds) *seconds = v.seconds;
-  return settings.granularity == Granularity::Object ? objects_of(scene, v.triangles) : std::move(v.triangles);
+  if (settings.granularity == Granularity::Object) return objects_of(scene, v.triangles, v.spheres);
+  std::vector<uint32_t> ids = std::move(v.triangles);
+  for (uint32_t s : v.spheres) ids.push_back(uint32_t(scene.triangle_count() + s));
+  return ids;
 }
 
 BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,

@@ -283,6 +283,10 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
     std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(), rr.visible.end(),
                    std::back_inserter(merged));
     out.triangles = std::move(merged);
+    merged.clear();
+    std::set_union(out.spheres.begin(), out.spheres.end(), rr.visible_spheres.begin(), rr.visible_spheres.end(),
+                   std::back_inserter(merged));
+    out.spheres = std::move(merged);
     out.seconds += rr.seconds;
   }
   return out;

@@ -89,6 +89,7 @@ uint64_t cell_seed(uint64_t seed, uint32_t cell);
 
 struct CellVisibility {
   std::vector<uint32_t> triangles;  // visible triangle ids, sorted
+  std::vector<uint32_t> spheres;    // visible sphere indices, sorted
   std::vector<Segment> segments;    // cell_boundary_segments(view region)
   double seconds = 0;               // kernel seconds
 };
