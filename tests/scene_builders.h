@@ -22,6 +22,19 @@ inline vislib::Scene soup(const std::vector<std::array<vislib::Vec3, 3>>& tris) 
   return s;
 }
 
+// A random soup of n triangles of size ~`size` around random centres in [-extent, extent]^3.
+inline vislib::Scene random_soup(int n, uint64_t seed, double extent = 10, double size = 2) {
+  vislib::Rng rng(seed);
+  std::vector<std::array<vislib::Vec3, 3>> tris;
+  for (int i = 0; i < n; ++i) {
+    vislib::Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent), rng.uniform(-extent, extent)};
+    std::array<vislib::Vec3, 3> t;
+    for (auto& p : t) p = c + vislib::Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)};
+    tris.push_back(t);
+  }
+  return soup(tris);
+}
+
 // Appends an indexed quad (two triangles) a b c d (counter-clockwise) to `s` as one object.
 inline void add_quad(vislib::Scene& s, vislib::Vec3 a, vislib::Vec3 b, vislib::Vec3 c, vislib::Vec3 d) {
   if (s.positions.empty()) s.positions.resize(1);

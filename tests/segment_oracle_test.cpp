@@ -17,6 +17,7 @@
 #include "vislib/segment_visibility.h"
 
 using namespace vislib;
+using vislib_test::random_soup;
 
 namespace {
 
@@ -177,17 +178,6 @@ void check_scene(const std::string& name, const Scene& scene, int segments, int 
               (unsigned long long)total.settled_by_double);
 }
 
-Scene random_soup(int n, uint64_t seed, double extent, double size) {
-  Rng rng(seed);
-  std::vector<std::array<Vec3, 3>> tris;
-  for (int i = 0; i < n; ++i) {
-    Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent), rng.uniform(-extent, extent)};
-    std::array<Vec3, 3> t;
-    for (auto& p : t) p = c + Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)};
-    tris.push_back(t);
-  }
-  return vislib_test::soup(tris);
-}
 
 }  // namespace
 

@@ -10,21 +10,10 @@
 #include "vislib/segment_visibility.h"
 
 using namespace vislib;
+using vislib_test::random_soup;
 
 namespace {
 
-// A random soup of n triangles of size ~`size` in a box around the origin, away from the eye.
-Scene random_soup(int n, uint64_t seed, double extent = 10, double size = 2) {
-  Rng rng(seed);
-  std::vector<std::array<Vec3, 3>> tris;
-  for (int i = 0; i < n; ++i) {
-    Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent), rng.uniform(-extent, extent)};
-    std::array<Vec3, 3> t;
-    for (auto& p : t) p = c + Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)};
-    tris.push_back(t);
-  }
-  return vislib_test::soup(tris);
-}
 
 bool same_lists(const std::vector<PieceList>& a, const std::vector<PieceList>& b,
                 const std::vector<uint32_t>* map_b_to_a = nullptr) {
