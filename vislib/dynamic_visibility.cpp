@@ -24,6 +24,7 @@
 #include "vislib/footprint.h"
 #include "vislib/polynomial.h"
 #include "vislib/segment_visibility.h"
+#include "vislib/tile_bins.h"
 
 namespace vislib {
 
@@ -447,24 +448,7 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
         if (!ok) b[0] = 1, b[1] = 0;
       }
     });
-    std::fill(bin_start.begin(), bin_start.end(), 0);
-    for (size_t p = 0; p < nprim; ++p) {
-      const int* b = &bbox[p * 4];
-      if (b[0] > b[1]) continue;
-      for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
-        for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx) ++bin_start[ty * tiles_x + tx + 1];
-    }
-    for (int i = 0; i < tile_count; ++i) bin_start[i + 1] += bin_start[i];
-    bins.resize(bin_start[tile_count]);
-    {
-      std::vector<uint32_t> fill(bin_start.begin(), bin_start.end() - 1);
-      for (size_t p = 0; p < nprim; ++p) {
-        const int* b = &bbox[p * 4];
-        if (b[0] > b[1]) continue;
-        for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
-          for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx) bins[fill[ty * tiles_x + tx]++] = {uint32_t(p), zmin[p]};
-      }
-    }
+    bin_by_tile(bbox, nprim, TS, tiles_x, bin_start, bins, [&](size_t p) { return Binned{uint32_t(p), zmin[p]}; });
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
       Scratch& sc = scratch.local();
       auto& lists = sc.lists;

@@ -20,6 +20,7 @@
 #include <cmath>
 
 #include "vislib/footprint.h"
+#include "vislib/tile_bins.h"
 
 namespace vislib {
 
@@ -175,25 +176,8 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
       }
     });
     // (2) bin by tile (counting sort, in id order).
-    std::fill(bin_start.begin(), bin_start.end(), 0);
-    for (size_t t = 0; t < ntri; ++t) {
-      const int* b = &bbox[t * 4];
-      if (b[0] > b[1]) continue;
-      for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
-        for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx) ++bin_start[ty * tiles_x + tx + 1];
-    }
-    for (int i = 0; i < tile_count; ++i) bin_start[i + 1] += bin_start[i];
-    bins.resize(bin_start[tile_count]);
-    {
-      std::vector<uint32_t> fill(bin_start.begin(), bin_start.end() - 1);
-      for (size_t t = 0; t < ntri; ++t) {
-        const int* b = &bbox[t * 4];
-        if (b[0] > b[1]) continue;
-        for (int ty = b[2] / TS; ty <= b[3] / TS; ++ty)
-          for (int tx = b[0] / TS; tx <= b[1] / TS; ++tx)
-            bins[fill[ty * tiles_x + tx]++] = {uint32_t(t), zmin[t]};
-      }
-    }
+    bin_by_tile(bbox, ntri, TS, tiles_x, bin_start, bins,
+                [&](size_t t) { return FaceTriangle{uint32_t(t), zmin[t]}; });
 
     // (3) tiles in parallel.
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
