@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -233,6 +234,19 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   EXPECT_GE(j["ssim"].get<double>(), -1.0);
   EXPECT_LE(j["ssim"].get<double>(), 1.0);
   EXPECT_TRUE(j["without_morph"].contains("ssim"));
+  // --grow: both ring sequences, merged radii a subsequence of the equal-area ones ending at r2,
+  // every ring after the first injected over --frames-per-ring (default 4) frames.
+  const nlohmann::json& c = j["continuity"];
+  const auto equal = c["equal_area"]["radii"].get<std::vector<double>>();
+  const auto merged = c["merged"]["radii"].get<std::vector<double>>();
+  ASSERT_EQ(equal.size(), 4u);
+  ASSERT_FALSE(merged.empty());
+  EXPECT_LE(merged.size(), equal.size());
+  EXPECT_DOUBLE_EQ(merged.back(), 30.0);
+  for (double r : merged) EXPECT_NE(std::find(equal.begin(), equal.end(), r), equal.end()) << r;
+  EXPECT_EQ(c["equal_area"]["frames"].get<size_t>(), 1 + 4 * (equal.size() - 1));
+  EXPECT_EQ(c["merged"]["frames"].get<size_t>(), 1 + 4 * (merged.size() - 1));
+  EXPECT_EQ(c["min_consecutive_ssim"], c["merged"]["min_consecutive_ssim"]);
   // A PVS of another scene is rejected.
   ASSERT_EQ(run_pvs("generate city --blocks 2,2 --seed 9 -o " + dir + "/other.glb", &out), 0) << out;
   EXPECT_NE(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/other.glb --at 5,1.6,5 --look 40,1.6,5 "
