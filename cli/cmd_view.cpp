@@ -2,6 +2,7 @@
 // eye, its ground truth (the full scene) and error heat map, and the metrics: epsilon, PSNR, SSIM,
 // OVC, OFC with and without the Eq. 1 morph, triangles per region, and with --grow the continuity
 // (minimum SSIM between consecutive frames) while the near region grows ring by ring.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -30,8 +31,8 @@ struct ViewArgs {
   std::string file, scene, at, look, near_far = "10,20", centre, output, json_path;
   std::string frame = "640x480", lookup = "eye";
   bool grow = false;
-  int env_size = 0, rings = 8;
-  double near_fraction = 0.7;
+  int env_size = 0, rings = 8, states = 1, frames_per_ring = 4;
+  double near_fraction = 0.7, tau = 0, merge_min = -1;
 };
 
 json quality_json(const vislib::Scene& scene, const vislib::Frame& truth, const vislib::Frame& test) {
@@ -69,6 +70,16 @@ void add_view(CLI::App& app) {
   cmd->add_flag("--grow", a->grow, "Also render the progressive near region (CloVR rings up to r2) and report "
                                    "the minimum SSIM between consecutive frames");
   cmd->add_option("--rings", a->rings, "--grow: equal-area rings up to r2")->check(CLI::Range(1, 1000))->capture_default_str();
+  cmd->add_option("--frames-per-ring", a->frames_per_ring,
+                  "--grow: frames over which each ring is injected (Alg. 1 with R animated from the previous "
+                  "ring's radius to the ring's)")->check(CLI::Range(1, 1000))->capture_default_str();
+  cmd->add_option("--merge-min", a->merge_min,
+                  "--grow: merged rings contribute at least this many visible triangles (entering the near "
+                  "region) each (default: the mean over the equal-area rings)");
+  cmd->add_option("--states", a->states, "Key states to sample glTF animations into (as for the bake)")
+      ->check(CLI::Range(1, 100000))->capture_default_str();
+  cmd->add_option("--time", a->tau, "Animation time tau in [0,1] of the frame (dynamic scenes)")
+      ->check(CLI::Range(0.0, 1.0))->capture_default_str();
   cmd->add_option("--near-fraction", a->near_fraction, "--grow: R_n / R of Alg. 1")
       ->check(CLI::Range(0.01, 0.99))->capture_default_str();
   cmd->add_option("--frame", a->frame, "Frame size WxH")->capture_default_str();
@@ -90,9 +101,9 @@ void add_view(CLI::App& app) {
     const vislib::Vec3 eye = parse_vec3(a->at, "--at"), target = parse_vec3(a->look, "--look");
     if (length(target - eye) == 0) throw CLI::ValidationError("--look", "must differ from --at");
 
-    vislib::Scene scene = load_scene_for_cli(a->scene, 1);
+    vislib::Scene full_scene = load_scene_for_cli(a->scene, a->states);
     pvs::ReadOptions opt;
-    opt.expected_fingerprint = vislib::scene_fingerprint(scene);
+    opt.expected_fingerprint = vislib::scene_fingerprint(full_scene);
     std::vector<uint32_t> tris;
     uint32_t cell = 0;
     vislib::Vec3 centre;
@@ -100,7 +111,7 @@ void add_view(CLI::App& app) {
       pvs::Reader r = pvs::Reader::from_file(a->file, opt);
       const pvs::FileInfo& info = r.info();
       const bool object = info.granularity == pvs::Granularity::Object;
-      if ((object ? scene.objects.size() : scene.triangle_count()) != info.universe)
+      if ((object ? full_scene.objects.size() : full_scene.triangle_count()) != info.universe)
         throw vislib::InputError(a->file, "universe " + std::to_string(info.universe) + " differs from the scene's");
       double q[3] = {eye.x, eye.y, eye.z};
       std::optional<uint32_t> c = info.layout.find_cell(q);
@@ -115,10 +126,10 @@ void add_view(CLI::App& app) {
       }
       std::vector<uint32_t> ids = r.read_cell(cell);
       if (object) {
-        std::vector<uint8_t> keep(scene.objects.size(), 0);
+        std::vector<uint8_t> keep(full_scene.objects.size(), 0);
         for (uint32_t o : ids) keep[o] = 1;
-        for (uint32_t t = 0; t < scene.triangle_count(); ++t)
-          if (keep[scene.triangle_object[t]]) tris.push_back(t);
+        for (uint32_t t = 0; t < full_scene.triangle_count(); ++t)
+          if (keep[full_scene.triangle_object[t]]) tris.push_back(t);
       } else {
         tris = ids;
       }
@@ -147,6 +158,11 @@ void add_view(CLI::App& app) {
     s.env_size = a->env_size > 0 ? a->env_size : fh;
     s.lookup = a->lookup == "cylinder" ? vislib::EnvironmentLookup::CylinderR2 : vislib::EnvironmentLookup::EyeDirection;
 
+    // Everything is rendered from the scene at tau (one state); the moving triangles are those of
+    // the loaded key states.
+    const std::vector<uint8_t> moving = vislib::moving_triangles(full_scene);
+    s.dynamic = moving.data();
+    const vislib::Scene scene = vislib::scene_at(full_scene, a->tau);
     vislib::EmbreeScene rt(scene, 0.0, eye);
     vislib::Frame truth = vislib::render_frame(scene, rt, cam);
     vislib::RegionCounts rc;
@@ -168,11 +184,15 @@ void add_view(CLI::App& app) {
     j["centre"] = {centre.x, centre.y, centre.z};
     j["r1"] = s.r1;
     j["r2"] = s.r2;
+    j["tau"] = a->tau;
+    j["states"] = full_scene.state_count();
     j["frame"] = {fw, fh};
     j["env_size"] = s.env_size;
     j["lookup"] = a->lookup;
     j["triangles"] = {{"scene", scene.triangle_count()}, {"visible", tris.size()}, {"near", rc.near},
-                      {"intermediate", rc.intermediate}, {"far", rc.far}, {"env_map", rc.env_map}};
+                      {"intermediate", rc.intermediate}, {"far", rc.far}, {"env_map", rc.env_map},
+                      {"moving_in_scene", size_t(std::count(moving.begin(), moving.end(), uint8_t(1)))},
+                      {"far_dynamic_drawn", rc.far_dynamic}, {"far_dynamic_shown", rc.far_dynamic_shown}};
     j["without_morph"] = quality_json(scene, truth, unmorphed);
     // Baseline: the cell's visible set rendered from geometry, no near-far partition.
     vislib::Frame pvs_frame = vislib::render_frame(scene, rt, cam, vislib::triangle_mask(scene.triangle_count(), tris).data());
@@ -181,26 +201,49 @@ void add_view(CLI::App& app) {
                    {"nomorph", sibling(a->output, "_nomorph")}, {"heat_map", sibling(a->output, "_heat")}};
 
     if (a->grow) {
-      const std::vector<double> rings =
-          pvs_runtime::equal_area_ring_radii(M_PI * s.r2 * s.r2 / a->rings, s.r2);
-      json steps = json::array();
-      double min_ssim = 1;
-      std::optional<vislib::Frame> prev;
-      for (double big_r : rings) {
-        if (!(eye_axis < a->near_fraction * big_r)) continue;  // Alg. 1 needs the eye inside R_n
-        vislib::Frame f = vislib::render_progressive(scene, rt, tris, cam, centre, big_r, a->near_fraction, s.env_size);
-        json step = {{"radius", big_r}, {"ssim_to_truth", vislib::frame_quality(truth, f).ssim}};
-        if (prev) {
-          double ss = vislib::ssim_luminance(fw, fh, prev->rgb, f.rgb);
-          step["ssim_to_previous"] = ss;
-          min_ssim = std::min(min_ssim, ss);
+      const double ring_area = M_PI * s.r2 * s.r2 / a->rings;
+      const std::vector<double> equal = pvs_runtime::equal_area_ring_radii(ring_area, s.r2);
+      const std::vector<double> contribution =
+          vislib::ring_visible_triangle_contribution(scene, tris, centre, equal);
+      double total = 0;
+      for (double c : contribution) total += c;
+      const double min_contribution = a->merge_min >= 0 ? a->merge_min : total / double(equal.size());
+      const std::vector<double> merged = pvs_runtime::merge_rings(equal, contribution, min_contribution);
+      // The growth through the ring radii `radii`: ring i injected over frames_per_ring frames
+      // (Alg. 1 with R = R_{i-1} + (R_i - R_{i-1}) j / F, j = 1..F); the first ring appears at once.
+      auto grow = [&](const std::vector<double>& radii) {
+        json steps = json::array();
+        double min_ssim = 1;
+        std::optional<vislib::Frame> prev;
+        for (size_t i = 0; i < radii.size(); ++i) {
+          const int frames = i == 0 ? 1 : a->frames_per_ring;
+          for (int k = 1; k <= frames; ++k) {
+            const double big_r = i == 0 ? radii[0] : radii[i - 1] + (radii[i] - radii[i - 1]) * k / frames;
+            if (!(eye_axis < a->near_fraction * big_r)) continue;  // Alg. 1 needs the eye inside R_n
+            vislib::Frame f = vislib::render_progressive(scene, rt, tris, cam, centre, big_r, a->near_fraction,
+                                                         s.env_size, radii[i]);
+            json step = {{"ring", i}, {"ring_radius", radii[i]}, {"radius", big_r},
+                         {"ssim_to_truth", vislib::frame_quality(truth, f).ssim}};
+            if (prev) {
+              double ss = vislib::ssim_luminance(fw, fh, prev->rgb, f.rgb);
+              step["ssim_to_previous"] = ss;
+              min_ssim = std::min(min_ssim, ss);
+            }
+            steps.push_back(step);
+            prev = std::move(f);
+          }
         }
-        steps.push_back(step);
-        prev = std::move(f);
-      }
-      j["continuity"] = {{"min_consecutive_ssim", steps.size() >= 2 ? json(min_ssim) : json(nullptr)},
-                         {"near_fraction", a->near_fraction}, {"ring_area", M_PI * s.r2 * s.r2 / a->rings},
-                         {"steps", steps}};
+        return json{{"radii", radii},
+                    {"min_consecutive_ssim", steps.size() >= 2 ? json(min_ssim) : json(nullptr)},
+                    {"frames", steps.size()}, {"steps", steps}};
+      };
+      json merged_json = grow(merged);
+      json equal_json = grow(equal);
+      j["continuity"] = {{"min_consecutive_ssim", merged_json["min_consecutive_ssim"]},
+                         {"near_fraction", a->near_fraction}, {"ring_area", ring_area},
+                         {"frames_per_ring", a->frames_per_ring}, {"ring_contribution", contribution},
+                         {"merge_min_contribution", min_contribution}, {"merged", merged_json},
+                         {"equal_area", equal_json}};
     }
 
     auto fmt_psnr = [](const json& v) { return v.is_null() ? std::string("inf") : std::to_string(v.get<double>()); };
@@ -213,9 +256,16 @@ void add_view(CLI::App& app) {
                  j["triangle_mismatch"].get<double>(), j["without_morph"]["epsilon"].get<double>(), fmt_psnr(j["without_morph"]["psnr"]).c_str(),
                  j["without_morph"]["ssim"].get<double>(), j["without_morph"]["ovc"].get<double>(),
                  j["without_morph"]["ofc"].get<double>(), j["without_morph"]["triangle_mismatch"].get<double>());
-    if (j.contains("continuity") && !j["continuity"]["min_consecutive_ssim"].is_null())
-      std::fprintf(stderr, "  growth: %zu frames, min consecutive SSIM %.4f\n", j["continuity"]["steps"].size(),
-                   j["continuity"]["min_consecutive_ssim"].get<double>());
+    if (!moving.empty() && full_scene.is_dynamic())
+      std::fprintf(stderr, "  tau %.4f: dynamic far triangles drawn %zu, shown %zu\n", a->tau, rc.far_dynamic,
+                   rc.far_dynamic_shown);
+    if (j.contains("continuity"))
+      for (const char* k : {"merged", "equal_area"}) {
+        const json& g = j["continuity"][k];
+        if (g["min_consecutive_ssim"].is_null()) continue;
+        std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
+                     g["radii"].size(), g["frames"].get<size_t>(), g["min_consecutive_ssim"].get<double>());
+      }
     if (a->json_path == "-") {
       std::printf("%s\n", j.dump(1).c_str());
     } else if (!a->json_path.empty()) {

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -129,6 +130,83 @@ TEST(NearFarRender, VertexOnR2ThroughEyeDirectionLookupLandsWhereOSeesIt) {
   EXPECT_NEAR(got.second, got_truth.second, 1.0);
 }
 
+// A stationary far wall at z = -8 (as seen from O at the origin) and a moving far triangle: in
+// key state 0 it is behind the wall (z = -10), in state 1 in front of it (z = -6). Eq. 2 draws it
+// from the eye; Eq. 3 against the wall's range from O hides it at tau = 0 and shows it at tau = 1,
+// as the full-scene frame does.
+TEST(NearFarRender, DynamicFarTriangleBehindAStationaryFarWallIsHidden) {
+  vislib::Scene s;
+  add_quad(s, {-6, -3, -8}, {6, -3, -8}, {6, 4, -8}, {-6, 4, -8});  // triangles 0, 1 (static)
+  s.positions.resize(2, s.positions[0]);
+  const uint32_t base = uint32_t(s.positions[0].size());
+  for (double z : {-10.0, -6.0}) {
+    const size_t k = z < -8 ? 0 : 1;
+    for (Vec3 p : {Vec3{-0.8, 0.0, z}, Vec3{0.8, 0.0, z}, Vec3{0.0, 1.2, z}}) s.positions[k].push_back(p);
+  }
+  s.objects.push_back({"mover"});
+  s.triangles.push_back({base, base + 1, base + 2});  // triangle 2 (moving)
+  s.triangle_object.push_back(1);
+  const std::vector<uint8_t> moving = vislib::moving_triangles(s);
+  ASSERT_EQ(moving, (std::vector<uint8_t>{0, 0, 1}));
+
+  vislib::Camera cam;
+  cam.eye = {0.2, 0.4, 0.1};
+  cam.forward = {0, 0, -1};
+  cam.width = 96, cam.height = 64;
+  vislib::NearFarSettings set;
+  set.centre = {0, 0.3, 0};
+  set.r1 = 1, set.r2 = 2;  // the wall and the triangle are far in both states
+  set.env_size = 128;
+  set.dynamic = moving.data();
+  size_t shown[2] = {0, 0}, in_truth[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    const vislib::Scene at = vislib::scene_at(s, double(k));
+    vislib::EmbreeScene rt(at, 0.0, cam.eye);
+    vislib::RegionCounts rc;
+    const vislib::Frame nf = vislib::render_near_far(at, rt, all_ids(at), cam, set, &rc);
+    const vislib::Frame truth = vislib::render_frame(at, rt, cam);
+    EXPECT_EQ(rc.far, 3u);
+    EXPECT_EQ(rc.far_dynamic, 1u);
+    EXPECT_EQ(rc.env_map, 2u);  // the moving triangle is never baked into the map
+    for (uint32_t t : nf.tri) shown[k] += t == 2;
+    for (uint32_t t : truth.tri) in_truth[k] += t == 2;
+    EXPECT_EQ(rc.far_dynamic_shown, shown[k] > 0 ? 1u : 0u);
+  }
+  EXPECT_EQ(in_truth[0], 0u);
+  EXPECT_EQ(shown[0], 0u) << "behind the wall as seen from O: Eq. 3 must hide it";
+  EXPECT_GT(in_truth[1], 20u);
+  EXPECT_GT(shown[1], 20u) << "in front of the wall: it must appear";
+  // Its footprint is the true one shifted by Eq. 2's U - O (a few pixels at this distance).
+  EXPECT_NEAR(double(shown[1]), double(in_truth[1]), 0.25 * double(in_truth[1]));
+}
+
+// A moving far triangle with no stationary far geometry behind it (the map's range is +infinity
+// along its directions) passes Eq. 3 and is drawn.
+TEST(NearFarRender, DynamicFarTriangleWithNothingBehindIsDrawnByEq2) {
+  vislib::Scene s;
+  s.positions.resize(2);
+  for (Vec3 p : {Vec3{-0.8, 0.0, -10}, Vec3{0.8, 0.0, -10}, Vec3{0.0, 1.2, -10}}) s.positions[0].push_back(p);
+  for (Vec3 p : {Vec3{-0.8, 0.0, -6}, Vec3{0.8, 0.0, -6}, Vec3{0.0, 1.2, -6}}) s.positions[1].push_back(p);
+  s.objects.push_back({"mover"});
+  s.triangles.push_back({0, 1, 2});
+  s.triangle_object.push_back(0);
+  const std::vector<uint8_t> moving = vislib::moving_triangles(s);
+  vislib::Camera cam;
+  cam.eye = {0.2, 0.4, 0.1};
+  cam.forward = {0, 0, -1};
+  cam.width = 96, cam.height = 64;
+  vislib::NearFarSettings set;
+  set.centre = {0, 0.3, 0};
+  set.r1 = 1, set.r2 = 2;
+  set.env_size = 64;
+  set.dynamic = moving.data();
+  const vislib::Scene at = vislib::scene_at(s, 0.0);
+  vislib::EmbreeScene rt(at, 0.0, cam.eye);
+  vislib::RegionCounts rc;
+  const vislib::Frame nf = vislib::render_near_far(at, rt, all_ids(at), cam, set, &rc);
+  EXPECT_EQ(rc.far_dynamic_shown, 1u);
+}
+
 TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   using vislib_test::run_pvs;
   const std::string dir = vislib_test::temp_dir("pvs_view");
@@ -156,6 +234,19 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   EXPECT_GE(j["ssim"].get<double>(), -1.0);
   EXPECT_LE(j["ssim"].get<double>(), 1.0);
   EXPECT_TRUE(j["without_morph"].contains("ssim"));
+  // --grow: both ring sequences, merged radii a subsequence of the equal-area ones ending at r2,
+  // every ring after the first injected over --frames-per-ring (default 4) frames.
+  const nlohmann::json& c = j["continuity"];
+  const auto equal = c["equal_area"]["radii"].get<std::vector<double>>();
+  const auto merged = c["merged"]["radii"].get<std::vector<double>>();
+  ASSERT_EQ(equal.size(), 4u);
+  ASSERT_FALSE(merged.empty());
+  EXPECT_LE(merged.size(), equal.size());
+  EXPECT_DOUBLE_EQ(merged.back(), 30.0);
+  for (double r : merged) EXPECT_NE(std::find(equal.begin(), equal.end(), r), equal.end()) << r;
+  EXPECT_EQ(c["equal_area"]["frames"].get<size_t>(), 1 + 4 * (equal.size() - 1));
+  EXPECT_EQ(c["merged"]["frames"].get<size_t>(), 1 + 4 * (merged.size() - 1));
+  EXPECT_EQ(c["min_consecutive_ssim"], c["merged"]["min_consecutive_ssim"]);
   // A PVS of another scene is rejected.
   ASSERT_EQ(run_pvs("generate city --blocks 2,2 --seed 9 -o " + dir + "/other.glb", &out), 0) << out;
   EXPECT_NE(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/other.glb --at 5,1.6,5 --look 40,1.6,5 "

@@ -144,61 +144,108 @@ EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt,
   return env;
 }
 
+Scene scene_at(const Scene& scene, double tau) {
+  Scene out;
+  out.triangles = scene.triangles;
+  out.triangle_object = scene.triangle_object;
+  out.objects = scene.objects;
+  out.sphere_radius = scene.sphere_radius;
+  out.sphere_object = scene.sphere_object;
+  if (!scene.positions.empty()) {
+    out.positions.resize(1);
+    out.positions[0].resize(scene.vertex_count());
+    for (uint32_t v = 0; v < scene.vertex_count(); ++v) out.positions[0][v] = scene.position_at(v, tau);
+  }
+  if (!scene.sphere_centers.empty()) {
+    out.sphere_centers.resize(1);
+    out.sphere_centers[0].resize(scene.sphere_count());
+    for (uint32_t k = 0; k < scene.sphere_count(); ++k) out.sphere_centers[0][k] = scene.sphere_center_at(k, tau);
+  }
+  return out;
+}
+
+std::vector<uint8_t> moving_triangles(const Scene& scene) {
+  std::vector<uint8_t> moves(scene.triangle_count(), 0);
+  for (size_t k = 1; k < scene.positions.size(); ++k)
+    for (uint32_t t = 0; t < scene.triangle_count(); ++t)
+      for (uint32_t v : scene.triangles[t])
+        if (!(scene.positions[k][v] == scene.positions[0][v])) moves[t] = 1;
+  return moves;
+}
+
 Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
                       const Camera& camera, const NearFarSettings& s, RegionCounts* counts) {
   assert(s.r1 >= 0 && s.r1 < s.r2 && s.env_size >= 1);
   const nf::Point3 o = to_point(s.centre), u = to_point(camera.eye);
   assert(nf::axis_distance(u, o) < s.r1);
   const auto& pos = scene.positions[0];
-  std::vector<uint32_t> geometry_ids;
-  std::vector<uint8_t> env_mask(scene.triangle_count(), 0);
-  std::vector<uint8_t> is_intermediate(scene.triangle_count(), 0);
-  RegionCounts rc;
-  for (uint32_t t : visible) {
-    bool all_near = true, all_far = true, any_far = false;
-    for (uint32_t v : scene.triangles[t]) {
-      const nf::Region r = nf::vertex_region(nf::axis_distance(to_point(pos[v]), o), s.r1, s.r2);
-      all_near = all_near && r == nf::Region::Near;
-      all_far = all_far && r == nf::Region::Far;
-      any_far = any_far || r == nf::Region::Far;
-    }
-    if (all_near) {
-      ++rc.near;
-      geometry_ids.push_back(t);
-    } else if (all_far) {
-      ++rc.far;
-    } else {
-      ++rc.intermediate;
-      geometry_ids.push_back(t);
-      is_intermediate[t] = 1;
-    }
-    if (any_far) {
-      env_mask[t] = 1;
-      ++rc.env_map;
-    }
+  std::vector<float> pos_f(3 * pos.size());
+  for (size_t v = 0; v < pos.size(); ++v) {
+    pos_f[3 * v] = float(pos[v].x), pos_f[3 * v + 1] = float(pos[v].y), pos_f[3 * v + 2] = float(pos[v].z);
   }
-  if (counts) *counts = rc;
+  const nf::NearFarPartition part =
+      nf::partition_near_far(pos_f.data(), pos.size(), scene.triangles.empty() ? nullptr : scene.triangles[0].data(),
+                             scene.triangle_count(), s.dynamic, visible.data(), visible.size(), o, s.r1, s.r2);
+  RegionCounts rc;
+  rc.near = part.near_ids.size();
+  rc.intermediate = part.intermediate_ids.size();
+  rc.far = part.far_static_ids.size() + part.far_dynamic_ids.size();
+  rc.far_dynamic = part.far_dynamic_ids.size();
+  rc.env_map = part.environment_map_ids.size();
+  // Drawn from geometry with the morph: near and intermediate (geometry_ids minus the dynamic far).
+  std::vector<uint32_t> geometry_ids;
+  {
+    const std::vector<uint8_t> far_dyn = triangle_mask(scene.triangle_count(), part.far_dynamic_ids);
+    for (uint32_t t : part.geometry_ids)
+      if (!far_dyn[t]) geometry_ids.push_back(t);
+  }
   Frame f = render_displaced(scene, geometry_ids, camera, [&](uint32_t v) {
     if (!s.morph) return pos[v];
     return to_vec(nf::morph_vertex(to_point(pos[v]), u, o, s.r1, s.r2));
   });
-  const EnvironmentMap env = render_environment_map(scene, rt, s.centre, s.env_size, env_mask.data());
+  const EnvironmentMap env = render_environment_map(
+      scene, rt, s.centre, s.env_size, triangle_mask(scene.triangle_count(), part.environment_map_ids).data());
+  if (!part.far_dynamic_ids.empty()) {
+    // Eq. 2 displacement, then Eq. 3 against the map's range, then the depth test against geometry.
+    const Frame dyn = render_displaced(scene, part.far_dynamic_ids, camera,
+                                       [&](uint32_t v) { return to_vec(nf::displace_far(to_point(pos[v]), u, o)); });
+    const nf::RangeCubeMap range{env.size, env.range.data()};
+    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+      for (int y = rows.begin(); y != rows.end(); ++y)
+        for (int x = 0; x < camera.width; ++x) {
+          const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
+          if (dyn.tri[p] == kNoHit || !(dyn.depth[p] < f.depth[p])) continue;
+          Vec3 d = camera_ray(camera, x, y);
+          d = d * (1.0 / length(d));
+          if (!nf::passes_range_test(to_point(camera.eye + d * double(dyn.depth[p])), u, range)) continue;
+          f.tri[p] = dyn.tri[p];
+          f.depth[p] = dyn.depth[p];
+          for (int k = 0; k < 3; ++k) f.rgb[3 * p + size_t(k)] = dyn.rgb[3 * p + size_t(k)];
+        }
+    });
+    std::vector<uint8_t> shown(scene.triangle_count(), 0);
+    for (uint32_t t : f.tri)
+      if (t != kNoHit) shown[t] = 1;
+    for (uint32_t t : part.far_dynamic_ids) rc.far_dynamic_shown += shown[t];
+  }
+  if (counts) *counts = rc;
   compose(f, env, camera, s.lookup, s.r2);
   return f;
 }
 
 Frame render_progressive(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
-                         const Camera& camera, Vec3 centre, double big_r, double near_fraction, int env_size) {
-  assert(near_fraction > 0 && near_fraction < 1 && big_r > 0);
+                         const Camera& camera, Vec3 centre, double big_r, double near_fraction, int env_size,
+                         double ring_radius) {
+  assert(near_fraction > 0 && near_fraction < 1 && big_r > 0 && big_r <= ring_radius);
   const nf::Point3 o = to_point(centre), u = to_point(camera.eye);
   const double r_n = near_fraction * big_r;
   assert(nf::axis_distance(u, o) < r_n);
   const auto& pos = scene.positions[0];
-  // An object is near when one of its visible vertices is within big_r of the axis.
+  // An object is near (received) when one of its visible vertices is within ring_radius of the axis.
   std::vector<uint8_t> near_object(scene.objects.size(), 0);
   for (uint32_t t : visible)
     for (uint32_t v : scene.triangles[t])
-      if (nf::axis_distance(to_point(pos[v]), o) < big_r) near_object[scene.triangle_object[t]] = 1;
+      if (nf::axis_distance(to_point(pos[v]), o) < ring_radius) near_object[scene.triangle_object[t]] = 1;
   std::vector<uint32_t> near_ids;
   std::vector<uint8_t> env_mask(scene.triangle_count(), 0);
   for (uint32_t t : visible) {
@@ -213,6 +260,24 @@ Frame render_progressive(const Scene& scene, const EmbreeScene& rt, const std::v
   const EnvironmentMap env = render_environment_map(scene, rt, centre, env_size, env_mask.data());
   compose(f, env, camera, EnvironmentLookup::EyeDirection, big_r);
   return f;
+}
+
+std::vector<double> ring_visible_triangle_contribution(const Scene& scene, const std::vector<uint32_t>& visible,
+                                                        Vec3 centre, const std::vector<double>& radii) {
+  const nf::Point3 o = to_point(centre);
+  const auto& pos = scene.positions[0];
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<double> object_radius(scene.objects.size(), inf), object_tris(scene.objects.size(), 0);
+  for (uint32_t t : visible) {
+    const uint32_t obj = scene.triangle_object[t];
+    object_tris[obj] += 1;
+    for (uint32_t v : scene.triangles[t])
+      object_radius[obj] = std::fmin(object_radius[obj], nf::axis_distance(to_point(pos[v]), o));
+  }
+  std::vector<double> item_radius, item_weight;
+  for (size_t obj = 0; obj < scene.objects.size(); ++obj)
+    if (object_tris[obj] > 0) item_radius.push_back(object_radius[obj]), item_weight.push_back(object_tris[obj]);
+  return nf::ring_contributions(radii, item_radius, item_weight);
 }
 
 ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const Frame& test) {

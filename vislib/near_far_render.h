@@ -30,7 +30,15 @@
 //        point. A far point on the cylinder then lands at its true pixel; the depth is
 //        |O + range * dir - U|. This does not match the Eq. 1 morph at r2 (which follows the
 //        paper's lookup), so it is offered for comparison only.
-//     Geometry is drawn over the map without Eq. 3 (there are no dynamic far triangles here).
+//     Geometry is drawn over the map.
+//  4. Dynamic far triangles (settings.dynamic marks the moving triangles; a moving triangle with
+//     every vertex at or beyond r2): never put into the environment map; drawn per frame from the
+//     eye with every vertex displaced by Eq. 2 (pvs_runtime::displace_far, Q = U + P - O, with or
+//     without the morph), and each such fragment (the eye ray's first hit among them, at
+//     q = U + depth * dir) kept only if it passes Eq. 3 (pvs_runtime::passes_range_test against
+//     the map's range from O) and is nearer than the geometry of step 1. A moving triangle that
+//     crosses r2 stays intermediate (morphed, not tested by Eq. 3), as in
+//     pvs_runtime::partition_near_far, which makes the partition.
 //  The output Frame's tri holds scene triangle ids (from geometry or from the map), kNoHit where
 //  both miss; rgb and depth as above.
 //
@@ -57,14 +65,29 @@ struct NearFarSettings {
   bool morph = true;        // false: intermediate triangles drawn where they are (no Eq. 1)
   int env_size = 512;       // environment map face side, pixels, >= 1
   EnvironmentLookup lookup = EnvironmentLookup::EyeDirection;
+  // One byte per scene triangle, nonzero = the triangle moves (moving_triangles), or null for a
+  // static scene. Not owned.
+  const uint8_t* dynamic = nullptr;
 };
 
 // Visible triangles per region (near: all vertices within r1 of the axis; far: all at or beyond
 // r2; intermediate: the rest). env_map counts what goes into the environment map (far plus the
 // intermediate triangles with a vertex at or beyond r2).
+// far_dynamic: the far triangles that move (included in far, drawn per frame by Eq. 2 and Eq. 3,
+// not in env_map); far_dynamic_shown: how many of them show in at least one pixel of the frame.
 struct RegionCounts {
-  size_t near = 0, intermediate = 0, far = 0, env_map = 0;
+  size_t near = 0, intermediate = 0, far = 0, env_map = 0, far_dynamic = 0, far_dynamic_shown = 0;
 };
+
+// A single-state copy of `scene` at animation time tau in [0,1]: vertex v at
+// scene.position_at(v, tau), sphere s at scene.sphere_center_at(s, tau); triangles, objects and
+// radii unchanged. Render a dynamic scene at tau through this copy (render_frame and
+// render_near_far shade with key state 0).
+Scene scene_at(const Scene& scene, double tau);
+
+// One byte per triangle of `scene`: 1 where some vertex of the triangle differs between key
+// states (the triangle moves), else 0. All 0 for a single-state scene.
+std::vector<uint8_t> moving_triangles(const Scene& scene);
 
 // The environment cube map rendered from O: 6 faces of size x size, index (face*size + y)*size + x.
 struct EnvironmentMap {
@@ -87,13 +110,27 @@ EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt,
 Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
                       const Camera& camera, const NearFarSettings& settings, RegionCounts* counts = nullptr);
 
-// The CloVR frame with near radius big_r (object level, CloVR §3): the triangles (of `visible`)
-// of every object with a visible vertex within big_r of O's axis are drawn from geometry with
-// their vertices displaced by pvs_runtime::inject_vertex (Alg. 1, R_n = near_fraction * big_r);
-// the other visible triangles form this ring's environment map, looked up along the eye ray.
-// camera.eye's axis distance must be < near_fraction * big_r; 0 < near_fraction < 1.
+// The CloVR frame while ring `ring_radius` is injected with the near region at radius big_r
+// (object level, CloVR §3, Alg. 1): the triangles (of `visible`) of every object with a visible
+// vertex within ring_radius of O's axis (the geometry received so far) are drawn from geometry
+// with their vertices displaced by pvs_runtime::inject_vertex (Alg. 1 at R = big_r,
+// R_n = near_fraction * big_r: a vertex beyond big_r is drawn where the map showed it); the other
+// visible triangles form this ring's environment map, looked up along the eye ray. Animating
+// big_r from the previous ring's radius up to ring_radius gives the in-between frames of the
+// injection; big_r = ring_radius is the ring's final frame.
+// camera.eye's axis distance must be < near_fraction * big_r; 0 < near_fraction < 1;
+// 0 < big_r <= ring_radius.
 Frame render_progressive(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
-                         const Camera& camera, Vec3 centre, double big_r, double near_fraction, int env_size);
+                         const Camera& camera, Vec3 centre, double big_r, double near_fraction, int env_size,
+                         double ring_radius);
+
+// The CloVR per-ring contribution for merging (pvs_runtime::merge_rings): for each ring
+// [radii[k-1], radii[k]) of the equal-area sequence `radii`, the number of triangles of `visible`
+// whose objects enter the near region in that ring (an object enters with its first visible vertex,
+// as in render_progressive), i.e. the visible triangles that change from environment map to
+// geometry in that ring. Objects entering at or beyond the last radius are not counted.
+std::vector<double> ring_visible_triangle_contribution(const Scene& scene, const std::vector<uint32_t>& visible,
+                                                        Vec3 centre, const std::vector<double>& radii);
 
 // CloVR's completion metrics of `test` against `truth` (same size; tri ids of the same scene):
 //  - OVC, object visualization completion: the share of objects with at least one pixel in
