@@ -24,7 +24,7 @@
 #include "vislib/footprint.h"
 #include "vislib/polynomial.h"
 #include "vislib/segment_visibility.h"
-#include "vislib/tile_bins.h"
+#include "vislib/kernel_support.h"
 
 namespace vislib {
 
@@ -372,23 +372,8 @@ struct Run {
   bool diagonal;        // part of the Diagonal mode (its pieces map onto t)
 };
 
-struct Found {
-  std::vector<uint8_t> seen;        // per primitive (triangles, then spheres)
-  std::vector<double> witness_len;  // per primitive, -1 = none
-  std::vector<Witness> witness;
-};
-
-bool better(double la, const Witness& a, double lb, const Witness& b) {
-  if (la != lb) return la > lb;
-  if (a.face != b.face) return a.face < b.face;
-  if (a.y != b.y) return a.y < b.y;
-  if (a.x != b.x) return a.x < b.x;
-  if (a.t != b.t) return a.t < b.t;
-  return a.tau < b.tau;
-}
-
 void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
-                tbb::enumerable_thread_specific<Found>& found_by_thread,
+                tbb::enumerable_thread_specific<FoundMarks>& found_by_thread,
                 std::vector<std::vector<GeneralPiece>>* pieces, std::vector<SegmentStats>& all_stats) {
   const int N = opt.resolution, TS = opt.tile_size;
   const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
@@ -452,7 +437,7 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
       Scratch& sc = scratch.local();
       auto& lists = sc.lists;
-      Found& found = found_by_thread.local();
+      FoundMarks& found = found_by_thread.local();
       for (int tile = r.begin(); tile != r.end(); ++tile) {
         SegmentStats& stats = all_stats[size_t(face) * tile_count + tile];
         const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
@@ -552,23 +537,17 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
               double span = std::max(std::fabs(run.t1 - run.t0), std::fabs(run.tau1 - run.tau0));
               double len = (pc.t1 - pc.t0) * span;
               if (!(len > opt.eps_len)) continue;
-              found.seen[pc.id] = 1;
-              if (!found.witness_len.empty()) {
-                double sm = 0.5 * (pc.t0 + pc.t1);
-                bool sph = pc.id >= ntri;
-                Witness w;
-                w.tri = sph ? uint32_t(pc.id - ntri) : pc.id;
-                w.is_sphere = sph;
-                w.face = face;
-                w.x = x;
-                w.y = y;
-                w.t = run.t0 + sm * (run.t1 - run.t0);
-                w.tau = run.tau0 + sm * (run.tau1 - run.tau0);
-                if (better(len, w, found.witness_len[pc.id], found.witness[pc.id])) {
-                  found.witness_len[pc.id] = len;
-                  found.witness[pc.id] = w;
-                }
-              }
+              double sm = 0.5 * (pc.t0 + pc.t1);
+              bool sph = pc.id >= ntri;
+              Witness w;
+              w.tri = sph ? uint32_t(pc.id - ntri) : pc.id;
+              w.is_sphere = sph;
+              w.face = face;
+              w.x = x;
+              w.y = y;
+              w.t = run.t0 + sm * (run.t1 - run.t0);
+              w.tau = run.tau0 + sm * (run.tau1 - run.tau0);
+              found.mark(pc.id, len, w);
             }
             if (pieces && run.diagonal) {
               auto& dst = (*pieces)[(size_t(face) * N + y) * N + x];
@@ -618,43 +597,15 @@ SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, c
   }
   SegmentResult result;
   if (opt.want_pieces) result.general_pieces.resize(size_t(6) * opt.resolution * opt.resolution);
-  tbb::enumerable_thread_specific<Found> found_by_thread([&] {
-    Found f;
-    f.seen.assign(nprim, 0);
-    if (opt.want_witnesses) {
-      f.witness_len.assign(nprim, -1.0);
-      f.witness.resize(nprim);
-    }
-    return f;
-  });
+  tbb::enumerable_thread_specific<FoundMarks> found_by_thread([&] { return FoundMarks(nprim, opt.want_witnesses); });
   const int tiles_x = (opt.resolution + opt.tile_size - 1) / opt.tile_size;
   std::vector<SegmentStats> stats(size_t(6) * tiles_x * tiles_x);
   for (const Run& run : runs)
     run_kernel(scene, run, opt, found_by_thread, opt.want_pieces ? &result.general_pieces : nullptr, stats);
-  for (const SegmentStats& ts : stats) {
-    SegmentStats& s = result.stats;
-    s.pair_tests += ts.pair_tests;
-    s.covered_pairs += ts.covered_pairs;
-    s.final_pieces += ts.final_pieces;
-    s.pixels_with_pieces += ts.pixels_with_pieces;
-    s.max_pieces_per_pixel = std::max(s.max_pieces_per_pixel, ts.max_pieces_per_pixel);
-    s.triangle_tiles += ts.triangle_tiles;
-    s.culled_triangle_tiles += ts.culled_triangle_tiles;
-    s.culled_pairs += ts.culled_pairs;
-    s.peak_tile_bytes = std::max(s.peak_tile_bytes, ts.peak_tile_bytes);
-  }
-  std::vector<uint8_t> seen(nprim, 0);
-  std::vector<double> best_len(opt.want_witnesses ? nprim : 0, -1.0);
-  std::vector<Witness> best(opt.want_witnesses ? nprim : 0);
-  for (const Found& f : found_by_thread) {
-    for (size_t p = 0; p < nprim; ++p) seen[p] |= f.seen[p];
-    if (opt.want_witnesses)
-      for (size_t p = 0; p < nprim; ++p)
-        if (f.witness_len[p] >= 0 && better(f.witness_len[p], f.witness[p], best_len[p], best[p])) {
-          best_len[p] = f.witness_len[p];
-          best[p] = f.witness[p];
-        }
-  }
+  for (const SegmentStats& ts : stats) result.stats.add(ts);
+  std::vector<uint8_t> seen;
+  std::vector<Witness> best;
+  reduce_found(found_by_thread, nprim, opt.want_witnesses, seen, best);
   for (size_t p = 0; p < nprim; ++p) {
     if (!seen[p]) continue;
     if (p < ntri)

@@ -20,7 +20,7 @@
 #include <cmath>
 
 #include "vislib/footprint.h"
-#include "vislib/tile_bins.h"
+#include "vislib/kernel_support.h"
 
 namespace vislib {
 
@@ -89,24 +89,6 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
 
 namespace {
 
-// What one thread found: a mark per visible triangle and, if wanted, its best witness so far.
-// Threads are reduced with a total order (union; best witness by better_witness), so the result
-// does not depend on which thread handled which tile.
-struct ThreadFound {
-  std::vector<uint8_t> seen;        // per triangle id
-  std::vector<double> witness_len;  // per triangle id: length of the witness piece (-1 = none)
-  std::vector<Witness> witness;     // per triangle id
-};
-
-// Witness order: longer piece first, then lower face, row, column.
-// A missing witness has length -1 and loses to any real one.
-bool better_witness(double len_a, const Witness& a, double len_b, const Witness& b) {
-  if (len_a != len_b) return len_a > len_b;
-  if (a.face != b.face) return a.face < b.face;
-  if (a.y != b.y) return a.y < b.y;
-  return a.x < b.x;
-}
-
 struct FaceTriangle {
   uint32_t id;
   float zmin;  // nearest possible view depth over the segment (rounded down)
@@ -139,15 +121,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     return TileScratch{std::vector<PieceList>(size_t(TS) * TS), std::vector<uint8_t>(size_t(TS) * TS),
                        std::vector<double>(size_t(TS) * TS)};
   });
-  tbb::enumerable_thread_specific<ThreadFound> found_by_thread([&] {
-    ThreadFound f;
-    f.seen.assign(ntri, 0);
-    if (opt.want_witnesses) {
-      f.witness_len.assign(ntri, -1.0);
-      f.witness.resize(ntri);
-    }
-    return f;
-  });
+  tbb::enumerable_thread_specific<FoundMarks> found_by_thread([&] { return FoundMarks(ntri, opt.want_witnesses); });
 
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
@@ -183,7 +157,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
       TileScratch& sc = scratch.local();
       auto& lists = sc.lists;
-      ThreadFound& found = found_by_thread.local();
+      FoundMarks& found = found_by_thread.local();
       for (int tile = r.begin(); tile != r.end(); ++tile) {
         SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
         const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
@@ -263,19 +237,13 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
             for (const Piece& p : l) {
               double len = p.t1 - p.t0;
               if (!(len > opt.eps_len)) continue;
-              found.seen[p.id] = 1;
-              if (opt.want_witnesses) {
-                Witness w;
-                w.tri = p.id;
-                w.face = face;
-                w.x = x;
-                w.y = y;
-                w.t = 0.5 * (p.t0 + p.t1);
-                if (better_witness(len, w, found.witness_len[p.id], found.witness[p.id])) {
-                  found.witness_len[p.id] = len;
-                  found.witness[p.id] = w;
-                }
-              }
+              Witness w;
+              w.tri = p.id;
+              w.face = face;
+              w.x = x;
+              w.y = y;
+              w.t = 0.5 * (p.t0 + p.t1);
+              found.mark(p.id, len, w);
             }
             if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
           }
@@ -285,30 +253,10 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   }
 
   // (4) reduce: statistics in tile order; marks and witnesses over threads by a total order.
-  for (const SegmentStats& ts : tile_stats) {
-    SegmentStats& s = result.stats;
-    s.pair_tests += ts.pair_tests;
-    s.culled_pairs += ts.culled_pairs;
-    s.covered_pairs += ts.covered_pairs;
-    s.final_pieces += ts.final_pieces;
-    s.pixels_with_pieces += ts.pixels_with_pieces;
-    s.max_pieces_per_pixel = std::max(s.max_pieces_per_pixel, ts.max_pieces_per_pixel);
-    s.triangle_tiles += ts.triangle_tiles;
-    s.culled_triangle_tiles += ts.culled_triangle_tiles;
-    s.peak_tile_bytes = std::max(s.peak_tile_bytes, ts.peak_tile_bytes);
-  }
-  std::vector<uint8_t> seen(ntri, 0);
-  std::vector<double> best_len(opt.want_witnesses ? ntri : 0, -1.0);
-  std::vector<Witness> best(opt.want_witnesses ? ntri : 0);
-  for (const ThreadFound& f : found_by_thread) {
-    for (size_t t = 0; t < ntri; ++t) seen[t] |= f.seen[t];
-    if (opt.want_witnesses)
-      for (size_t t = 0; t < ntri; ++t)
-        if (f.witness_len[t] >= 0 && better_witness(f.witness_len[t], f.witness[t], best_len[t], best[t])) {
-          best_len[t] = f.witness_len[t];
-          best[t] = f.witness[t];
-        }
-  }
+  for (const SegmentStats& ts : tile_stats) result.stats.add(ts);
+  std::vector<uint8_t> seen;
+  std::vector<Witness> best;
+  reduce_found(found_by_thread, ntri, opt.want_witnesses, seen, best);
   for (size_t t = 0; t < ntri; ++t)
     if (seen[t]) {
       result.visible.push_back(uint32_t(t));

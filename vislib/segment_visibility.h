@@ -66,6 +66,18 @@ struct SegmentStats {
   uint64_t culled_triangle_tiles = 0;  // of which skipped by depth culling
   double peak_tile_bytes = 0;      // largest memory held by one tile's pixel lists
   double seconds = 0;              // wall time of the call
+  // Adds another part's counts (maxima for the max fields).
+  void add(const SegmentStats& o) {
+    pair_tests += o.pair_tests;
+    culled_pairs += o.culled_pairs;
+    covered_pairs += o.covered_pairs;
+    final_pieces += o.final_pieces;
+    pixels_with_pieces += o.pixels_with_pieces;
+    max_pieces_per_pixel = max_pieces_per_pixel > o.max_pieces_per_pixel ? max_pieces_per_pixel : o.max_pieces_per_pixel;
+    triangle_tiles += o.triangle_tiles;
+    culled_triangle_tiles += o.culled_triangle_tiles;
+    peak_tile_bytes = peak_tile_bytes > o.peak_tile_bytes ? peak_tile_bytes : o.peak_tile_bytes;
+  }
   double pieces_per_pixel() const {
     return pixels_with_pieces ? double(final_pieces) / double(pixels_with_pieces) : 0.0;
   }
