@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "cli/cmd_view_stereo.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "pvs_format/pvs_format.h"
@@ -91,7 +92,8 @@ void add_view(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Near-far frame (.png); <out>_truth.png, <out>_heat.png and "
                                             "<out>_nomorph.png are written next to it")->required();
   cmd->add_option("--json", a->json_path, "Write the metrics as JSON ('-' = stdout)");
-  cmd->callback([a] {
+  std::shared_ptr<ViewStereoArgs> stereo = add_view_stereo_options(cmd);
+  cmd->callback([a, stereo] {
     int fw = 0, fh = 0;
     if (std::sscanf(a->frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 || fh > 8192)
       throw CLI::ValidationError("--frame", "expected WxH with 11 <= W, H <= 8192, got '" + a->frame + "'");
@@ -266,6 +268,7 @@ void add_view(CLI::App& app) {
         std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
                      g["radii"].size(), g["frames"].get<size_t>(), g["min_consecutive_ssim"].get<double>());
       }
+    if (stereo->enabled()) j["stereo"] = run_view_stereo(*stereo, a->file, scene, rt, cam, a->output);
     if (a->json_path == "-") {
       std::printf("%s\n", j.dump(1).c_str());
     } else if (!a->json_path.empty()) {
