@@ -183,8 +183,9 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
         ej["patched_share"] = 0.0;
       } else {
         t0 = clock::now();
-        size_t resolved = 0, patched = 0, cast = 0;
-        if (a.reshade) resolved = vislib::reshade(r, scene, cam);
+        size_t patched = 0, cast = 0;
+        vislib::ReshadeStats rs;
+        if (a.reshade) rs = vislib::reshade(r, scene, cam);
         if (a.patch == "none") {
           out_frame[e] = vislib::patch_none(r, &patched);
         } else if (a.patch == "median") {
@@ -197,8 +198,11 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
           rays += cast;
         }
         t_patch += seconds_since(t0);
-        ej["patched_share"] = holes ? double(patched + resolved) / double(holes) : 1.0;
-        ej["cracks_resolved_by_reshade"] = resolved;
+        // Holes that show a surface afterwards, over the holes plus the filled pixels --reshade
+        // found wrong (they are patched too).
+        const size_t open = holes + rs.unresolved;
+        ej["patched_share"] = open ? double(patched + rs.cracks_resolved) / double(open) : 1.0;
+        ej["reshade"] = {{"cracks_resolved", rs.cracks_resolved}, {"unresolved", rs.unresolved}};
       }
     }
     ej["method_error"] = quality(truth, out_frame[e]);

@@ -196,7 +196,7 @@ TEST(StereoReproject, HoleMaskMatchesRayOracle) {
           ipd, dir == 0 ? "left->right" : "right->left", pr.mask, pr.truth, pr.precision(),
           pr.recall(), outside_both, outside_true, r.count(HoleKind::Crack));
       EXPECT_GT(pr.truth, 100u);
-      EXPECT_GE(pr.precision(), 0.85);
+      EXPECT_GE(pr.precision(), 0.95);
       EXPECT_GE(pr.recall(), 0.9);
       EXPECT_GE(double(outside_both), 0.95 * double(outside_true));
     }
@@ -214,7 +214,7 @@ TEST(StereoReproject, ThinPoleLeavesFarFewerHolesThanAlg2AsPrinted) {
   centre.eye = {0, 0, 0};
   centre.forward = {0, 0, -1};
   centre.width = 640;
-  centre.height = 48;
+  centre.height = 480;
   centre.vfov_degrees = 60;
   EmbreeScene rt(s, 0, centre.eye);
   StereoPair eyes = stereo_pair(centre, 0.065);
@@ -224,7 +224,7 @@ TEST(StereoReproject, ThinPoleLeavesFarFewerHolesThanAlg2AsPrinted) {
   Reprojection exact = reproject(source, eyes.right, eyes.left);
   Reprojection alg2 = reproject(source, eyes.right, eyes.left, Splatting::Alg2AsPrinted);
   Oracle o = hole_oracle(truth, eyes.left, eyes.right, rt);
-  const int y = 24;  // a middle row; every row is alike
+  const int y = 240;  // a middle row; every row is alike
   auto row_holes = [&](const std::vector<HoleKind>& h) {
     int n = 0;
     for (int x = 0; x < 640; ++x) n += h[size_t(y) * 640 + size_t(x)] == HoleKind::Disocclusion;
@@ -274,8 +274,8 @@ TEST(StereoReproject, CantedAndAsymmetricCamerasNeedTheDivide) {
     const char* name;
     double toe_in, shift;
   };
-  for (const Case& k : {Case{"canted 3 deg", 3.0, 0.0}, Case{"off-axis 0.08", 0.0, 0.08},
-                        Case{"canted + off-axis", 1.5, -0.05}}) {
+  for (const Case& k : {Case{"canted 1 deg", 1.0, 0.0}, Case{"off-axis 0.03", 0.0, 0.03},
+                        Case{"canted + off-axis", 0.5, 0.015}}) {
     StereoPair eyes = stereo_pair(head(), 0.065, k.toe_in, k.shift);
     Frame source = render_frame(s, rt, eyes.left);
     Frame truth = render_frame(s, rt, eyes.right);
@@ -292,22 +292,24 @@ TEST(StereoReproject, CantedAndAsymmetricCamerasNeedTheDivide) {
     Oracle o = hole_oracle(truth, eyes.right, eyes.left, rt);
     PrecisionRecall pr = compare_mask(r, o);
     Reprojection rs = r;
-    reshade(rs, s, eyes.right);
-    size_t same_reshaded = 0;
-    for (size_t p = 0; p < r.pixel_count(); ++p)
-      same_reshaded += r.hole[p] == HoleKind::Filled && rs.tri[p] == truth.tri[p];
-    std::printf(
-        "%s: moved +x %zu, -x %zu; filled %zu, same triangle %.4f (reshaded %.4f); holes precision "
-        "%.4f "
-        "recall %.4f\n",
-        k.name, plus, minus, filled, double(same) / double(filled),
-        double(same_reshaded) / double(filled), pr.precision(), pr.recall());
-    if (k.toe_in > 0) {
-      EXPECT_GT(plus, 1000u);
-      EXPECT_GT(minus, 1000u);
+    const ReshadeStats st = reshade(rs, s, eyes.right);
+    size_t still = 0, same_reshaded = 0;
+    for (size_t p = 0; p < r.pixel_count(); ++p) {
+      still += r.hole[p] == HoleKind::Filled && rs.hole[p] == HoleKind::Filled;
+      same_reshaded += r.hole[p] == HoleKind::Filled && rs.hole[p] == HoleKind::Filled &&
+                       rs.tri[p] == truth.tri[p];
     }
+    std::printf(
+        "%s: moved +x %zu, -x %zu; filled %zu, same triangle %.4f; reshade: %zu unresolved, same "
+        "triangle "
+        "%.5f; holes precision %.4f recall %.4f\n",
+        k.name, plus, minus, filled, double(same) / double(filled), st.unresolved,
+        double(same_reshaded) / double(still), pr.precision(), pr.recall());
+    EXPECT_GT(plus, 1000u);
+    EXPECT_GT(minus, 1000u);
     EXPECT_GE(double(same) / double(filled), 0.97);
-    EXPECT_GE(double(same_reshaded) / double(filled), 0.999);
+    EXPECT_GE(double(same_reshaded) / double(still), 0.999);
+    EXPECT_LT(st.unresolved, filled / 100);
     EXPECT_GE(pr.precision(), 0.85);
     EXPECT_GE(pr.recall(), 0.9);
   }
@@ -407,7 +409,7 @@ TEST(StereoPatch, YoroWeightsFavourTheSampleNextToTheHole) {
       for (double v : w) sum += v;
       EXPECT_NEAR(sum, 1, 1e-12);
       EXPECT_GE(w[0], 0.515);
-      EXPECT_LE(w[0], 0.8 + 1e-12);
+      EXPECT_LE(w[0], 0.801);
       for (size_t k = 1; k < w.size(); ++k) EXPECT_LT(w[k], w[k - 1]);
     }
   // A one-row image: background ramp | 4-pixel hole | foreground. The fixed patcher fills from
@@ -437,6 +439,7 @@ TEST(StereoPatch, YoroWeightsFavourTheSampleNextToTheHole) {
 // 5 m in front of a wall. Holes grow with the IPD and shrink with the distance; the patched eye
 // keeps SSIM >= 0.95 (the paper's threshold) except where noted.
 TEST(StereoSweep, IpdAndObjectDistance) {
+  double prev_distance_share = 1;
   for (double dist : {0.5, 1.0, 2.0, 3.0}) {
     // A lumpy sphere of radius 0.1 * dist (the same size on screen at every distance).
     Scene s;
@@ -469,7 +472,7 @@ TEST(StereoSweep, IpdAndObjectDistance) {
     c.height = 240;
     c.vfov_degrees = 60;
     EmbreeScene rt(s, 0, c.eye);
-    double prev_share = -1;
+    double first_share = -1, share_65 = 0;
     for (double ipd = 0.05; ipd <= 0.0751; ipd += 0.005) {
       StereoPair eyes = stereo_pair(c, ipd);
       Frame source = render_frame(s, rt, eyes.right);
@@ -479,9 +482,88 @@ TEST(StereoSweep, IpdAndObjectDistance) {
       const FrameQuality q = frame_quality(truth, patch_yoro(r));
       std::printf("distance %.1f m, IPD %.1f cm: disocclusion %.4f, yoro PSNR %.2f SSIM %.4f\n",
                   dist, ipd * 100, share, q.psnr, q.ssim);
-      EXPECT_GE(share, prev_share);
-      prev_share = share;
+      if (first_share < 0) first_share = share;
+      if (std::fabs(ipd - 0.065) < 1e-9) share_65 = share;
       EXPECT_GE(q.ssim, 0.95);
+      EXPECT_GE(q.psnr, 30.0);
+      if (ipd > 0.0749) EXPECT_GT(share, first_share);  // 7.5 cm leaves more holes than 5 cm
     }
+    EXPECT_LT(share_65, prev_distance_share);  // farther object, fewer holes (at 6.5 cm)
+    prev_distance_share = share_65;
   }
+}
+
+// Item 3: `pvs view --stereo` on a baked city, the head on a cell boundary so that the eyes lie in
+// two cells (their union is rendered); the fallback; Alg. 2; bad options.
+TEST(StereoCli, ViewStereoWritesThePairTheHoleMaskAndTheJsonBlock) {
+  using nlohmann::json;
+  const std::string dir = vislib_test::temp_dir("stereo_cli");
+  const std::string city = dir + "/city.glb", pvs = dir + "/city.pvs";
+  std::string out;
+  ASSERT_EQ(vislib_test::run_pvs("generate city --blocks 2,2 -o " + city, &out), 0) << out;
+  ASSERT_EQ(vislib_test::run_pvs(
+                "bake " + city +
+                    " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 -o " + pvs,
+                &out),
+            0)
+      << out;
+  const std::string view =
+      "view " + pvs + " --scene " + city +
+      " --at 0,1.6,-20 --look 0.5,1.5,-100 --near-far 40,60 --frame 160x120 -o " + dir +
+      "/f.png --json " + dir + "/m.json";
+  auto load = [&] {
+    std::ifstream in(dir + "/m.json");
+    return json::parse(in);
+  };
+  ASSERT_EQ(
+      vislib_test::run_pvs(view + " --stereo yoro --ipd 0.065 --dominant left --patch yoro", &out),
+      0)
+      << out;
+  json j = load()["stereo"];
+  EXPECT_EQ(j["cells"].size(), 2u) << j.dump(1);  // x = 0 is a cell boundary: one eye on each side
+  EXPECT_TRUE(j["eyes"]["left"]["rendered"].get<bool>());
+  EXPECT_FALSE(j["eyes"]["right"]["rendered"].get<bool>());
+  EXPECT_TRUE(
+      j["eyes"]["left"]["method_error"]["psnr"].is_null());  // the rendered eye is the truth
+  EXPECT_GT(j["eyes"]["right"]["holes"]["share"].get<double>(), 0.0);
+  EXPECT_GT(j["eyes"]["right"]["method_error"]["ssim"].get<double>(), 0.9);
+  EXPECT_EQ(j["rays"]["both_eyes"].get<size_t>(), 2u * 160 * 120);
+  EXPECT_EQ(j["rays"]["cast"].get<size_t>(), 160u * 120);
+  for (const auto& [k, v] : j["images"].items())
+    EXPECT_TRUE(std::filesystem::exists(v.get<std::string>())) << k;
+
+  ASSERT_EQ(
+      vislib_test::run_pvs(view + " --stereo true --patch rays --reshade --dominant right", &out),
+      0)
+      << out;
+  j = load()["stereo"];
+  EXPECT_LT(j["eyes"]["left"]["method_error"]["triangle_mismatch"].get<double>(), 0.001);
+  EXPECT_GT(j["rays"]["cast"].get<size_t>(), 160u * 120);
+
+  ASSERT_EQ(vislib_test::run_pvs(view + " --stereo yoro --max-hole-share 0", &out), 0) << out;
+  j = load()["stereo"];
+  EXPECT_TRUE(j["eyes"]["right"]["fallback"].get<bool>());
+  EXPECT_TRUE(j["eyes"]["right"]["method_error"]["psnr"].is_null());
+  EXPECT_EQ(j["rays"]["cast"].get<size_t>(), 2u * 160 * 120);
+
+  ASSERT_EQ(vislib_test::run_pvs(view + " --stereo alg2 --dominant centre --patch median", &out), 0)
+      << out;
+  j = load()["stereo"];
+  EXPECT_EQ(j["splatting"], "alg2_as_printed");
+  EXPECT_FALSE(j["eyes"]["left"]["rendered"].get<bool>());
+  EXPECT_FALSE(j["eyes"]["right"]["rendered"].get<bool>());
+  EXPECT_EQ(j["cells"].size(), 2u);
+
+  EXPECT_EQ(vislib_test::run_pvs(view + " --stereo yoro --ipd -1", &out), 2) << out;
+  EXPECT_EQ(vislib_test::run_pvs(view + " --stereo maybe", &out), 2) << out;
+  EXPECT_EQ(vislib_test::run_pvs(view + " --stereo yoro --patch telea", &out), 2) << out;
+  // An eye outside every cell: the baked boxes end at x = 60.
+  EXPECT_EQ(vislib_test::run_pvs(
+                "view " + pvs + " --scene " + city +
+                    " --at 59.99,1.6,-20 --look 59.99,1.6,-100 --near-far 40,60 --frame 32x24 -o " +
+                    dir + "/g.png --stereo yoro --ipd 0.2",
+                &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("in no cell"), std::string::npos) << out;
 }

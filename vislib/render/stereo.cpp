@@ -595,12 +595,12 @@ Frame patch_rays(const Reprojection& r, const Scene& scene, const EmbreeScene& r
   return f;
 }
 
-size_t reshade(Reprojection& r, const Scene& scene, const Camera& target) {
+ReshadeStats reshade(Reprojection& r, const Scene& scene, const Camera& target) {
   assert(r.width == target.width && r.height == target.height);
   const Basis b = basis(target);
   const int w = r.width, h = r.height;
   const Reprojection in = r;  // candidates come from the unmodified reprojection
-  std::vector<size_t> row_resolved(size_t(h), 0);
+  std::vector<size_t> row_resolved(size_t(h), 0), row_unresolved(size_t(h), 0);
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     std::vector<std::pair<uint32_t, size_t>> cand;  // (triangle, pixel it came from)
     for (int y = rows.begin(); y != rows.end(); ++y)
@@ -641,14 +641,20 @@ size_t reshade(Reprojection& r, const Scene& scene, const Camera& target) {
             ++row_resolved[size_t(y)];
           }
         } else if (k == HoleKind::Filled && in.tri[p] != kNoHit) {
-          const auto c = shade_triangle(scene, in.tri[p], d);
-          out[0] = c[0], out[1] = c[1], out[2] = c[2];
+          r.hole[p] = HoleKind::Disocclusion;
+          r.source[p] = kNoSource;
+          r.tri[p] = kNoHit;
+          r.depth[p] = std::numeric_limits<float>::infinity();
+          out[0] = kStereoHoleColour[0], out[1] = kStereoHoleColour[1],
+          out[2] = kStereoHoleColour[2];
+          ++row_unresolved[size_t(y)];
         }
       }
   });
-  size_t n = 0;
-  for (size_t c : row_resolved) n += c;
-  return n;
+  ReshadeStats st;
+  for (size_t c : row_resolved) st.cracks_resolved += c;
+  for (size_t c : row_unresolved) st.unresolved += c;
+  return st;
 }
 
 std::vector<uint8_t> hole_mask_image(const Frame& frame, const std::vector<HoleKind>& hole) {

@@ -144,12 +144,19 @@ std::vector<double> yoro_kernel_weights(int width, double t);
 // the reprojection filled and at its cracks, from triangle ids (run it before a patcher): each
 // such pixel's ray (camera_ray of `target`) is intersected exactly (double, two-sided) with the
 // triangles of the filled pixels of its 3 x 3 neighbourhood in `r`; the nearest hit beyond
-// target.z_near gives tri, range and render_frame's shading for this eye (shade_triangle). A
-// filled pixel whose ray hits no candidate keeps its triangle and range and is re-shaded with its
-// own ray direction (background stays background); a crack whose ray hits one becomes Filled
-// (source: the neighbour that supplied the triangle), else it stays a crack. Returns the number of
-// cracks resolved. `target` must be the camera `r` was reprojected into.
-size_t reshade(Reprojection& r, const Scene& scene, const Camera& target);
+// target.z_near gives tri, range and render_frame's shading for this eye (shade_triangle).
+//  - A crack whose ray hits a candidate becomes Filled (source: the neighbour that supplied the
+//    triangle); else it stays a crack.
+//  - A filled pixel whose ray hits no candidate, its own triangle included, shows a surface the
+//    splat got wrong (a sample rounded across a silhouette or into a newly visible face): it
+//    becomes a Disocclusion hole (source kNoSource, hole colour) for the patcher. Background
+//    pixels whose ray hits no candidate stay background.
+// `target` must be the camera `r` was reprojected into. Thread-safe, deterministic.
+struct ReshadeStats {
+  size_t cracks_resolved = 0;  // cracks that became Filled
+  size_t unresolved = 0;       // filled pixels that became holes
+};
+ReshadeStats reshade(Reprojection& r, const Scene& scene, const Camera& target);
 
 // An RGB picture of the hole mask over a darkened frame: Filled pixels at 30% of frame.rgb,
 // Disocclusion red (255, 0, 0), Crack yellow (255, 255, 0), OutsideView blue (0, 96, 255).
