@@ -137,7 +137,7 @@ void write_sample(Reprojection& r, const Frame& src, size_t p, uint32_t s, float
 
 // Crack / outside / disocclusion for every hole of `r` (see stereo.h); `vdepth` is the target view
 // depth per pixel (inf at background and holes).
-void classify_holes(Reprojection& r, const std::vector<double>& vdepth, const Frame& src,
+void classify_holes(Reprojection& r, const std::vector<float>& vdepth, const Frame& src,
                     const Camera& sc, const Camera& tc) {
   const int w = r.width, h = r.height;
   const Basis sb = basis(sc), tb = basis(tc);
@@ -148,7 +148,7 @@ void classify_holes(Reprojection& r, const std::vector<double>& vdepth, const Fr
     const long sa = long(r.source[a]), sbi = long(r.source[b]);
     const long ax = sa % src.width, ay = sa / src.width, bx = sbi % src.width, by = sbi / src.width;
     if (std::max(std::labs(ax - bx), std::labs(ay - by)) > kStereoCrackSourceSpan) return false;
-    const double da = vdepth[a], db = vdepth[b];
+    const double da = double(vdepth[a]), db = double(vdepth[b]);
     if (std::isinf(da) || std::isinf(db)) return std::isinf(da) && std::isinf(db);
     return std::max(da, db) <= kStereoSurfaceDepthRatio * std::min(da, db);
   };
@@ -165,7 +165,7 @@ void classify_holes(Reprojection& r, const std::vector<double>& vdepth, const Fr
     }
     return !p || !inside(sc, p->x, p->y);
   };
-  std::vector<HoleKind> kind(r.hole);
+  std::vector<HoleKind>& kind = r.hole;  // classification reads r.source and r.depth only
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
     std::vector<int> left(static_cast<size_t>(w)), right(static_cast<size_t>(w));
     for (int y = rows.begin(); y != rows.end(); ++y) {
@@ -214,45 +214,58 @@ void classify_holes(Reprojection& r, const std::vector<double>& vdepth, const Fr
       }
     }
   });
-  r.hole = std::move(kind);
 }
 
 Reprojection reproject_exact(const Frame& src, const Camera& sc, const Camera& tc) {
   const Basis sb = basis(sc), tb = basis(tc);
   const size_t n = src.pixel_count();
-  std::vector<Landing> landing(n);
-  tbb::parallel_for(
-      tbb::blocked_range<int>(0, src.height), [&](const tbb::blocked_range<int>& rows) {
-        for (int y = rows.begin(); y != rows.end(); ++y)
-          for (int x = 0; x < src.width; ++x)
-            landing[size_t(y) * size_t(src.width) + size_t(x)] = land(src, sc, sb, tc, tb, x, y);
-      });
+  // Where each source sample lands (slot i): target pixel and target view depth (float: only
+  // compared, ties go to the smaller source index).
+  std::vector<uint32_t> target(n);
+  std::vector<float> depth(n);
+  tbb::parallel_for(tbb::blocked_range<int>(0, src.height),
+                    [&](const tbb::blocked_range<int>& rows) {
+                      for (int y = rows.begin(); y != rows.end(); ++y)
+                        for (int x = 0; x < src.width; ++x) {
+                          const size_t i = size_t(y) * size_t(src.width) + size_t(x);
+                          const Landing l = land(src, sc, sb, tc, tb, x, y);
+                          target[i] = l.target;
+                          depth[i] = float(l.view_depth);
+                        }
+                    });
   // Bucket the samples by target row, in source order (a sequential counting sort).
   const size_t tw = size_t(tc.width);
-  std::vector<size_t> start(size_t(tc.height) + 1, 0);
-  for (const Landing& l : landing)
-    if (l.target != kNoSource) ++start[l.target / tw + 1];
+  std::vector<uint32_t> start(size_t(tc.height) + 1, 0);
+  for (uint32_t t : target)
+    if (t != kNoSource) ++start[t / tw + 1];
   for (size_t y = 0; y < size_t(tc.height); ++y) start[y + 1] += start[y];
   std::vector<uint32_t> order(start.back());
   {
-    std::vector<size_t> fill(start.begin(), start.end() - 1);
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
     for (size_t i = 0; i < n; ++i)
-      if (landing[i].target != kNoSource) order[fill[landing[i].target / tw]++] = uint32_t(i);
+      if (target[i] != kNoSource) order[fill[target[i] / tw]++] = uint32_t(i);
   }
   Reprojection r = empty_reprojection(tc.width, tc.height);
-  std::vector<double> vdepth(r.pixel_count(), kInf);
+  std::vector<float> vdepth(r.pixel_count(), std::numeric_limits<float>::infinity());
   tbb::parallel_for(tbb::blocked_range<int>(0, tc.height),
                     [&](const tbb::blocked_range<int>& rows) {
-                      for (int y = rows.begin(); y != rows.end(); ++y)
-                        for (size_t k = start[size_t(y)]; k < start[size_t(y) + 1]; ++k) {
+                      for (int y = rows.begin(); y != rows.end(); ++y) {
+                        for (uint32_t k = start[size_t(y)]; k < start[size_t(y) + 1]; ++k) {
                           const uint32_t s = order[k];
-                          const Landing& l = landing[s];
-                          const size_t p = l.target;
+                          const size_t p = target[s];
                           // Nearest wins; on equal depth the earlier (smaller) source index stays.
-                          if (r.source[p] != kNoSource && !(l.view_depth < vdepth[p])) continue;
-                          vdepth[p] = l.view_depth;
+                          if (r.source[p] != kNoSource && !(depth[s] < vdepth[p])) continue;
+                          vdepth[p] = depth[s];
+                          r.source[p] = s;
+                        }
+                        for (size_t p = size_t(y) * tw; p < size_t(y + 1) * tw; ++p) {
+                          const uint32_t s = r.source[p];
+                          if (s == kNoSource) continue;
+                          const Landing l = land(src, sc, sb, tc, tb, int(s % uint32_t(src.width)),
+                                                 int(s / uint32_t(src.width)));
                           write_sample(r, src, p, s, l.range);
                         }
+                      }
                     });
   classify_holes(r, vdepth, src, sc, tc);
   return r;
@@ -281,7 +294,7 @@ Reprojection reproject_alg2(const Frame& src, const Camera& sc, const Camera& tc
   const bool mirror = dot(offset, sb.r) > 0;
   const int w = sc.width;
   Reprojection r = empty_reprojection(tc.width, tc.height);
-  std::vector<double> vdepth(r.pixel_count(), kInf);
+  std::vector<float> vdepth(r.pixel_count(), std::numeric_limits<float>::infinity());
   tbb::parallel_for(
       tbb::blocked_range<int>(0, sc.height), [&](const tbb::blocked_range<int>& rows) {
         // S-hat of the row: (x0 or source column, reversed depth d, width w); w == 0 = a sample.
@@ -316,7 +329,7 @@ Reprojection reproject_alg2(const Frame& src, const Camera& sc, const Camera& tc
             const uint32_t s = uint32_t(size_t(y) * size_t(w) + size_t(xs));
             const Landing l = land(src, sc, sb, tc, tb, xs, y);
             const size_t p = size_t(y) * size_t(w) + size_t(xt);
-            vdepth[p] = l.view_depth;
+            vdepth[p] = float(l.view_depth);
             write_sample(r, src, p, s, l.range);
           }
         }
