@@ -243,6 +243,14 @@ TEST(StereoReproject, ThinPoleLeavesFarFewerHolesThanAlg2AsPrinted) {
   EXPECT_LE(std::abs(he - oracle_row), 1);
   EXPECT_GE(h2, 2 * he);
   EXPECT_GE(poisoned, h2 - oracle_row - 1);
+  // The mirror image (left eye rendered, pixels move to -x, the scan runs right to left).
+  Frame source_l = render_frame(s, rt, eyes.left);
+  Reprojection exact_l = reproject(source_l, eyes.left, eyes.right);
+  Reprojection alg2_l = reproject(source_l, eyes.left, eyes.right, Splatting::Alg2AsPrinted);
+  const int he_l = row_holes(exact_l.hole), h2_l = row_holes(alg2_l.hole);
+  std::printf("mirrored: exact %d, Alg. 2 as printed %d\n", he_l, h2_l);
+  EXPECT_LE(std::abs(he_l - he), 2);
+  EXPECT_GE(h2_l, 2 * he_l);
   // Where both fill a pixel, they agree (the defect is the poisoning, not the positions).
   for (size_t p = 0; p < exact.pixel_count(); ++p)
     if (exact.hole[p] == HoleKind::Filled && alg2.hole[p] == HoleKind::Filled) {
