@@ -13,10 +13,10 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
-#include "vislib/bake.h"
-#include "vislib/error.h"
-#include "vislib/file_util.h"
-#include "vislib/view_cells.h"
+#include "vislib/bake/bake.h"
+#include "vislib/base/error.h"
+#include "vislib/base/file_util.h"
+#include "vislib/bake/view_cells.h"
 
 namespace pvs_cli {
 namespace {

@@ -1,5 +1,5 @@
 // pvs bench: from-segment against from-point visibility on one view region, with frame quality
-// (vislib/benchmark_compare.h). Writes CSV, JSON, frames and (through bench/plot_bench.py and
+// (vislib/eval/benchmark_compare.h). Writes CSV, JSON, frames and (through bench/plot_bench.py and
 // matplotlib) PNG plots into --out. docs/bench.md describes every file and key.
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -17,9 +17,9 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
-#include "vislib/benchmark_compare.h"
-#include "vislib/file_util.h"
-#include "vislib/image_io.h"
+#include "vislib/eval/benchmark_compare.h"
+#include "vislib/base/file_util.h"
+#include "vislib/eval/image_io.h"
 
 namespace pvs_cli {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
-#include "vislib/file_util.h"
+#include "vislib/base/file_util.h"
 
 namespace pvs_cli {
 namespace {

@@ -1,9 +1,9 @@
-// pvs info SCENE [--json] [--states K]: scene statistics and hygiene report (vislib/scene_info.h).
+// pvs info SCENE [--json] [--states K]: scene statistics and hygiene report (vislib/scene/scene_info.h).
 #include <cstdio>
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
-#include "vislib/scene_info.h"
+#include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
 namespace {

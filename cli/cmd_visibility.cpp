@@ -10,9 +10,9 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
-#include "vislib/file_util.h"
-#include "vislib/import.h"
-#include "vislib/region_visibility.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/import.h"
+#include "vislib/kernel/region_visibility.h"
 
 namespace pvs_cli {
 namespace {

@@ -6,7 +6,7 @@
 #include <sstream>
 
 #include "cli/commands.h"
-#include "vislib/error.h"
+#include "vislib/base/error.h"
 
 namespace pvs_cli {
 

@@ -11,11 +11,11 @@
 
 #include "tests/scene_builders.h"
 #include "tests/test_support.h"
-#include "vislib/embree_scene.h"
-#include "vislib/generate.h"
-#include "vislib/import.h"
-#include "vislib/ray_oracle.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/scene/generate.h"
+#include "vislib/scene/import.h"
+#include "tests/support/ray_oracle.h"
+#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 

@@ -7,10 +7,10 @@
 #include <cmath>
 
 #include "tests/scene_builders.h"
-#include "vislib/footprint.h"
-#include "vislib/polynomial.h"
-#include "vislib/ray_oracle.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/kernel/footprint.h"
+#include "vislib/base/polynomial.h"
+#include "tests/support/ray_oracle.h"
+#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 using vislib_test::soup;

@@ -6,8 +6,8 @@
 #include <numeric>
 
 #include "tests/scene_builders.h"
-#include "vislib/region_visibility.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 using vislib_test::random_soup;
