@@ -14,9 +14,9 @@
 
 #include "cli/commands.h"
 #include "pvs_format/pvs_format.h"
-#include "vislib/error.h"
-#include "vislib/image_io.h"
-#include "vislib/metrics.h"
+#include "vislib/base/error.h"
+#include "vislib/eval/image_io.h"
+#include "vislib/eval/metrics.h"
 #include "vislib/render/stereo.h"
 
 namespace pvs_cli {

@@ -8,9 +8,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "vislib/embree_scene.h"
-#include "vislib/render.h"
-#include "vislib/scene.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/eval/render.h"
+#include "vislib/scene/scene.h"
 
 namespace pvs_cli {
 

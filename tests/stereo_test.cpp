@@ -15,9 +15,9 @@
 
 #include "tests/scene_builders.h"
 #include "tests/test_support.h"
-#include "vislib/generate.h"
-#include "vislib/metrics.h"
-#include "vislib/render.h"
+#include "vislib/eval/metrics.h"
+#include "vislib/eval/render.h"
+#include "vislib/scene/generate.h"
 
 using namespace vislib;
 using vislib_test::add_quad;
