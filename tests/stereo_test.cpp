@@ -494,7 +494,9 @@ TEST(StereoSweep, IpdAndObjectDistance) {
       if (std::fabs(ipd - 0.065) < 1e-9) share_65 = share;
       EXPECT_GE(q.ssim, 0.95);
       EXPECT_GE(q.psnr, 30.0);
-      if (ipd > 0.0749) EXPECT_GT(share, first_share);  // 7.5 cm leaves more holes than 5 cm
+      if (ipd > 0.0749) {
+        EXPECT_GT(share, first_share);  // 7.5 cm leaves more holes than 5 cm
+      }
     }
     EXPECT_LT(share_65, prev_distance_share);  // farther object, fewer holes (at 6.5 cm)
     prev_distance_share = share_65;
