@@ -513,7 +513,7 @@ TEST(StereoCli, ViewStereoWritesThePairTheHoleMaskAndTheJsonBlock) {
   ASSERT_EQ(vislib_test::run_pvs("generate city --blocks 2,2 -o " + city, &out), 0) << out;
   ASSERT_EQ(vislib_test::run_pvs(
                 "bake " + city +
-                    " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 -o " + pvs,
+                    " --box -60,0,-60,60,3,60 --grid 2,1,1 --res 24 -o " + pvs,
                 &out),
             0)
       << out;
