@@ -207,9 +207,14 @@ pvs_rt_status pvs_rt_scene_fingerprint(const pvs_rt_mesh* meshes, size_t mesh_co
                   where + "give exactly one of positions_f32 and positions_f64");
     if (mesh.triangle_count && !mesh.indices)
       return fail(PVS_RT_INVALID_ARGUMENT, where + "indices is null");
-    if (mesh.triangle_count && mesh.object_id >= object_count)
-      return fail(PVS_RT_INVALID_ARGUMENT, where + "object_id " + std::to_string(mesh.object_id) +
-                                               " >= object_count " + std::to_string(object_count));
+    for (size_t t = 0; t < mesh.triangle_count; ++t) {
+      const uint32_t ob = mesh.triangle_objects ? mesh.triangle_objects[t] : mesh.object_id;
+      if (ob >= object_count)
+        return fail(PVS_RT_INVALID_ARGUMENT,
+                    where + "object " + std::to_string(ob) + " of triangle " + std::to_string(t) +
+                        " >= object_count " + std::to_string(object_count));
+      if (!mesh.triangle_objects) break;
+    }
     for (size_t i = 0; i < 3 * mesh.triangle_count; ++i)
       if (mesh.indices[i] >= mesh.vertex_count)
         return fail(PVS_RT_INVALID_ARGUMENT, where + "index " + std::to_string(mesh.indices[i]) +
@@ -254,7 +259,7 @@ pvs_rt_status pvs_rt_scene_fingerprint(const pvs_rt_mesh* meshes, size_t mesh_co
       const pvs_rt_mesh& mesh = meshes[m];
       for (size_t t = 0; t < mesh.triangle_count; ++t) {
         for (int k = 0; k < 3; ++k) put_u32(buf, offset + mesh.indices[3 * t + k]);
-        put_u32(buf, mesh.object_id);
+        put_u32(buf, mesh.triangle_objects ? mesh.triangle_objects[t] : mesh.object_id);
         flush(false);
       }
       offset += uint32_t(mesh.vertex_count);

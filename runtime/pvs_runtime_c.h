@@ -115,7 +115,7 @@ PVS_RT_API const char* pvs_rt_version_string(void);
  * (positions_f32) or double ones (positions_f64), not both; vislib's importers read glTF floats,
  * which convert to double exactly, so float buffers reproduce the bake's fingerprint. Triangles:
  * triangle_count triples of indices local to this mesh (each < vertex_count), all of object
- * object_id. */
+ * object_id, or, if triangle_objects is not NULL, of object triangle_objects[t] each. */
 typedef struct pvs_rt_mesh {
   const float* positions_f32;
   const double* positions_f64;
@@ -123,6 +123,7 @@ typedef struct pvs_rt_mesh {
   const uint32_t* indices;
   size_t triangle_count;
   uint32_t object_id;
+  const uint32_t* triangle_objects;
 } pvs_rt_mesh;
 
 /* The scene fingerprint a PVS file stores (docs/pvs-format.md, "The scene fingerprint"), of the
