@@ -44,11 +44,14 @@ json growth_json(const vislib::GrowthRun& g) {
                  {"radius", s.radius},
                  {"ssim_to_truth", s.ssim_to_truth}};
     if (s.ssim_to_previous) step["ssim_to_previous"] = *s.ssim_to_previous;
+    if (s.whole_ssim_to_previous) step["whole_ssim_to_previous"] = *s.whole_ssim_to_previous;
     steps.push_back(step);
   }
   return json{{"radii", g.radii},
               {"min_consecutive_ssim",
                g.min_consecutive_ssim ? json(*g.min_consecutive_ssim) : json(nullptr)},
+              {"min_consecutive_whole_ssim",
+               g.min_consecutive_whole_ssim ? json(*g.min_consecutive_whole_ssim) : json(nullptr)},
               {"frames", g.steps.size()},
               {"steps", steps}};
 }
@@ -78,9 +81,12 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
     for (const char* k : {"merged", "equal_area"}) {
       const json& g = j["continuity"][k];
       if (g["min_consecutive_ssim"].is_null()) continue;
-      std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
-                   g["radii"].size(), g["frames"].get<size_t>(),
-                   g["min_consecutive_ssim"].get<double>());
+      std::fprintf(stderr,
+                   "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f (whole "
+                   "image %.4f)\n",
+                   k, g["radii"].size(), g["frames"].get<size_t>(),
+                   g["min_consecutive_ssim"].get<double>(),
+                   g["min_consecutive_whole_ssim"].get<double>());
     }
 }
 
