@@ -112,8 +112,9 @@ PVS_RT_API const char* pvs_rt_version_string(void);
 /* One mesh of the engine's scene, as the engine holds it (docs/runtime.md, "Binding a PVS to the
  * assets"). Vertices: vertex_count of them per key state, state-major: state s, vertex v at
  * positions[3 * (s * vertex_count + v)] (x, y, z; y up, scene units). Give either float positions
- * (positions_f32) or double ones (positions_f64), not both; vislib's importers read glTF floats,
- * which convert to double exactly, so float buffers reproduce the bake's fingerprint. Triangles:
+ * (positions_f32) or double ones (positions_f64), not both. They are the world-space positions
+ * vislib hashes (glTF node transforms applied in double): float buffers reproduce the bake's
+ * fingerprint only where those are float-exact (docs/runtime.md, "Binding a PVS"). Triangles:
  * triangle_count triples of indices local to this mesh (each < vertex_count), all of object
  * object_id, or, if triangle_objects is not NULL, of object triangle_objects[t] each. */
 typedef struct pvs_rt_mesh {

@@ -16,10 +16,10 @@
 
 namespace {
 
-// One pvs_rt_mesh per id-map run, with float positions (as an engine's vertex buffer holds them)
-// and indices local to the run's vertex block, all key states.
+// One pvs_rt_mesh per id-map run, with the world-space positions (node transforms applied, in
+// double, as vislib's importer does) and indices local to the run's vertex block, all key states.
 struct EngineBuffers {
-  std::vector<std::vector<float>> positions;
+  std::vector<std::vector<double>> positions;
   std::vector<std::vector<uint32_t>> indices;
   std::vector<pvs_rt_mesh> meshes;
 };
@@ -27,12 +27,11 @@ struct EngineBuffers {
 EngineBuffers engine_buffers(const vislib::Scene& scene, const vislib::IdMap& map) {
   EngineBuffers b;
   for (const vislib::IdRun& run : map.runs) {
-    std::vector<float> pos;
+    std::vector<double> pos;
     for (const auto& state : scene.positions)
       for (uint32_t v = run.first_vertex; v < run.first_vertex + run.vertex_count; ++v) {
         const vislib::Vec3 p = state[v];
-        EXPECT_EQ(double(float(p.x)), p.x);  // glTF stores floats: the buffers are exact
-        pos.insert(pos.end(), {float(p.x), float(p.y), float(p.z)});
+        pos.insert(pos.end(), {p.x, p.y, p.z});
       }
     std::vector<uint32_t> idx;
     for (uint32_t t = run.first_triangle; t < run.first_triangle + run.triangle_count; ++t)
@@ -41,7 +40,7 @@ EngineBuffers engine_buffers(const vislib::Scene& scene, const vislib::IdMap& ma
     b.indices.push_back(std::move(idx));
   }
   for (size_t m = 0; m < map.runs.size(); ++m)
-    b.meshes.push_back({b.positions[m].data(), nullptr, map.runs[m].vertex_count,
+    b.meshes.push_back({nullptr, b.positions[m].data(), map.runs[m].vertex_count,
                         b.indices[m].data(), map.runs[m].triangle_count, map.runs[m].object,
                         nullptr});
   return b;
@@ -62,8 +61,8 @@ TEST(FingerprintCApi, EnginesMeshBuffersGiveTheBakesFingerprintForTheCity) {
       PVS_RT_OK)
       << pvs_rt_last_error();
   EXPECT_EQ(fp, vislib::scene_fingerprint(scene));
-  // One float of one vertex off by one ulp: another asset, another fingerprint.
-  b.positions[3][4] = std::nextafter(b.positions[3][4], 1e9f);
+  // One coordinate of one vertex off by one ulp: another asset, another fingerprint.
+  b.positions[3][4] = std::nextafter(b.positions[3][4], 1e9);
   uint64_t moved = 0;
   ASSERT_EQ(pvs_rt_scene_fingerprint(b.meshes.data(), b.meshes.size(), 1,
                                      uint32_t(scene.objects.size()), &moved),
