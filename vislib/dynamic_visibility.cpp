@@ -40,6 +40,13 @@ double GeneralDepth::at(double t) const {
   return h < 0 ? m / (-h + sq) : (-h - sq) / dd;  // stable form of the near root (§4)
 }
 
+bool same_depth(const GeneralDepth& a, const GeneralDepth& b) {
+  if (a.kind != b.kind) return false;
+  for (int k = 0; k < 16; ++k)
+    if (a.c[k] != b.c[k]) return false;
+  return true;
+}
+
 int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi, double* out) {
   if (i.kind == GeneralDepth::Rational && j.kind == GeneralDepth::Rational) {
     // sign(lambda_i - lambda_j) = sign(P) sign(D_i D_j), P = N_i D_j - N_j D_i (deg <= 5).

@@ -11,7 +11,13 @@
 // (view depth lambda at t) and a free function
 //   int depth_crossings(const D& lower_id, const D& higher_id, double lo, double hi, double* out)
 // writing the ascending crossing times strictly inside (lo, hi) (at most kMaxCrossings) computed
-// with the pair in id order, so that the result does not depend on which one is being inserted.
+// with the pair in id order, so that the result does not depend on which one is being inserted,
+// and a free function `bool same_depth(const D&, const D&)`: true when two pieces of one primitive
+// follow the same depth function. Touching pieces are merged only when they have the same id AND
+// the same depth function: one primitive can own touching pieces on different surfaces (a
+// sphere's entry and exit roots when the eye enters it, math note §4), and a merged piece would
+// carry the first one's depth over both, so later insertions would be compared with the wrong
+// surface.
 #pragma once
 
 #include <algorithm>
@@ -34,6 +40,9 @@ struct LinearDepth {
   double at(double t) const { return (n0 - n1 * t) / dn; }
 };
 int depth_crossings(const LinearDepth& i, const LinearDepth& j, double lo, double hi, double* out);
+inline bool same_depth(const LinearDepth& a, const LinearDepth& b) {
+  return a.n0 == b.n0 && a.n1 == b.n1 && a.dn == b.dn;
+}
 
 template <class D>
 struct PieceT {
@@ -61,10 +70,16 @@ int crossings(const PieceT<D>& a, const PieceT<D>& b, double lo, double hi, doub
                      : depth_crossings(b.depth, a.depth, lo, hi, out);
 }
 
+// True when b continues a: same primitive, same depth function, touching (a before b).
+template <class D>
+bool continues(const PieceT<D>& a, const PieceT<D>& b) {
+  return a.id == b.id && a.t1 == b.t0 && same_depth(a.depth, b.depth);
+}
+
 template <class D>
 void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t1) {
   if (!(t0 < t1)) return;
-  if (!out.empty() && out.back().id == src.id && out.back().t1 == t0) {
+  if (!out.empty() && out.back().id == src.id && out.back().t1 == t0 && same_depth(out.back().depth, src.depth)) {
     out.back().t1 = t1;
     return;
   }
@@ -138,8 +153,8 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
     count = out.size();
   }
   // `push` merged inside the new range; merge across its two ends (higher index first).
-  auto merge_at = [&list](size_t k) {  // list[k] absorbs list[k+1] if same id and touching
-    if (k + 1 < list.size() && list[k].id == list[k + 1].id && list[k].t1 == list[k + 1].t0) {
+  auto merge_at = [&list](size_t k) {  // list[k] absorbs list[k+1] if it continues it
+    if (k + 1 < list.size() && detail::continues(list[k], list[k + 1])) {
       list[k].t1 = list[k + 1].t1;
       list.erase(list.begin() + k + 1);
     }
@@ -170,8 +185,8 @@ bool covers_segment(const std::vector<PieceT<D>>& list) {
 // Largest depth over all pieces of a list of linear depths (at the piece ends); -inf if empty.
 double farthest_depth(const PieceList& list);
 
-// Checks the invariants of §7 (sorted, disjoint, 0 <= t0 < t1 <= 1, touching same-id pieces
-// merged). For tests and debug builds.
+// Checks the invariants of §7 (sorted, disjoint, 0 <= t0 < t1 <= 1, touching pieces with the same
+// id and the same depth function merged). For tests and debug builds.
 template <class D>
 bool is_valid(const std::vector<PieceT<D>>& list) {
   for (size_t k = 0; k < list.size(); ++k) {
@@ -179,7 +194,7 @@ bool is_valid(const std::vector<PieceT<D>>& list) {
     if (!(0.0 <= p.t0 && p.t0 < p.t1 && p.t1 <= 1.0)) return false;
     if (k > 0) {
       if (list[k - 1].t1 > p.t0) return false;
-      if (list[k - 1].t1 == p.t0 && list[k - 1].id == p.id) return false;
+      if (detail::continues(list[k - 1], p)) return false;
     }
   }
   return true;
