@@ -30,6 +30,8 @@ struct VisibilityArgs {
   int states = 1;
   std::string granularity = "triangle";
   std::string mode = "diagonal";
+  std::string coplanar = "both";
+  double eps_z = vislib::kDefaultEpsZ;
   std::string json_out;
 };
 
@@ -59,6 +61,19 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
                   "frozen at each state while the eye moves)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))
       ->capture_default_str();
+  cmd->add_option(
+         "--coplanar", a.coplanar,
+         "Depth ties (coplanar or near-coplanar overlaps): 'both' = surfaces within --eps-z of the "
+         "front depth are visible too (a z-buffer z-fights there); 'first' = the old rule, the "
+         "nearer surface wins and exact ties go to the lower id")
+      ->check(CLI::IsMember({"both", "first"}))
+      ->capture_default_str();
+  cmd->add_option(
+         "--eps-z", a.eps_z,
+         "Depth tie tolerance with --coplanar both, relative to the front depth (unitless: 1e-6 = "
+         "1 um at 1 m)")
+      ->check(CLI::Range(0.0, 0.1))
+      ->capture_default_str();
   cmd->add_option("--json", a.json_out, "Write the result as JSON to this file ('-' = stdout)")->required();
 }
 
@@ -69,6 +84,8 @@ vislib::SegmentOptions segment_options(const VisibilityArgs& a) {
   o.eps_len = a.eps_len;
   o.tile_size = a.tile;
   o.mode = a.mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
+  o.coplanar = a.coplanar == "first" ? vislib::CoplanarRule::First : vislib::CoplanarRule::Both;
+  o.eps_z = a.eps_z;
   return o;
 }
 
@@ -80,6 +97,15 @@ double peak_rss_bytes() {
 
 json vec_json(vislib::Vec3 v) { return json::array({v.x, v.y, v.z}); }
 json mat_json(const vislib::Mat3& m) { return json(std::vector<double>(m.m, m.m + 9)); }
+
+json witness_json(const vislib::Witness& x) {
+  return {{x.is_sphere ? "sphere" : "tri", x.tri},
+          {"face", x.face},
+          {"x", x.x},
+          {"y", x.y},
+          {"t", x.t},
+          {"tau", x.tau}};
+}
 
 json counts_json(const vislib::SegmentStats& s) {
   return {{"triangle_pixel_pairs", s.pair_tests},
@@ -160,14 +186,14 @@ void add_segment(CLI::App& app) {
               {"orientation", mat_json(so.orientation)},
               {"granularity", a->granularity},
               {"mode", a->mode},
+              {"coplanar", a->coplanar},
+              {"eps_z", so.eps_z},
               {"states", scene.state_count()},
               {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
               {"visible_spheres", r.visible_spheres},
               {"visible_triangles", r.visible.size()}};
     json w = json::array();
-    for (const auto& x : r.witnesses)
-      w.push_back({{x.is_sphere ? "sphere" : "tri", x.tri}, {"face", x.face}, {"x", x.x}, {"y", x.y}, {"t", x.t},
-                   {"tau", x.tau}});
+    for (const auto& x : r.witnesses) w.push_back(witness_json(x));
     j["witnesses"] = w;
     j["timings"] = {{"load_seconds", load_s}, {"visibility_seconds", r.stats.seconds}};
     j["counts"] = counts_json(r.stats);
@@ -185,6 +211,7 @@ void add_region(CLI::App& app) {
   auto box = std::make_shared<std::string>();
   auto runs = std::make_shared<int>(1);
   auto seed = std::make_shared<uint64_t>(1);
+  auto witness = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "region",
       "Triangles visible from a view region: from-segment runs on the perimeter of a view "
@@ -195,6 +222,10 @@ void add_region(CLI::App& app) {
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--seed", *seed, "Seed of the random orientations")->capture_default_str();
+  cmd->add_flag(
+      "--witness", *witness,
+      "Add one witness per id of the union: the perimeter segment and run that saw it, and its "
+      "(face, x, y, t, tau) in that run");
   cmd->callback([=] {
     auto limit = thread_limit(a->threads);
     auto b = parse_doubles(*box, "--box", 6);
@@ -203,6 +234,7 @@ void add_region(CLI::App& app) {
     region.extend({b[3], b[4], b[5]});
     vislib::RegionOptions ro;
     ro.segment = segment_options(*a);
+    ro.segment.want_witnesses = *witness;
     ro.runs = *runs;
     ro.seed = *seed;
     double load_s;
@@ -228,22 +260,36 @@ void add_region(CLI::App& app) {
       }
       segs.push_back({{"from", vec_json(r.segments[s].from)}, {"to", vec_json(r.segments[s].to)}, {"runs", runs_j}});
     }
-    json j = {{"scene", a->scene},
-              {"resolution", ro.segment.resolution},
-              {"near", ro.segment.near},
-              {"eps_len", ro.segment.eps_len},
-              {"box", {{"min", vec_json(region.min)}, {"max", vec_json(region.max)}}},
-              {"runs", ro.runs},
-              {"seed", ro.seed},
-              {"granularity", a->granularity},
-              {"segments", segs},
-              {"mode", a->mode},
-              {"states", scene.state_count()},
-              {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
-              {"visible_spheres", r.visible_spheres},
-              {"visible_triangles", r.visible.size()},
-              {"timings", {{"load_seconds", load_s}, {"visibility_seconds", r.seconds}}},
-              {"counts", {{"scene_triangles", scene.triangle_count()}, {"peak_rss_bytes", peak_rss_bytes()}}}};
+    json j = {
+        {"scene", a->scene},
+        {"resolution", ro.segment.resolution},
+        {"near", ro.segment.near},
+        {"eps_len", ro.segment.eps_len},
+        {"box", {{"min", vec_json(region.min)}, {"max", vec_json(region.max)}}},
+        {"runs", ro.runs},
+        {"seed", ro.seed},
+        {"granularity", a->granularity},
+        {"segments", segs},
+        {"mode", a->mode},
+        {"coplanar", a->coplanar},
+        {"eps_z", ro.segment.eps_z},
+        {"states", scene.state_count()},
+        {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
+        {"visible_spheres", r.visible_spheres},
+        {"visible_triangles", r.visible.size()},
+        {"timings", {{"load_seconds", load_s}, {"visibility_seconds", r.seconds}}},
+        {"counts",
+         {{"scene_triangles", scene.triangle_count()}, {"peak_rss_bytes", peak_rss_bytes()}}}};
+    if (*witness) {
+      json w = json::array();
+      for (const auto& x : r.witnesses) {
+        json e = witness_json(x.witness);
+        e["segment"] = x.segment;
+        e["run"] = x.run;
+        w.push_back(e);
+      }
+      j["witnesses"] = w;
+    }
     write_json(a->json_out, j);
     std::fprintf(stderr, "pvs region: %zu of %zu triangles visible from %zu segments x %d runs (%.3f s)\n",
                  r.visible.size(), scene.triangle_count(), r.segments.size(), ro.runs, r.seconds);
