@@ -2,10 +2,10 @@
 // one cell's details (boundary segments, visible ids, share of the scene), and the scene reduced
 // to one cell's set as glTF.
 #include <algorithm>
-#include <map>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
@@ -18,6 +18,7 @@
 #include "vislib/image_io.h"
 #include "vislib/metrics.h"
 #include "vislib/render.h"
+#include "vislib/scene/id_universe.h"
 #include "vislib/scene_fingerprint.h"
 #include "vislib/scene_subset.h"
 #include "vislib/view_cells.h"
@@ -191,14 +192,12 @@ void print_summary(const std::string& path, const json& j) {
 json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids, vislib::Granularity g,
                  vislib::Vec3 eye, const std::string& dir, int width, int height) {
   std::filesystem::create_directories(dir);
-  std::vector<uint32_t> tris = ids;
-  if (g == vislib::Granularity::Object) {
-    std::vector<uint8_t> keep(scene.objects.size(), 0);
-    for (uint32_t o : ids) keep[o] = 1;
-    tris.clear();
-    for (uint32_t t = 0; t < scene.triangle_count(); ++t)
-      if (keep[scene.triangle_object[t]]) tris.push_back(t);
-  }
+  std::vector<uint32_t> tris =
+      vislib::primitives_of(
+          scene,
+          g == vislib::Granularity::Object ? pvs::Granularity::Object : pvs::Granularity::Triangle,
+          ids)
+          .triangles;
   std::vector<uint8_t> mask = vislib::triangle_mask(scene.triangle_count(), tris);
   vislib::EmbreeScene rt(scene, 0.0, eye);
   json views = json::array();
@@ -271,7 +270,7 @@ void add_inspect(CLI::App& app) {
       pvs::Reader r = pvs::Reader::from_file(a->file, opt);
       const pvs::FileInfo& info = r.info();
       if (!a->scene.empty()) {
-        size_t expect = info.granularity == pvs::Granularity::Object ? scene.objects.size() : scene.triangle_count();
+        uint32_t expect = vislib::id_universe(scene, info.granularity);  // the bake's id rule
         if (expect != info.universe)
           throw vislib::InputError(a->file, "universe " + std::to_string(info.universe) + " differs from the scene's " + std::to_string(expect));
       }

@@ -20,6 +20,7 @@
 #include "vislib/metrics.h"
 #include "vislib/near_far_render.h"
 #include "vislib/render.h"
+#include "vislib/scene/id_universe.h"
 #include "vislib/scene_fingerprint.h"
 
 namespace pvs_cli {
@@ -105,14 +106,17 @@ void add_view(CLI::App& app) {
     pvs::ReadOptions opt;
     opt.expected_fingerprint = vislib::scene_fingerprint(full_scene);
     std::vector<uint32_t> tris;
+    size_t visible_spheres = 0;
     uint32_t cell = 0;
     vislib::Vec3 centre;
     try {
       pvs::Reader r = pvs::Reader::from_file(a->file, opt);
       const pvs::FileInfo& info = r.info();
       const bool object = info.granularity == pvs::Granularity::Object;
-      if ((object ? full_scene.objects.size() : full_scene.triangle_count()) != info.universe)
-        throw vislib::InputError(a->file, "universe " + std::to_string(info.universe) + " differs from the scene's");
+      if (vislib::id_universe(full_scene, info.granularity) != info.universe)  // the bake's id rule
+        throw vislib::InputError(
+            a->file, "universe " + std::to_string(info.universe) + " differs from the scene's " +
+                         std::to_string(vislib::id_universe(full_scene, info.granularity)));
       double q[3] = {eye.x, eye.y, eye.z};
       std::optional<uint32_t> c = info.layout.find_cell(q);
       if (!c) {
@@ -125,14 +129,11 @@ void add_view(CLI::App& app) {
         throw Exit{2};
       }
       std::vector<uint32_t> ids = r.read_cell(cell);
-      if (object) {
-        std::vector<uint8_t> keep(full_scene.objects.size(), 0);
-        for (uint32_t o : ids) keep[o] = 1;
-        for (uint32_t t = 0; t < full_scene.triangle_count(); ++t)
-          if (keep[full_scene.triangle_object[t]]) tris.push_back(t);
-      } else {
-        tris = ids;
-      }
+      // Triangles drawn by the near-far renderer; sphere ids (triangle granularity) and the
+      // spheres of visible objects are counted, not drawn (the renderer draws triangles).
+      vislib::Primitives prims = vislib::primitives_of(full_scene, info.granularity, ids);
+      tris = std::move(prims.triangles);
+      visible_spheres = prims.spheres.size();
       pvs::Box region = info.layout.view_region(cell);
       centre = {(region.min[0] + region.max[0]) / 2, (region.min[1] + region.max[1]) / 2,
                 (region.min[2] + region.max[2]) / 2};
@@ -193,6 +194,7 @@ void add_view(CLI::App& app) {
                       {"intermediate", rc.intermediate}, {"far", rc.far}, {"env_map", rc.env_map},
                       {"moving_in_scene", size_t(std::count(moving.begin(), moving.end(), uint8_t(1)))},
                       {"far_dynamic_drawn", rc.far_dynamic}, {"far_dynamic_shown", rc.far_dynamic_shown}};
+    j["spheres"] = {{"scene", full_scene.sphere_count()}, {"visible", visible_spheres}};
     j["without_morph"] = quality_json(scene, truth, unmorphed);
     // Baseline: the cell's visible set rendered from geometry, no near-far partition.
     vislib::Frame pvs_frame = vislib::render_frame(scene, rt, cam, vislib::triangle_mask(scene.triangle_count(), tris).data());
