@@ -3,12 +3,13 @@
 #include <cstdio>
 
 #include "cli/commands.h"
-#include "vislib/scene_info.h"
+#include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
 
 vislib::Scene load_scene_for_cli(const std::string& path, int states) {
-  if (states < 1) throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
+  if (states < 1)
+    throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
   vislib::LoadOptions options;
   options.states = states;
   std::vector<std::string> warnings;
