@@ -275,7 +275,6 @@ TEST(CliBake, SphereAndMixedScenesBakeInspectAndViewWithOneIdUniverse) {
     size_t brace = out.find('{');
     ASSERT_NE(brace, std::string::npos) << out;
     json v = json::parse(out.substr(brace));
-    EXPECT_EQ(v["spheres"]["scene"], 40);
     EXPECT_EQ(v["triangles"]["scene"], tris);
   }
 }
