@@ -246,13 +246,13 @@ Scene coplanar_rooms(uint64_t seed) {
   Rng rng(seed);
   Scene s;
   auto wall = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
-    add_quad(s, a, b, c, d);
-    add_quad(s, b, c, d, a);       // the same wall, the other diagonal
+    vislib_test::add_quad(s, a, b, c, d);
+    vislib_test::add_quad(s, b, c, d, a);       // the same wall, the other diagonal
     for (int k = 0; k < 4; ++k) {  // decals
       double u0 = rng.uniform(0, 0.8), w0 = rng.uniform(0, 0.8), du = rng.uniform(0.05, 0.2),
              dw = rng.uniform(0.05, 0.2);
       auto at = [&](double u, double w) { return a + (b - a) * u + (d - a) * w; };
-      add_quad(s, at(u0, w0), at(u0 + du, w0), at(u0 + du, w0 + dw), at(u0, w0 + dw));
+      vislib_test::add_quad(s, at(u0, w0), at(u0 + du, w0), at(u0 + du, w0 + dw), at(u0, w0 + dw));
     }
   };
   for (int room = 0; room < 3; ++room) {
@@ -263,7 +263,7 @@ Scene coplanar_rooms(uint64_t seed) {
     wall({x1, y0, z0}, {x1, y0, z1}, {x1, y1, z1}, {x1, y1, z0});
     for (int k = 0; k < 3; ++k) {  // overlapping floor tiles
       double a = x0 + rng.uniform(0, 3), b = z0 + rng.uniform(0, 3);
-      add_quad(s, {a, y0, b}, {a, y0, b + 3}, {a + 3, y0, b + 3}, {a + 3, y0, b});
+      vislib_test::add_quad(s, {a, y0, b}, {a, y0, b + 3}, {a + 3, y0, b + 3}, {a + 3, y0, b});
     }
   }
   Scene clutter = random_soup(150, seed + 1, 10, 0.6);
