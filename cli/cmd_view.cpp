@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "cli/cmd_view_ods.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "pvs_format/pvs_format.h"
@@ -62,7 +63,7 @@ void add_view(CLI::App& app) {
   cmd->add_option("PVS", a->file, "PVS file")->required();
   cmd->add_option("--scene", a->scene, "The scene the PVS was baked for (checked by its fingerprint)")->required();
   cmd->add_option("--at", a->at, "User eye x,y,z (its cell's visible set is used)")->required();
-  cmd->add_option("--look", a->look, "Point x,y,z the user looks at")->required();
+  cmd->add_option("--look", a->look, "Point x,y,z the user looks at (required without --ods)");
   cmd->add_option("--near-far", a->near_far, "Radii r1,r2 of the cylinders about the centre (scene units)")
       ->capture_default_str();
   cmd->add_option("--centre", a->centre, "Centre O x,y,z of the cylinders and environment map (default: the "
@@ -91,7 +92,12 @@ void add_view(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Near-far frame (.png); <out>_truth.png, <out>_heat.png and "
                                             "<out>_nomorph.png are written next to it")->required();
   cmd->add_option("--json", a->json_path, "Write the metrics as JSON ('-' = stdout)");
-  cmd->callback([a] {
+  auto ods = std::make_shared<OdsViewArgs>();
+  add_ods_view_options(cmd, ods);
+  cmd->callback([a, ods] {
+    if (ods->enabled)
+      return run_view_ods(*ods, {a->file, a->scene, a->at, a->output, a->json_path, a->states, a->tau});
+    if (a->look.empty()) throw CLI::ValidationError("--look", "is required (except with --ods)");
     int fw = 0, fh = 0;
     if (std::sscanf(a->frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 || fh > 8192)
       throw CLI::ValidationError("--frame", "expected WxH with 11 <= W, H <= 8192, got '" + a->frame + "'");

@@ -307,4 +307,18 @@ std::vector<ProjTriangle> split_seam_pole(const std::array<ProjVertex, 3>& v, in
   return out;
 }
 
+bool disc_inside_box(const Point3& c, double radius, const double lo[3], const double hi[3]) {
+  assert(radius >= 0);
+  return c.y >= lo[1] && c.y <= hi[1] && c.x - radius >= lo[0] && c.x + radius <= hi[0] &&
+         c.z - radius >= lo[2] && c.z + radius <= hi[2];
+}
+
+bool disc_touches_box(const Point3& c, double radius, const double lo[3], const double hi[3]) {
+  assert(radius >= 0);
+  if (c.y < lo[1] || c.y > hi[1]) return false;
+  const double dx = std::max({lo[0] - c.x, 0.0, c.x - hi[0]});
+  const double dz = std::max({lo[2] - c.z, 0.0, c.z - hi[2]});
+  return dx * dx + dz * dz <= radius * radius;
+}
+
 }  // namespace pvs_runtime

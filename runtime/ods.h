@@ -209,4 +209,14 @@ struct ProjTriangle {
 std::vector<ProjTriangle> split_seam_pole(const std::array<ProjVertex, 3>& v, int pole,
                                           double pole_range);
 
+// ---- The viewing disc and the PVS cells (issue 14, deliverable 4) ---------------------------
+
+// The eyes of an ODS panorama centred at c lie on the horizontal disc of radius `radius` (IPD/2)
+// about c. A cell's visible set is valid for eyes in its view region (an axis-aligned box
+// [lo, hi], boundaries inclusive): the set alone is enough when the whole disc lies in the box;
+// else the union of the sets of every cell whose view region the disc touches (find them with
+// Pvs::neighbours(cell, radius), then this test). radius >= 0.
+bool disc_inside_box(const Point3& c, double radius, const double lo[3], const double hi[3]);
+bool disc_touches_box(const Point3& c, double radius, const double lo[3], const double hi[3]);
+
 }  // namespace pvs_runtime
