@@ -237,7 +237,7 @@ Frame render_ods_raster(const Scene& scene, const std::vector<uint32_t>& ids, co
     std::vector<ImgTri>().swap(v);
   }
   const int bands = (H + kBandRows - 1) / kBandRows;
-  std::vector<std::vector<uint32_t>> band_tris(size_t(bands));
+  std::vector<std::vector<uint32_t>> band_tris(static_cast<size_t>(bands));
   for (size_t i = 0; i < all.size(); ++i) {
     const ImgTri& t = all[i];
     const double vmin = std::min({t.v[0], t.v[1], t.v[2]}),
@@ -332,8 +332,8 @@ std::vector<BandDisagreement> lr_disagreement_by_latitude(const Frame& left, con
                                                           double band_degrees) {
   assert(left.width == right.width && left.height == right.height && band_degrees > 0);
   const int bands = int(std::ceil(180.0 / band_degrees - 1e-9));
-  std::vector<BandDisagreement> out(size_t(bands));
-  std::vector<double> mismatch(size_t(bands), 0), luma_sum(size_t(bands), 0);
+  std::vector<BandDisagreement> out(static_cast<size_t>(bands));
+  std::vector<double> mismatch(static_cast<size_t>(bands), 0.0), luma_sum(static_cast<size_t>(bands), 0.0);
   for (int b = 0; b < bands; ++b) {
     out[size_t(b)].lat_max_deg = 90.0 - b * band_degrees;
     out[size_t(b)].lat_min_deg = std::max(-90.0, 90.0 - (b + 1) * band_degrees);
