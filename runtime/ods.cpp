@@ -290,17 +290,24 @@ std::vector<ProjTriangle> split_seam_pole(const std::array<ProjVertex, 3>& v, in
       out.push_back(t);
     }
   };
+  // b placed relative to a: a's centre longitude, the short way to b's, then b's eye offset.
+  auto unwrap_from = [](const ProjVertex& a, ProjVertex b) {
+    const double a_centre = a.lon - wrap_longitude(a.lon - a.lon_centre);
+    b.lon = a_centre + wrap_longitude(b.lon_centre - a.lon_centre) +
+            wrap_longitude(b.lon - b.lon_centre);
+    return b;
+  };
   if (pole == 0) {
     ProjTriangle t{v};
-    for (int i = 1; i < 3; ++i) t.v[i].lon = v[0].lon + wrap_longitude(v[i].lon - v[0].lon);
+    for (int i = 1; i < 3; ++i) t.v[size_t(i)] = unwrap_from(v[0], v[size_t(i)]);
     emit(t);
     return out;
   }
   const double pole_lat = pole > 0 ? kOdsPi / 2 : -kOdsPi / 2;
   for (int e = 0; e < 3; ++e) {
-    ProjVertex a = v[e], b = v[(e + 1) % 3];
-    b.lon = a.lon + wrap_longitude(b.lon - a.lon);
-    const ProjVertex pa{a.lon, pole_lat, pole_range}, pb{b.lon, pole_lat, pole_range};
+    const ProjVertex a = v[size_t(e)], b = unwrap_from(a, v[size_t((e + 1) % 3)]);
+    const ProjVertex pa{a.lon, pole_lat, pole_range, a.lon_centre},
+        pb{b.lon, pole_lat, pole_range, b.lon_centre};
     emit(ProjTriangle{{a, b, pb}});
     emit(ProjTriangle{{a, pb, pa}});
   }

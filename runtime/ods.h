@@ -188,24 +188,31 @@ struct AxisCrossing {
 AxisCrossing axis_crossing(const std::array<Point3, 3>& v, const Point3& centre);
 
 // A projected vertex: position in the panorama (radians; lon may lie outside [-pi, pi] after the
-// split, to be clipped by the rasteriser) and its range (interpolated linearly, as the paper's
-// orthographic z = -|v_dir|).
+// split, to be clipped by the rasteriser), its range (interpolated linearly, as the paper's
+// orthographic z = -|v_dir|) and lon_centre, the longitude of the 3D point seen from the centre
+// C (direction_lonlat(p - C).lon), the reference for unwrapping. The eye offset moves a vertex's
+// longitude by up to 90 degrees (asin(h/r_h) or atan(h/r_h)) and by different amounts for the
+// vertices of one triangle near the axis, so the short way between eye longitudes can be the
+// wrong way round; between centre longitudes it is right for any triangle that the axis does not
+// cross.
 struct ProjVertex {
-  double lon = 0, lat = 0, range = 0;
+  double lon = 0, lat = 0, range = 0, lon_centre = 0;
 };
 struct ProjTriangle {
   std::array<ProjVertex, 3> v;
 };
 // The triangles to rasterise for one small (tessellated) triangle with projected vertices v
-// (lon in (-pi, pi]):
-//  - no pole (pole_range < 0): the longitudes unwrapped the short way from v[0]; if the result
-//    spills past -pi or pi, a second copy shifted by 2 pi in the other direction (the paper's
-//    "draw twice, let clipping remove"); 1 or 2 triangles.
+// (lon in (-pi, pi]). Unwrapping: vertex i is placed at
+//   v[0].lon_centre + wrap(v[i].lon_centre - v[0].lon_centre) + wrap(v[i].lon - v[i].lon_centre),
+// its centre longitude unwrapped the short way from v[0]'s plus its own eye offset.
+//  - no pole (pole = 0): the unwrapped triangle; if it spills past -pi or pi, a second copy
+//    shifted by 2 pi the other way (the paper's "draw twice, let clipping remove"); 1 or 2
+//    triangles.
 //  - a pole (pole = +1 / -1, pole_range = the range of the axis crossing point): the paper's
 //    case 3 strip, for each edge (a, b) the quad a, b, (b.lon, pole lat), (a.lon, pole lat) with
-//    b.lon unwrapped from a.lon (pole vertices get pole_range), as two triangles, each with its
-//    shifted copy if it spills; up to 12 triangles. (Cases 1 and 2 of the paper, a vertex or edge
-//    on the axis, are the same strip with collapsed quads, which the rasteriser skips.)
+//    b unwrapped from a (pole vertices get pole_range), as two triangles, each with its shifted
+//    copy if it spills; up to 12 triangles. (Cases 1 and 2 of the paper, a vertex or edge on the
+//    axis, are the same strip with collapsed quads, which the rasteriser skips.)
 std::vector<ProjTriangle> split_seam_pole(const std::array<ProjVertex, 3>& v, int pole,
                                           double pole_range);
 

@@ -355,9 +355,9 @@ TEST(OdsProjection, PoleMergedFixedPointConvergesInFewSteps) {
 
 TEST(OdsSplit, PaperSeamExampleIsDrawnOnBothSides) {
   // §3.2: vertices at (-170, 45), (-170, 35), (165, 40): 25 deg wide across the back.
-  const std::array<ProjVertex, 3> v{ProjVertex{-170 * kDeg, 45 * kDeg, 1},
-                                    ProjVertex{-170 * kDeg, 35 * kDeg, 1},
-                                    ProjVertex{165 * kDeg, 40 * kDeg, 1}};
+  const std::array<ProjVertex, 3> v{ProjVertex{-170 * kDeg, 45 * kDeg, 1, -170 * kDeg},
+                                    ProjVertex{-170 * kDeg, 35 * kDeg, 1, -170 * kDeg},
+                                    ProjVertex{165 * kDeg, 40 * kDeg, 1, 165 * kDeg}};
   const auto out = split_seam_pole(v, 0, 0);
   ASSERT_EQ(out.size(), 2u);
   for (const ProjTriangle& t : out) {
@@ -367,9 +367,21 @@ TEST(OdsSplit, PaperSeamExampleIsDrawnOnBothSides) {
     EXPECT_TRUE(lo < -kPi || hi > kPi);
   }
   // A triangle away from the seam is drawn once, unchanged.
-  const std::array<ProjVertex, 3> w{ProjVertex{0, 0, 1}, ProjVertex{0.1, 0, 1},
-                                    ProjVertex{0, 0.1, 1}};
+  const std::array<ProjVertex, 3> w{ProjVertex{0, 0, 1}, ProjVertex{0.1, 0, 1, 0.1},
+                                    ProjVertex{0, 0.1, 1, 0}};
   EXPECT_EQ(split_seam_pole(w, 0, 0).size(), 1u);
+}
+
+// Near the axis the eye offsets (up to 90 deg) differ between the vertices of one triangle, and
+// the short way between eye longitudes goes round the wrong side: unwrap by centre longitudes.
+TEST(OdsSplit, UnwrapsByCentreLongitudeNotByEyeLongitude) {
+  const std::array<ProjVertex, 3> v{ProjVertex{-85 * kDeg, -80 * kDeg, 1, 0},
+                                    ProjVertex{165 * kDeg, -80 * kDeg, 1, 170 * kDeg},
+                                    ProjVertex{20 * kDeg, -85 * kDeg, 1, 50 * kDeg}};
+  const auto out = split_seam_pole(v, 0, 0);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(out[0].v[1].lon / kDeg, 165, 1e-9);  // not 165 - 360
+  EXPECT_NEAR(out[0].v[2].lon / kDeg, 20, 1e-9);
 }
 
 TEST(OdsSplit, PoleComesFromTheAxisCrossingNotTheFirstVertex) {
@@ -389,16 +401,18 @@ TEST(OdsSplit, PoleComesFromTheAxisCrossingNotTheFirstVertex) {
 
 TEST(OdsSplit, PoleTriangleBecomesAStripToThePoleRow) {
   // Three vertices around the north pole at 60 deg latitude.
-  const std::array<ProjVertex, 3> v{ProjVertex{-150 * kDeg, 60 * kDeg, 2},
-                                    ProjVertex{-30 * kDeg, 60 * kDeg, 2},
-                                    ProjVertex{90 * kDeg, 60 * kDeg, 2}};
+  const std::array<ProjVertex, 3> v{ProjVertex{-150 * kDeg, 60 * kDeg, 2, -150 * kDeg},
+                                    ProjVertex{-30 * kDeg, 60 * kDeg, 2, -30 * kDeg},
+                                    ProjVertex{90 * kDeg, 60 * kDeg, 2, 90 * kDeg}};
   const auto out = split_seam_pole(v, 1, 1.5);
   // 3 quads of 2 triangles, the one across the seam (90 -> 210) twice.
   EXPECT_EQ(out.size(), 8u);
   double covered = 0;  // lon extent of the strip at the pole row, without the shifted copies
-  for (const ProjTriangle& t : out)
-    for (const ProjVertex& p : t.v)
+  for (const ProjTriangle& t : out) {
+    for (const ProjVertex& p : t.v) {
       if (p.lat == kPi / 2) EXPECT_EQ(p.range, 1.5);
+    }
+  }
   for (size_t i = 0; i < out.size(); ++i) {
     const auto& t = out[i];
     if (t.v[2].lat == kPi / 2 && t.v[0].lat != kPi / 2)

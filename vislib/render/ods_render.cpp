@@ -81,6 +81,132 @@ struct ImgTri {
 
 constexpr int kBandRows = 8;
 
+// Horizontal (x-z) distance from the axis through c to segment ab.
+double axis_segment_distance(const Point3& c, const Point3& a, const Point3& b) {
+  const double ax = a.x - c.x, az = a.z - c.z, dx = b.x - a.x, dz = b.z - a.z;
+  const double len2 = dx * dx + dz * dz;
+  const double t = len2 > 0 ? std::clamp(-(ax * dx + az * dz) / len2, 0.0, 1.0) : 0.0;
+  return std::hypot(ax + t * dx, az + t * dz);
+}
+
+// Turns small (tessellated) triangles into image-space triangles for one eye.
+struct Emitter {
+  struct Vtx {
+    Point3 p;
+    pvs_runtime::OdsProjection pr;
+    double lon_c = 0;  // longitude seen from the centre
+  };
+  static constexpr int kMaxDepth = 6;  // subdivisions of a triangle meeting the viewing disc
+
+  const Point3& c;
+  const OdsSettings& s;
+  Eye eye;
+  bool exact;
+  int W, H;
+  uint32_t tri;
+  std::vector<ImgTri>& dst;
+  OdsRasterStats& st;
+
+  Vtx make(const Point3& p) const {
+    Vtx v;
+    v.p = p;
+    v.pr = exact ? pvs_runtime::ods_project_exact(p, c, s.ipd, eye, s.merge)
+                 : pvs_runtime::ods_project_paper(p, c, s.ipd, eye, s.merge);
+    v.lon_c = pvs_runtime::direction_lonlat({p.x - c.x, p.y - c.y, p.z - c.z}).lon;
+    return v;
+  }
+
+  // Projects, splits at the seam and (if the axis crosses it) the pole, and appends.
+  void draw(const Vtx& a, const Vtx& b, const Vtx& d) {
+    const pvs_runtime::AxisCrossing ax = pvs_runtime::axis_crossing({a.p, b.p, d.p}, c);
+    int pole = 0;
+    double pole_range = 0;
+    if (ax.crosses) {
+      ++st.pole_triangles;
+      pole = ax.pole;
+      pole_range = std::fabs(ax.point.y - c.y);
+    }
+    const std::array<pvs_runtime::ProjVertex, 3> pv{
+        pvs_runtime::ProjVertex{a.pr.ll.lon, a.pr.ll.lat, a.pr.range, a.lon_c},
+        pvs_runtime::ProjVertex{b.pr.ll.lon, b.pr.ll.lat, b.pr.range, b.lon_c},
+        pvs_runtime::ProjVertex{d.pr.ll.lon, d.pr.ll.lat, d.pr.range, d.lon_c}};
+    for (const pvs_runtime::ProjTriangle& pt : pvs_runtime::split_seam_pole(pv, pole, pole_range)) {
+      ImgTri out;
+      out.tri = tri;
+      for (size_t i = 0; i < 3; ++i) {
+        const auto px = pvs_runtime::lonlat_to_pixel({pt.v[i].lon, pt.v[i].lat}, W, H);
+        out.u[i] = float(px[0]);
+        out.v[i] = float(px[1]);
+        out.r[i] = float(pt.v[i].range);
+      }
+      dst.push_back(out);
+    }
+  }
+
+  // The visible point of segment from visible v to invisible w nearest the visibility boundary.
+  Vtx boundary(const Vtx& v, const Vtx& w) const {
+    double lo = 0, hi = 1;  // lo visible, hi not
+    Vtx best = v;
+    for (int k = 0; k < 48; ++k) {
+      const double t = 0.5 * (lo + hi);
+      const Vtx m = make(
+          {v.p.x + t * (w.p.x - v.p.x), v.p.y + t * (w.p.y - v.p.y), v.p.z + t * (w.p.z - v.p.z)});
+      if (m.pr.visible) {
+        lo = t;
+        best = m;
+      } else {
+        hi = t;
+      }
+    }
+    return best;
+  }
+
+  // The exact projection: a triangle that meets the viewing disc (radius ipd/2 about the axis;
+  // inside it no ODS ray passes) is subdivided; at kMaxDepth its visible part (the polygon of its
+  // visible vertices and the boundary points on its edges) is drawn, whose boundary points
+  // project onto the pole row.
+  void exact_triangle(const Vtx& a, const Vtx& b, const Vtx& d, int depth) {
+    const int nvis = int(a.pr.visible) + int(b.pr.visible) + int(d.pr.visible);
+    if (nvis == 0) {
+      ++st.dropped_inside_circle;
+      return;
+    }
+    const double hmax = 0.5 * s.ipd;
+    const double edge_dist =
+        std::min({axis_segment_distance(c, a.p, b.p), axis_segment_distance(c, b.p, d.p),
+                  axis_segment_distance(c, d.p, a.p)});
+    const bool crosses = pvs_runtime::axis_crossing({a.p, b.p, d.p}, c).crosses;
+    // Clear of the disc (or containing all of it, drawn as the pole strip).
+    if (nvis == 3 && edge_dist > hmax) return draw(a, b, d);
+    if (depth < kMaxDepth) {
+      auto mid = [&](const Vtx& u, const Vtx& v) {
+        return make({(u.p.x + v.p.x) / 2, (u.p.y + v.p.y) / 2, (u.p.z + v.p.z) / 2});
+      };
+      const Vtx ab = mid(a, b), bd = mid(b, d), da = mid(d, a);
+      exact_triangle(a, ab, da, depth + 1);
+      exact_triangle(ab, b, bd, depth + 1);
+      exact_triangle(da, bd, d, depth + 1);
+      exact_triangle(ab, bd, da, depth + 1);
+      return;
+    }
+    if (nvis == 3) return draw(a, b, d);
+    if (crosses) {
+      ++st.dropped_inside_circle;
+      return;
+    }
+    const std::array<const Vtx*, 3> v{&a, &b, &d};
+    std::vector<Vtx> poly;
+    for (size_t i = 0; i < 3; ++i) {
+      const Vtx& p = *v[i];
+      const Vtx& q = *v[(i + 1) % 3];
+      if (p.pr.visible) poly.push_back(p);
+      if (p.pr.visible != q.pr.visible)
+        poly.push_back(p.pr.visible ? boundary(p, q) : boundary(q, p));
+    }
+    for (size_t k = 1; k + 1 < poly.size(); ++k) draw(poly[0], poly[k], poly[k + 1]);
+  }
+};
+
 }  // namespace
 
 Frame render_ods_rays(const Scene& scene, const EmbreeScene& rt, const OdsSettings& s, Eye eye,
@@ -131,6 +257,7 @@ Frame render_ods_raster(const Scene& scene, const std::vector<uint32_t>& ids, co
     std::map<std::array<int, 4>, pvs_runtime::Tessellation> cache;
     std::vector<Point3> world;
     std::vector<pvs_runtime::OdsProjection> proj;
+    std::vector<double> lon_c;
     for (size_t ch = range.begin(); ch != range.end(); ++ch) {
       OdsRasterStats& st = chunk_stats[ch];
       std::vector<ImgTri>& dst = out[ch];
@@ -167,12 +294,16 @@ Frame render_ods_raster(const Scene& scene, const std::vector<uint32_t>& ids, co
         const pvs_runtime::Tessellation& tess = it->second;
         world.resize(tess.points.size());
         proj.resize(tess.points.size());
+        lon_c.resize(tess.points.size());
         for (size_t q = 0; q < tess.points.size(); ++q) {
           const auto& w = tess.points[q];
           // Summed in this order so a point on a shared edge is bit-identical from both sides.
           world[q] = {(w[0] * p[0].x + w[1] * p[1].x) + w[2] * p[2].x,
                       (w[0] * p[0].y + w[1] * p[1].y) + w[2] * p[2].y,
                       (w[0] * p[0].z + w[1] * p[1].z) + w[2] * p[2].z};
+          lon_c[q] =
+              pvs_runtime::direction_lonlat({world[q].x - c.x, world[q].y - c.y, world[q].z - c.z})
+                  .lon;
           const bool at_centre = world[q].x == c.x && world[q].y == c.y && world[q].z == c.z;
           if (at_centre) {
             proj[q] = pvs_runtime::OdsProjection{};
@@ -182,38 +313,15 @@ Frame render_ods_raster(const Scene& scene, const std::vector<uint32_t>& ids, co
           }
         }
         st.tessellated += tess.triangles.size();
+        Emitter em{c, s, eye, exact, W, H, t, dst, st};
         for (const auto& tri : tess.triangles) {
-          const auto &a = proj[tri[0]], &b = proj[tri[1]], &d = proj[tri[2]];
-          if (!a.visible || !b.visible || !d.visible) {
-            ++st.dropped_inside_circle;
-            continue;
-          }
-          const pvs_runtime::AxisCrossing ax =
-              pvs_runtime::axis_crossing({world[tri[0]], world[tri[1]], world[tri[2]]}, c);
-          int pole = 0;
-          double pole_range = 0;
-          if (ax.crosses) {
-            ++st.pole_triangles;
-            pole = ax.pole;
-            pole_range = std::fabs(ax.point.y - c.y);
-          }
-          const std::array<pvs_runtime::ProjVertex, 3> pv{
-              pvs_runtime::ProjVertex{a.ll.lon, a.ll.lat, a.range},
-              pvs_runtime::ProjVertex{b.ll.lon, b.ll.lat, b.range},
-              pvs_runtime::ProjVertex{d.ll.lon, d.ll.lat, d.range}};
-          for (const pvs_runtime::ProjTriangle& pt :
-               pvs_runtime::split_seam_pole(pv, pole, pole_range)) {
-            ImgTri it2;
-            it2.tri = t;
-            for (int i = 0; i < 3; ++i) {
-              const auto px =
-                  pvs_runtime::lonlat_to_pixel({pt.v[size_t(i)].lon, pt.v[size_t(i)].lat}, W, H);
-              it2.u[size_t(i)] = float(px[0]);
-              it2.v[size_t(i)] = float(px[1]);
-              it2.r[size_t(i)] = float(pt.v[size_t(i)].range);
-            }
-            dst.push_back(it2);
-          }
+          const Emitter::Vtx a{world[tri[0]], proj[tri[0]], lon_c[tri[0]]};
+          const Emitter::Vtx b{world[tri[1]], proj[tri[1]], lon_c[tri[1]]};
+          const Emitter::Vtx d{world[tri[2]], proj[tri[2]], lon_c[tri[2]]};
+          if (exact)
+            em.exact_triangle(a, b, d, 0);
+          else
+            em.draw(a, b, d);
         }
       }
       st.drawn = dst.size();
@@ -333,7 +441,8 @@ std::vector<BandDisagreement> lr_disagreement_by_latitude(const Frame& left, con
   assert(left.width == right.width && left.height == right.height && band_degrees > 0);
   const int bands = int(std::ceil(180.0 / band_degrees - 1e-9));
   std::vector<BandDisagreement> out(static_cast<size_t>(bands));
-  std::vector<double> mismatch(static_cast<size_t>(bands), 0.0), luma_sum(static_cast<size_t>(bands), 0.0);
+  std::vector<double> mismatch(static_cast<size_t>(bands), 0.0),
+      luma_sum(static_cast<size_t>(bands), 0.0);
   for (int b = 0; b < bands; ++b) {
     out[size_t(b)].lat_max_deg = 90.0 - b * band_degrees;
     out[size_t(b)].lat_min_deg = std::max(-90.0, 90.0 - (b + 1) * band_degrees);
