@@ -96,7 +96,6 @@ struct Emitter {
     pvs_runtime::OdsProjection pr;
     double lon_c = 0;  // longitude seen from the centre
   };
-  static constexpr int kMaxDepth = 6;  // subdivisions of a triangle meeting the viewing disc
 
   const Point3& c;
   const OdsSettings& s;
@@ -161,27 +160,29 @@ struct Emitter {
     return best;
   }
 
-  // The exact projection: a triangle that meets the viewing disc (radius ipd/2 about the axis;
-  // inside it no ODS ray passes) is subdivided; at kMaxDepth its visible part (the polygon of its
-  // visible vertices and the boundary points on its edges) is drawn, whose boundary points
-  // project onto the pole row.
-  void exact_triangle(const Vtx& a, const Vtx& b, const Vtx& d, int depth) {
-    const int nvis = int(a.pr.visible) + int(b.pr.visible) + int(d.pr.visible);
-    if (nvis == 0) {
-      ++st.dropped_inside_circle;
-      return;
-    }
+  // The exact projection near the viewing disc (radius ipd/2 about the axis; inside it no ODS ray
+  // passes): an edge is halved while it comes within ipd/2 of the axis and is longer than
+  // ipd/32. The rule looks at the edge alone, so both triangles sharing an edge split it alike
+  // (no cracks). A triangle with no edge to split is drawn if all its vertices are visible;
+  // else its visible part (the polygon of its visible vertices and the boundary points on its
+  // edges, which project onto the pole row) is drawn, or nothing if the axis crosses it.
+  bool split_edge(const Vtx& u, const Vtx& v) const {
     const double hmax = 0.5 * s.ipd;
-    const double edge_dist =
-        std::min({axis_segment_distance(c, a.p, b.p), axis_segment_distance(c, b.p, d.p),
-                  axis_segment_distance(c, d.p, a.p)});
-    const bool crosses = pvs_runtime::axis_crossing({a.p, b.p, d.p}, c).crosses;
-    // Clear of the disc (or containing all of it, drawn as the pole strip).
-    if (nvis == 3 && edge_dist > hmax) return draw(a, b, d);
-    if (depth < kMaxDepth) {
-      auto mid = [&](const Vtx& u, const Vtx& v) {
-        return make({(u.p.x + v.p.x) / 2, (u.p.y + v.p.y) / 2, (u.p.z + v.p.z) / 2});
-      };
+    const double len =
+        std::sqrt((u.p.x - v.p.x) * (u.p.x - v.p.x) + (u.p.y - v.p.y) * (u.p.y - v.p.y) +
+                  (u.p.z - v.p.z) * (u.p.z - v.p.z));
+    return hmax > 0 && len > hmax / 16 && axis_segment_distance(c, u.p, v.p) <= hmax;
+  }
+  Vtx mid(const Vtx& u, const Vtx& v) const {
+    return make({(u.p.x + v.p.x) / 2, (u.p.y + v.p.y) / 2, (u.p.z + v.p.z) / 2});
+  }
+  void exact_triangle(const Vtx& a, const Vtx& b, const Vtx& d, int depth) {
+    const std::array<const Vtx*, 3> v{&a, &b, &d};
+    std::array<bool, 3> split{};  // split[i]: edge v[i] -> v[i+1]
+    int nsplit = 0;
+    if (depth < 40)
+      for (size_t i = 0; i < 3; ++i) nsplit += split[i] = split_edge(*v[i], *v[(i + 1) % 3]);
+    if (nsplit == 3) {
       const Vtx ab = mid(a, b), bd = mid(b, d), da = mid(d, a);
       exact_triangle(a, ab, da, depth + 1);
       exact_triangle(ab, b, bd, depth + 1);
@@ -189,12 +190,29 @@ struct Emitter {
       exact_triangle(ab, bd, da, depth + 1);
       return;
     }
+    if (nsplit == 1) {
+      const size_t i = split[0] ? 0 : (split[1] ? 1 : 2);
+      const Vtx &p = *v[i], &q = *v[(i + 1) % 3], &r = *v[(i + 2) % 3];
+      const Vtx m = mid(p, q);
+      exact_triangle(p, m, r, depth + 1);
+      exact_triangle(m, q, r, depth + 1);
+      return;
+    }
+    if (nsplit == 2) {
+      const size_t k = !split[0] ? 0 : (!split[1] ? 1 : 2);  // the edge kept: v[k] -> v[k+1]
+      const Vtx &p = *v[k], &q = *v[(k + 1) % 3], &r = *v[(k + 2) % 3];
+      const Vtx m1 = mid(q, r), m2 = mid(r, p);  // split edges q -> r and r -> p
+      exact_triangle(m1, r, m2, depth + 1);
+      exact_triangle(p, q, m1, depth + 1);
+      exact_triangle(p, m1, m2, depth + 1);
+      return;
+    }
+    const int nvis = int(a.pr.visible) + int(b.pr.visible) + int(d.pr.visible);
     if (nvis == 3) return draw(a, b, d);
-    if (crosses) {
+    if (nvis == 0 || pvs_runtime::axis_crossing({a.p, b.p, d.p}, c).crosses) {
       ++st.dropped_inside_circle;
       return;
     }
-    const std::array<const Vtx*, 3> v{&a, &b, &d};
     std::vector<Vtx> poly;
     for (size_t i = 0; i < 3; ++i) {
       const Vtx& p = *v[i];
