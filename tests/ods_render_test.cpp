@@ -317,4 +317,107 @@ TEST(OdsRender, SeamIsContinuousInBothMethods) {
   }
 }
 
+nlohmann::json read_json(const std::string& path) {
+  return nlohmann::json::parse(std::ifstream(path));
+}
+
+TEST(PvsViewOds, WritesPanoramasAndMetricsOnABakedCity) {
+  using vislib_test::run_pvs;
+  const std::string dir = vislib_test::temp_dir("pvs_view_ods");
+  std::string out;
+  ASSERT_EQ(run_pvs("generate city --blocks 2,2 -o " + dir + "/city.glb", &out), 0) << out;
+  ASSERT_EQ(
+      run_pvs(
+          "bake " + dir +
+              "/city.glb --box -10,0,-10,10,3,10 --grid 2,1,2 --eye-height 1.5,1.8 --res 32 -o " +
+              dir + "/city.pvs",
+          &out),
+      0)
+      << out;
+  const std::string base =
+      "view " + dir + "/city.pvs --scene " + dir + "/city.glb --ods --ods-size 128 ";
+  ASSERT_EQ(run_pvs(base + "--at 5,1.6,5 --pole-merge 45,0,1 -o " + dir + "/o.png --json " + dir +
+                        "/o.json",
+                    &out),
+            0)
+      << out;
+  for (const char* name :
+       {"/o.png", "/o_left.png", "/o_right.png", "/o_anaglyph.png", "/o_truth.png"})
+    EXPECT_TRUE(std::ifstream(dir + name).good()) << name;
+  nlohmann::json j = read_json(dir + "/o.json")["ods"];
+  for (const char* eye : {"left", "right"}) {
+    for (const char* key : {"epsilon", "psnr", "ssim", "triangle_mismatch"})
+      EXPECT_TRUE(j[eye].contains(key)) << key;
+    // The cell's PVS panorama against the full-scene one: the PVS misses (almost) nothing.
+    EXPECT_LE(j[eye]["triangle_mismatch"].get<double>(), 1e-3) << eye;
+    EXPECT_TRUE(j["seam"][eye].contains("triangle_mismatch"));
+  }
+  EXPECT_EQ(j["lr_disagreement_by_latitude"].size(), 36u);
+  EXPECT_EQ(j["lr_disagreement_by_latitude"][0]["triangle_mismatch"].get<double>(),
+            0.0);  // merged at the pole
+  EXPECT_EQ(j["cells_used"].size(), 1u);
+  EXPECT_TRUE(j["disc_in_cell_view_region"].get<bool>());
+  EXPECT_TRUE(j["disc_covered"].get<bool>());
+  EXPECT_EQ(j["counts"]["left"]["rays"].get<size_t>(), 128u * 64u);
+  EXPECT_DOUBLE_EQ(j["pole_merge"]["top"]["start_deg"].get<double>(), 45.0);
+
+  // A disc across the corner of four cells: the union of the cells it touches.
+  ASSERT_EQ(run_pvs(base + "--at 0.01,1.6,0.02 --ods-method raster-exact -o " + dir +
+                        "/c.png --json " + dir + "/c.json",
+                    &out),
+            0)
+      << out;
+  j = read_json(dir + "/c.json")["ods"];
+  EXPECT_FALSE(j["disc_in_cell_view_region"].get<bool>());
+  EXPECT_EQ(j["cells_used"].size(), 4u);
+  EXPECT_TRUE(j["disc_covered"].get<bool>());
+  EXPECT_GT(j["counts"]["left"]["tessellated"].get<size_t>(), 0u);
+  for (const char* eye : {"left", "right"})
+    EXPECT_LE(j["truth_against_rays"][eye]["triangle_mismatch"].get<double>(), 0.01) << eye;
+
+  // Bad options: exit 2, nothing written.
+  EXPECT_EQ(run_pvs(base + "--at 5,1.6,5 --pole-merge 10,20,1 -o " + dir + "/bad.png", &out), 2)
+      << out;
+  EXPECT_EQ(
+      run_pvs(base + "--at 5,1.6,5 --ods-size 130 --ods-method nope -o " + dir + "/bad.png", &out),
+      2)
+      << out;
+  EXPECT_FALSE(std::ifstream(dir + "/bad.png").good());
+  // Without --ods, --look is still required.
+  EXPECT_EQ(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/city.glb --at 5,1.6,5 -o " +
+                        dir + "/n.png",
+                    &out),
+            2)
+      << out;
+}
+
+// One walkable 8 m cell on the hill at the town's (-36, -36) corner, and an eye inside its view
+// region (eye band 2.4-6.8 m there).
+constexpr const char* TOWN_BAKE = "--walkable --box -40,-10,-40,-32,20,-32 --cell-size 8";
+constexpr const char* TOWN_EYE = "-36,4,-36";
+
+TEST(PvsViewOds, TruckTownCellAgainstTheFullScene) {
+  VISLIB_REQUIRE_SHARED(shared);
+  using vislib_test::run_pvs;
+  const std::string dir = vislib_test::temp_dir("pvs_view_ods_town");
+  const std::string town = shared + "/godot_truck_town/town_model.gltf";
+  std::string out;
+  ASSERT_EQ(
+      run_pvs("bake " + town + " " + std::string(TOWN_BAKE) + " --res 32 -o " + dir + "/town.pvs",
+              &out),
+      0)
+      << out;
+  ASSERT_EQ(run_pvs("view " + dir + "/town.pvs --scene " + town + " --at " + std::string(TOWN_EYE) +
+                        " --ods --ods-size 256 --pole-merge 45,0,3 -o " + dir + "/t.png --json " +
+                        dir + "/t.json",
+                    &out),
+            0)
+      << out;
+  const nlohmann::json j = read_json(dir + "/t.json")["ods"];
+  EXPECT_TRUE(j["disc_covered"].get<bool>());
+  EXPECT_LT(j["triangles"]["visible"].get<size_t>(), j["triangles"]["scene"].get<size_t>());
+  for (const char* eye : {"left", "right"})
+    EXPECT_LE(j[eye]["triangle_mismatch"].get<double>(), 2e-3) << eye;
+}
+
 }  // namespace
