@@ -18,7 +18,7 @@
 #include <map>
 
 #include "runtime/ods.h"
-#include "vislib/embree_scene.h"
+#include "vislib/eval/embree_scene.h"
 #include "vislib/render/ods_render.h"
 
 namespace {

@@ -15,14 +15,14 @@
 #include "pvs_format/pvs_format.h"
 #include "runtime/ods.h"
 #include "runtime/pvs_runtime.h"
-#include "vislib/embree_scene.h"
-#include "vislib/error.h"
-#include "vislib/file_util.h"
-#include "vislib/image_io.h"
-#include "vislib/metrics.h"
-#include "vislib/near_far_render.h"
+#include "vislib/base/error.h"
+#include "vislib/base/file_util.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/eval/image_io.h"
+#include "vislib/eval/metrics.h"
+#include "vislib/render/near_far_render.h"
 #include "vislib/render/ods_render.h"
-#include "vislib/scene_fingerprint.h"
+#include "vislib/scene/scene_fingerprint.h"
 
 namespace pvs_cli {
 namespace {

@@ -12,7 +12,7 @@
 
 #include "scene_builders.h"
 #include "test_support.h"
-#include "vislib/metrics.h"
+#include "vislib/eval/metrics.h"
 
 namespace {
 

@@ -32,10 +32,10 @@
 #include <vector>
 
 #include "runtime/ods.h"
-#include "vislib/embree_scene.h"
-#include "vislib/render.h"
-#include "vislib/scene.h"
-#include "vislib/vec.h"
+#include "vislib/base/vec.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/eval/render.h"
+#include "vislib/scene/scene.h"
 
 namespace vislib {
 
