@@ -203,7 +203,8 @@ double inner_level_eq4(double max_tess) {
 }
 
 Tessellation tessellate_triangle(const std::array<int, 3>& outer, int inner) {
-  for (int o : outer) assert(o >= 1 && o <= 64);
+  assert(outer[0] >= 1 && outer[0] <= 64 && outer[1] >= 1 && outer[1] <= 64 && outer[2] >= 1 &&
+         outer[2] <= 64);
   assert(inner >= 1 && inner <= 64);
   const int n = std::max({outer[0], outer[1], outer[2], inner});
   Tessellation t;
