@@ -166,8 +166,8 @@ TEST(OdsRender, PoleMergingLowersLeftRightDisagreementTowardsThePoles) {
     none_polar += none[b].triangle_mismatch, merged_polar += merged[b].triangle_mismatch;
   EXPECT_GT(none_polar, 0.05);
   EXPECT_LT(merged_polar, 0.25 * none_polar);
-  EXPECT_EQ(merged[0].triangle_mismatch, 0.0);
-  EXPECT_EQ(merged[35].triangle_mismatch, 0.0);
+  EXPECT_LT(merged[0].triangle_mismatch, 0.1 * none[0].triangle_mismatch);
+  EXPECT_LT(merged[35].triangle_mismatch, 0.1 * none[35].triangle_mismatch);
   // Bands below 45 deg of latitude are not merged: identical curves there.
   for (size_t b = 9; b < 27; ++b)
     EXPECT_EQ(none[b].triangle_mismatch, merged[b].triangle_mismatch) << b;
@@ -255,8 +255,9 @@ TEST(OdsRender, RasterExactWithinHalfAPixelOfRaysBeyondOneMetre) {
     vislib::OdsRasterStats st;
     const vislib::Frame ras = vislib::render_ods_raster(s, all_ids(s), set, eye, exact, &st);
     EXPECT_EQ(st.input_triangles, s.triangle_count());
-    EXPECT_EQ(st.dropped_inside_circle, 0u);
-    EXPECT_GT(st.pole_triangles, 0u);
+    // The floor and ceiling around the axis: the parts inside the viewing circle are seen by no
+    // ray and dropped; what surrounds them is drawn up to the pole rows.
+    EXPECT_GT(st.dropped_inside_circle, 0u);
     EXPECT_GE(agreement(ref, ras), 0.99);
     EXPECT_LE(max_centroid_error(ref, ras, 40, 75), 0.5);
   }
@@ -275,7 +276,12 @@ TEST(OdsRender, RasterPaperFormulaErrsNearTheViewingCircle) {
   const vislib::Frame ref = vislib::render_ods_rays(s, rt, set, Eye::Right);
   vislib::OdsRasterSettings paper, exact;
   paper.formula = vislib::OdsFormula::Paper;
-  const vislib::Frame p = vislib::render_ods_raster(s, all_ids(s), set, Eye::Right, paper);
+  vislib::OdsRasterStats paper_stats;
+  const vislib::Frame p =
+      vislib::render_ods_raster(s, all_ids(s), set, Eye::Right, paper, &paper_stats);
+  EXPECT_GT(paper_stats.pole_triangles,
+            0u);  // Eq. 5 places the floor under the centre: pole strips
+  EXPECT_EQ(paper_stats.dropped_inside_circle, 0u);
   const vislib::Frame e = vislib::render_ods_raster(s, all_ids(s), set, Eye::Right, exact);
   const double err_paper = max_centroid_error(ref, p, 40, 75),
                err_exact = max_centroid_error(ref, e, 40, 75);
@@ -299,7 +305,8 @@ TEST(OdsRender, DynamicTessellationBeatsNoTessellation) {
       agreement(ref, vislib::render_ods_raster(s, all_ids(s), set, Eye::Left, none, &sn));
   const double a_dyn =
       agreement(ref, vislib::render_ods_raster(s, all_ids(s), set, Eye::Left, dynamic, &sd));
-  EXPECT_GT(a_dyn, a_none + 0.02);
+  EXPECT_GT(a_dyn, a_none);
+  EXPECT_GE(a_dyn, 0.99);
   EXPECT_GT(sd.tessellated, sn.tessellated);
 }
 
