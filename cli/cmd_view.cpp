@@ -9,6 +9,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "cli/cmd_view_ods.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/view_report.h"
@@ -226,7 +227,7 @@ void add_view(CLI::App& app) {
                   "The scene the PVS was baked for (checked by its fingerprint)")
       ->required();
   cmd->add_option("--at", a->at, "User eye x,y,z (its cell's visible set is used)")->required();
-  cmd->add_option("--look", a->look, "Point x,y,z the user looks at")->required();
+  cmd->add_option("--look", a->look, "Point x,y,z the user looks at (required without --ods)");
   cmd->add_option(
       "--near-far", a->near_far,
       "Radii r1,r2 of the cylinders about the centre (scene units; default: r1 = 1.25 x "
@@ -277,7 +278,15 @@ void add_view(CLI::App& app) {
                   "<out>_nomorph.png are written next to it")
       ->required();
   cmd->add_option("--json", a->json_path, "Write the metrics as JSON ('-' = stdout)");
-  cmd->callback([a] { run_view(*a); });
+  auto ods = std::make_shared<OdsViewArgs>();
+  add_ods_view_options(cmd, ods);
+  cmd->callback([a, ods] {
+    if (ods->enabled)
+      return run_view_ods(*ods,
+                          {a->file, a->scene, a->at, a->output, a->json_path, a->states, a->tau});
+    if (a->look.empty()) throw CLI::ValidationError("--look", "is required (except with --ods)");
+    run_view(*a);
+  });
 }
 
 Registration view_registration("view", add_view);

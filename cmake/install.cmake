@@ -21,6 +21,7 @@ install(EXPORT vislibRuntimeTargets NAMESPACE vislib:: DESTINATION ${VISLIB_CMAK
 install(FILES ${PROJECT_SOURCE_DIR}/pvs_format/pvs_format.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vislib/pvs_format)
 install(FILES ${PROJECT_SOURCE_DIR}/runtime/pvs_runtime.h ${PROJECT_SOURCE_DIR}/runtime/pvs_runtime_c.h
               ${PROJECT_SOURCE_DIR}/runtime/near_far.h ${PROJECT_SOURCE_DIR}/runtime/near_far_c.h
+              ${PROJECT_SOURCE_DIR}/runtime/ods.h
               ${PROJECT_BINARY_DIR}/generated/runtime/vislib_version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vislib/runtime)
 
