@@ -102,9 +102,6 @@ std::shared_ptr<ViewStereoArgs> add_view_stereo_options(CLI::App* view) {
           "parallel "
           "eyes only); --at is the point between the eyes")
       ->check(CLI::IsMember({"yoro", "true", "alg2"}));
-  view->add_option("--ipd", a->ipd, "--stereo: interpupillary distance (scene units)")
-      ->check(CLI::Range(0.0, 1e6))
-      ->capture_default_str();
   view->add_option("--dominant", a->dominant,
                    "--stereo: the eye that is rendered: left, right or centre (a view between the "
                    "eyes, both "

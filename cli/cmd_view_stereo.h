@@ -16,14 +16,15 @@ namespace pvs_cli {
 
 struct ViewStereoArgs {
   std::string mode;  // empty: no stereo; "yoro"/"true": fixed splatting; "alg2": Alg. 2 as printed
-  double ipd = 0.065;
+  double ipd = 0.064;  // scene units; set from --ipd x --units-per-metre (shared with --ods)
   std::string dominant = "left", patch = "yoro";
   bool reshade = false;
   double max_hole_share = 1;
   bool enabled() const { return !mode.empty(); }
 };
 
-// Registers --stereo, --ipd, --dominant, --patch, --reshade, --max-hole-share on `view`.
+// Registers --stereo, --dominant, --patch, --reshade, --max-hole-share on `view` (--ipd and
+// --units-per-metre are registered by the --ods options and shared).
 std::shared_ptr<ViewStereoArgs> add_view_stereo_options(CLI::App* view);
 
 // Runs the stereo stage for the head camera `head` (its eye is the point between the eyes): finds
