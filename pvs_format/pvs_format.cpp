@@ -336,6 +336,9 @@ void put_box(std::string& out, const Box& b) {
   for (double v : b.max) put_f64(out, v);
 }
 
+// Box-list layouts: how far back (in cells) a Delta reference may be (write_pvs).
+constexpr uint32_t kBoxDeltaWindow = 4096;
+
 // Smallest encoding of one cell's set. `candidates` are earlier present cells allowed as Delta
 // references, in preference order.
 struct Choice {
@@ -343,9 +346,11 @@ struct Choice {
   int depth = 0;
 };
 
+// `set_of(ref)` gives the ids of an earlier present cell.
+template <class SetOf>
 Choice encode_cell(const std::vector<uint32_t>& ids, uint32_t cell,
-                   const std::vector<uint32_t>& candidates, const std::vector<CellSet>& cells,
-                   const std::vector<int>& depth) {
+                   const std::vector<uint32_t>& candidates, const SetOf& set_of,
+                   const std::vector<uint8_t>& depth) {
   Choice best;
   best.block.push_back(char(Encoding::SortedDelta));
   append_sorted_delta(best.block, ids);
@@ -353,7 +358,7 @@ Choice encode_cell(const std::vector<uint32_t>& ids, uint32_t cell,
   append_run_length(rle, ids);
   if (rle.size() < best.block.size()) best.block = rle;
   for (uint32_t ref : candidates) {
-    std::vector<uint32_t> diff = symmetric_difference(ids, *cells[ref]);
+    std::vector<uint32_t> diff = symmetric_difference(ids, set_of(ref));
     for (Encoding inner : {Encoding::SortedDelta, Encoding::RunLength}) {
       std::string b(1, char(Encoding::Delta));
       put_varint(b, cell - ref);
@@ -371,11 +376,13 @@ Choice encode_cell(const std::vector<uint32_t>& ids, uint32_t cell,
   return best;
 }
 
-std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<CellSet>& cells,
-                                       const std::vector<int>& depth, uint32_t cell) {
+// Delta reference candidates of `cell` among earlier cells, in preference order (write_pvs).
+// present[r]: cell r has a set; depth[r]: its delta chain length.
+std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<bool>& present,
+                                       const std::vector<uint8_t>& depth, uint32_t cell) {
   std::vector<uint32_t> out;
   auto consider = [&](uint32_t ref) {
-    if (!cells[ref] || depth[ref] + 1 > int(info.max_delta_depth)) return;
+    if (!present[ref] || depth[ref] + 1 > int(info.max_delta_depth)) return;
     if (std::find(out.begin(), out.end(), ref) == out.end()) out.push_back(ref);
   };
   const CellLayout& L = info.layout;
@@ -389,9 +396,9 @@ std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<C
     auto centre = [&](uint32_t c, int a) { return 0.5 * (L.boxes[c].min[a] + L.boxes[c].max[a]); };
     double best = std::numeric_limits<double>::infinity();
     uint32_t best_ref = cell;
-    uint32_t lo = cell > 4096 ? cell - 4096 : 0;
+    uint32_t lo = cell > kBoxDeltaWindow ? cell - kBoxDeltaWindow : 0;
     for (uint32_t r = cell; r-- > lo;) {
-      if (!cells[r] || depth[r] + 1 > int(info.max_delta_depth)) continue;
+      if (!present[r] || depth[r] + 1 > int(info.max_delta_depth)) continue;
       double d2 = 0;
       for (int a = 0; a < 3; ++a) {
         double d = centre(r, a) - centre(cell, a);
@@ -409,7 +416,23 @@ std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<C
 
 }  // namespace
 
-std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, WriteStats* stats) {
+struct StreamWriter::Impl {
+  FileInfo info;
+  Sink sink;
+  uint32_t n = 0, next = 0;
+  uint64_t index_offset = 0, blocks_offset = 0, at = 0;
+  size_t layout_size = 0;
+  std::string index;           // n entries of 16 bytes, written at finish()
+  std::vector<bool> present;   // per cell
+  std::vector<uint8_t> depth;  // per cell: delta chain length
+  // The sets a later cell may reference (grid: the previous nx*ny cells; box list: the previous
+  // kBoxDeltaWindow), sorted-delta encoded to keep them small, in a ring indexed by cell % window.
+  uint64_t window = 1;
+  std::vector<std::string> recent;
+  bool finished = false;
+};
+
+StreamWriter::StreamWriter(FileInfo info, Sink sink) : impl_(std::make_unique<Impl>()) {
   const CellLayout& L = info.layout;
   if (L.kind == LayoutKind::Grid) {
     if (L.nx == 0 || L.ny == 0 || L.nz == 0) throw std::invalid_argument("write_pvs: grid dimensions must be >= 1");
@@ -424,22 +447,18 @@ std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, W
     if (L.boxes.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: too many cells");
     for (const Box& b : L.boxes) check_box(b, "cell box");
   }
-  if (cells.size() != L.cell_count()) throw std::invalid_argument("write_pvs: cells.size() differs from the layout's cell count");
-  if (info.metadata.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: metadata too long");
-  for (const CellSet& s : cells) {
-    if (!s) {
-      if (!info.partial) throw std::invalid_argument("write_pvs: absent cell in a file not marked partial");
-      continue;
-    }
-    for (size_t i = 0; i < s->size(); ++i)
-      if ((*s)[i] >= info.universe || (i > 0 && (*s)[i] <= (*s)[i - 1]))
-        throw std::invalid_argument("write_pvs: a cell's ids are not sorted, unique and below the universe");
-  }
-
-  const uint32_t n = uint32_t(cells.size());
+  if (info.metadata.size() > 0xFFFFFFFFull)
+    throw std::invalid_argument("write_pvs: metadata too long");
+  Impl& w = *impl_;
+  w.n = L.cell_count();
+  w.window =
+      std::max<uint64_t>(1, L.kind == LayoutKind::Grid ? uint64_t(L.nx) * L.ny : kBoxDeltaWindow);
+  w.window = std::min<uint64_t>(w.window, std::max<uint32_t>(1, w.n));
+  w.recent.resize(size_t(w.window));
+  w.present.assign(w.n, false);
+  w.depth.assign(w.n, 0);
+  // Header (zeros until finish()), layout section, index (zeros until finish()).
   std::string out(kHeaderSize, '\0');
-  // Layout section.
-  size_t layout_start = out.size();
   if (L.kind == LayoutKind::Grid) {
     put_box(out, L.grid_box);
     put_u32(out, L.nx);
@@ -452,61 +471,124 @@ std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, W
   }
   put_u32(out, uint32_t(info.metadata.size()));
   out += info.metadata;
-  put_u32(out, crc32c(out.data() + layout_start, out.size() - layout_start));
-  const size_t layout_size = out.size() - layout_start;
+  put_u32(out, crc32c(out.data() + kHeaderSize, out.size() - kHeaderSize));
+  w.layout_size = out.size() - kHeaderSize;
+  w.index_offset = out.size();
+  w.blocks_offset = w.index_offset + uint64_t(w.n) * kIndexEntrySize + 4;
+  w.at = w.blocks_offset;
+  w.info = std::move(info);
+  w.sink = std::move(sink);
+  w.sink(0, out);
+  w.index.reserve(size_t(w.n) * kIndexEntrySize + 4);
+}
 
-  // Blocks, encoded first so that the index can be filled in.
-  std::vector<int> depth(n, 0);
-  std::vector<std::string> blocks(n);
-  for (uint32_t c = 0; c < n; ++c) {
-    std::string b;
-    if (!cells[c]) {
-      b.push_back(char(Encoding::Absent));
-    } else {
-      Choice ch = encode_cell(*cells[c], c, delta_candidates(info, cells, depth, c), cells, depth);
-      depth[c] = ch.depth;
-      b = std::move(ch.block);
-    }
-    put_u32(b, crc32c(b.data(), b.size()));
-    blocks[c] = std::move(b);
-  }
-  const size_t index_offset = out.size();
-  const uint64_t blocks_offset = index_offset + uint64_t(n) * kIndexEntrySize + 4;
-  uint64_t at = blocks_offset;
-  for (uint32_t c = 0; c < n; ++c) {
-    if (blocks[c].size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: block larger than 4 GiB");
-    put_u64(out, at);
-    put_u32(out, uint32_t(blocks[c].size()));
-    put_u32(out, cells[c] ? uint32_t(cells[c]->size()) : 0);
-    at += blocks[c].size();
-  }
-  put_u32(out, crc32c(out.data() + index_offset, out.size() - index_offset));
-  for (const std::string& b : blocks) out += b;
+StreamWriter::~StreamWriter() = default;
+StreamWriter::StreamWriter(StreamWriter&&) noexcept = default;
 
+uint32_t StreamWriter::next_cell() const {
+  return impl_->next;
+}
+
+void StreamWriter::add(const CellSet& s) {
+  Impl& w = *impl_;
+  if (w.finished || w.next >= w.n)
+    throw std::invalid_argument("write_pvs: more cells than the layout has");
+  const uint32_t c = w.next;
+  if (!s) {
+    if (!w.info.partial)
+      throw std::invalid_argument("write_pvs: absent cell in a file not marked partial");
+  } else {
+    for (size_t i = 0; i < s->size(); ++i)
+      if ((*s)[i] >= w.info.universe || (i > 0 && (*s)[i] <= (*s)[i - 1]))
+        throw std::invalid_argument(
+            "write_pvs: a cell's ids are not sorted, unique and below the universe");
+  }
+  std::string b;
+  if (!s) {
+    b.push_back(char(Encoding::Absent));
+  } else {
+    auto set_of = [&](uint32_t ref) {
+      const std::string& enc = w.recent[size_t(ref % w.window)];
+      return decode_sorted_delta(enc, w.info.universe, 0);
+    };
+    Choice ch =
+        encode_cell(*s, c, delta_candidates(w.info, w.present, w.depth, c), set_of, w.depth);
+    w.depth[c] = uint8_t(ch.depth);
+    b = std::move(ch.block);
+    w.present[c] = true;
+    std::string& slot = w.recent[size_t(c % w.window)];
+    slot.clear();
+    append_sorted_delta(slot, *s);
+    slot.shrink_to_fit();
+  }
+  put_u32(b, crc32c(b.data(), b.size()));
+  if (b.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: block larger than 4 GiB");
+  put_u64(w.index, w.at);
+  put_u32(w.index, uint32_t(b.size()));
+  put_u32(w.index, s ? uint32_t(s->size()) : 0);
+  w.sink(w.at, b);
+  w.at += b.size();
+  ++w.next;
+}
+
+WriteStats StreamWriter::finish() {
+  Impl& w = *impl_;
+  if (w.finished) throw std::invalid_argument("write_pvs: finish() twice");
+  if (w.next != w.n)
+    throw std::invalid_argument("write_pvs: cells.size() differs from the layout's cell count");
+  w.finished = true;
+  put_u32(w.index, crc32c(w.index.data(), w.index.size()));
+  w.sink(w.index_offset, w.index);
   // Header last: it holds the total size.
+  const CellLayout& L = w.info.layout;
   std::string h;
   h.append(kMagic, 8);
   put_u32(h, kFormatVersion);
-  put_u32(h, info.partial ? 1u : 0u);
-  put_u64(h, out.size());
-  put_u64(h, info.scene_fingerprint);
-  put_u32(h, info.universe);
-  put_u32(h, n);
-  put_u8(h, uint8_t(info.granularity));
+  put_u32(h, w.info.partial ? 1u : 0u);
+  put_u64(h, w.at);
+  put_u64(h, w.info.scene_fingerprint);
+  put_u32(h, w.info.universe);
+  put_u32(h, w.n);
+  put_u8(h, uint8_t(w.info.granularity));
   put_u8(h, uint8_t(L.kind));
-  put_u8(h, info.max_delta_depth);
+  put_u8(h, w.info.max_delta_depth);
   put_u8(h, 0);
-  put_u32(h, uint32_t(layout_size));
+  put_u32(h, uint32_t(w.layout_size));
   h.append(12, '\0');
   put_u32(h, crc32c(h.data(), h.size()));
-  out.replace(0, kHeaderSize, h);
-  if (stats) {
-    stats->file_bytes = out.size();
-    stats->header_bytes = kHeaderSize;
-    stats->layout_bytes = layout_size;
-    stats->index_bytes = blocks_offset - index_offset;
-    stats->block_bytes = out.size() - blocks_offset;
+  w.sink(0, h);
+  WriteStats stats;
+  stats.file_bytes = w.at;
+  stats.header_bytes = kHeaderSize;
+  stats.layout_bytes = w.layout_size;
+  stats.index_bytes = w.blocks_offset - w.index_offset;
+  stats.block_bytes = w.at - w.blocks_offset;
+  return stats;
+}
+
+std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, WriteStats* stats) {
+  if (cells.size() != info.layout.cell_count())
+    throw std::invalid_argument("write_pvs: cells.size() differs from the layout's cell count");
+  // Every set is checked before anything is encoded (as the contract says).
+  for (const CellSet& s : cells) {
+    if (!s) {
+      if (!info.partial)
+        throw std::invalid_argument("write_pvs: absent cell in a file not marked partial");
+      continue;
+    }
+    for (size_t i = 0; i < s->size(); ++i)
+      if ((*s)[i] >= info.universe || (i > 0 && (*s)[i] <= (*s)[i - 1]))
+        throw std::invalid_argument(
+            "write_pvs: a cell's ids are not sorted, unique and below the universe");
   }
+  std::string out;
+  StreamWriter w(info, [&out](uint64_t offset, std::string_view bytes) {
+    if (out.size() < offset + bytes.size()) out.resize(size_t(offset + bytes.size()));
+    std::memcpy(&out[size_t(offset)], bytes.data(), bytes.size());
+  });
+  for (const CellSet& s : cells) w.add(s);
+  WriteStats st = w.finish();
+  if (stats) *stats = st;
   return out;
 }
 

@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -120,6 +121,32 @@ struct WriteStats {
 // grid nx, ny, nz >= 1; eye_lo <= eye_hi. Violations throw std::invalid_argument.
 std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells,
                       WriteStats* stats = nullptr);
+
+// write_pvs one cell at a time, in cell order, for files larger than memory (pvs bake streams its
+// output): the same bytes as write_pvs(info, all cells). `sink(offset, bytes)` stores bytes at a
+// file offset: the header and layout at construction, each block as it is added (appended in
+// order), the index and the header (which hold the sizes and offsets) again at finish(). Holds
+// O(cell count) small state (16 index bytes, a depth byte and a bit per cell) plus the sets a
+// later cell may reference as a Delta (grid: the previous nx*ny cells; box list: the previous
+// 4096), kept sorted-delta encoded. Throws std::invalid_argument on the preconditions of
+// write_pvs (a bad layout at construction, a bad set in add(), a missing cell in finish()).
+// Not thread-safe.
+class StreamWriter {
+ public:
+  using Sink = std::function<void(uint64_t offset, std::string_view bytes)>;
+  StreamWriter(FileInfo info, Sink sink);
+  ~StreamWriter();
+  StreamWriter(StreamWriter&&) noexcept;
+  // Adds the next cell (next_cell()): its set, or nullopt for an absent cell (info.partial only).
+  void add(const CellSet& set);
+  uint32_t next_cell() const;
+  // Writes the index and the header once every cell was added. Returns the sizes.
+  WriteStats finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // ---- Reading --------------------------------------------------------------------------------
 

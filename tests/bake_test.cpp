@@ -161,7 +161,7 @@ TEST(Checkpoint, TornAtAnyByteKeepsEveryCompleteRecord) {
   }
 }
 
-TEST(Checkpoint, DamagedRecordEndsTheValidPart) {
+TEST(Checkpoint, DamagedLastRecordIsDropped) {
   std::string dir = temp_dir("checkpoint_damaged");
   std::string path = dir + "/c.ckpt";
   {
@@ -178,6 +178,119 @@ TEST(Checkpoint, DamagedRecordEndsTheValidPart) {
   EXPECT_TRUE(got[0]);
   EXPECT_FALSE(got[1]);
   EXPECT_GT(cp.discarded_bytes(), 0u);
+  EXPECT_EQ(cp.dropped_records(), 1u);
+}
+
+namespace {
+
+// A checkpoint of 38 records (cells 0..37 of 40, sets of varying size), as bytes; `ends[i]` is
+// the file size after record i.
+std::string checkpoint_of_38(const std::string& path, std::vector<size_t>& ends,
+                             std::vector<std::vector<uint32_t>>& sets) {
+  sets.clear();
+  ends.clear();
+  {
+    Checkpoint cp(path, 77, 40, false);
+    for (uint32_t c = 0; c < 38; ++c) {
+      std::vector<uint32_t> ids;
+      for (uint32_t i = 0; i < 3 + (c * 7) % 20; ++i) ids.push_back(c + 10 * i);
+      cp.append(c, ids);
+      sets.push_back(ids);
+      ends.push_back(std::filesystem::file_size(path));
+    }
+  }
+  return read_file(path);
+}
+
+}  // namespace
+
+// Issue 18: one flipped byte at a quarter of a 38-record checkpoint used to drop the valid records
+// after it. Now only the damaged record is dropped (skipped by its size field), whatever byte of
+// it is hit, and appending continues after the last record.
+TEST(Checkpoint, FlippedByteAtAQuarterKeepsEveryOtherRecord) {
+  std::string dir = temp_dir("checkpoint_flip");
+  std::string path = dir + "/c.ckpt";
+  std::vector<size_t> ends;
+  std::vector<std::vector<uint32_t>> sets;
+  const std::string full = checkpoint_of_38(path, ends, sets);
+  const size_t quarter = full.size() / 4;
+  size_t hit = 0;  // the record holding byte `quarter`
+  while (ends[hit] <= quarter) ++hit;
+  const size_t rec_start = hit == 0 ? 24 : ends[hit - 1];
+  // The byte at a quarter, then every byte of that record (size field, cell id, payload, CRC).
+  std::vector<size_t> where = {quarter};
+  for (size_t b = rec_start; b < ends[hit]; ++b) where.push_back(b);
+  for (size_t at : where) {
+    std::string f = full;
+    f[at] ^= 0x5a;
+    write_file_atomic(path, f);
+    std::vector<std::optional<std::vector<uint32_t>>> got;
+    Checkpoint cp(path, 77, 40, true, &got, 1000);
+    EXPECT_EQ(cp.recovered_records(), 37u) << "byte " << at;
+    EXPECT_EQ(cp.dropped_records(), 1u) << "byte " << at;
+    EXPECT_EQ(cp.discarded_bytes(), ends[hit] - rec_start) << "byte " << at;
+    for (uint32_t c = 0; c < 38; ++c) {
+      if (c == hit) {
+        EXPECT_FALSE(got[c]) << "byte " << at;
+      } else {
+        ASSERT_TRUE(got[c]) << "byte " << at << " cell " << c;
+        EXPECT_EQ(*got[c], sets[c]);
+      }
+    }
+    // The damaged cell is baked again and appended; a second reopen finds all 38.
+    cp.append(uint32_t(hit), sets[hit]);
+    std::vector<std::optional<std::vector<uint32_t>>> again;
+    Checkpoint reread(path, 77, 40, true, &again, 1000);
+    EXPECT_EQ(reread.recovered_records(), 38u) << "byte " << at;
+    EXPECT_EQ(again[hit], sets[hit]);
+  }
+}
+
+TEST(Checkpoint, SecondOpenOfTheSameCheckpointIsRefused) {
+  std::string dir = temp_dir("checkpoint_lock");
+  std::string path = dir + "/c.ckpt";
+  Checkpoint first(path, 1, 4, false);
+  first.append(0, {1});
+  EXPECT_THROW(Checkpoint(path, 1, 4, true), InputError);
+  EXPECT_THROW(Checkpoint(path, 1, 4, false), InputError);
+  // The refused opens did not truncate or cut the holder's file.
+  std::vector<std::optional<std::vector<uint32_t>>> got;
+  first.append(1, {2});
+  first.remove();
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// The streamed output (blocks written as cells finish, index patched at the end) holds exactly the
+// bytes pvs::write_pvs gives for every cell's set, for the whole bake and for a shard.
+TEST(Bake, StreamedFileEqualsWritePvsOfEveryCellsSet) {
+  Scene scene = small_city();
+  ViewCells cells = small_grid();
+  std::string dir = temp_dir("bake_stream");
+  pvs::FileInfo info = bake_file_info(scene, cells, settings());
+  std::vector<pvs::CellSet> sets(cells.layout.cell_count());
+  for (uint32_t c = 0; c < sets.size(); ++c)
+    sets[c] = bake_cell(scene, cells.layout, c, settings());
+  EXPECT_EQ(bake_bytes(scene, cells, settings(), dir + "/all.pvs", {}, 2),
+            pvs::write_pvs(info, sets));
+  info.partial = true;
+  for (uint32_t c = 0; c < sets.size(); ++c)
+    if (!in_shard(c, {1, 3})) sets[c].reset();
+  EXPECT_EQ(bake_bytes(scene, cells, settings(), dir + "/s1.pvs", {1, 3}, 2),
+            pvs::write_pvs(info, sets));
+}
+
+TEST(Bake, RefusedWhileAnotherBakeHoldsTheOutputLock) {
+  Scene scene = small_city();
+  std::string dir = temp_dir("bake_lock");
+  std::string out = dir + "/x.pvs";
+  {
+    FileLock other(out + ".lock", "the output");
+    EXPECT_THROW(bake(scene, small_grid(), settings(), {}, {out, out + ".ckpt", false}),
+                 InputError);
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  bake(scene, small_grid(), settings(), {}, {out, out + ".ckpt", false});
+  EXPECT_TRUE(std::filesystem::exists(out));
 }
 
 TEST(SceneFingerprint, ChangesWithAnyVertexIndexOrObjectButNotWithNames) {

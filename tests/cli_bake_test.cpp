@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -198,4 +199,41 @@ TEST(CliBake, InspectRejectsAnotherScenesPvsAndDamagedFiles) {
   ASSERT_EQ(run_pvs("inspect " + dir + "/damaged.pvs", &out), 2) << out;
   EXPECT_NE(out.find("checksum mismatch"), std::string::npos) << out;
   EXPECT_NE(out.find("damaged.pvs"), std::string::npos) << out;
+}
+
+// Two bakes of one output cannot run together: while another process holds OUTPUT.lock (as a
+// running bake does), `pvs bake` exits 2 saying so, and touches neither output nor checkpoint.
+TEST(CliBake, SecondConcurrentBakeOfTheSameOutputIsRefused) {
+  std::string dir = temp_dir("cli_bake_lock");
+  std::string out = dir + "/busy.pvs", text;
+  {
+    vislib::FileLock running(out + ".lock",
+                             "the output " + out);  // this process plays the first bake
+    EXPECT_EQ(run_pvs(grid_bake(out), &text), 2) << text;
+    EXPECT_NE(text.find("locked by another process"), std::string::npos) << text;
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_FALSE(std::filesystem::exists(out + ".ckpt"));
+    EXPECT_EQ(run_pvs(grid_bake(out) + " --resume", &text), 2) << text;
+  }
+  // Once released (and the lock file removed), the bake runs.
+  EXPECT_FALSE(std::filesystem::exists(out + ".lock"));
+  EXPECT_EQ(run_pvs(grid_bake(out), &text), 0) << text;
+  EXPECT_FALSE(std::filesystem::exists(out + ".lock"));
+}
+
+// Two resumes cannot append to one checkpoint: the checkpoint is locked too, even when the two
+// runs write different outputs.
+TEST(CliBake, SecondResumeOfALockedCheckpointIsRefused) {
+  std::string dir = temp_dir("cli_bake_ckpt_lock");
+  std::string ckpt = dir + "/shared.ckpt", text;
+  int fd = ::open(ckpt.c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // as a running bake holds it
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/other.pvs") + " --resume --checkpoint " + ckpt, &text), 2)
+      << text;
+  EXPECT_NE(text.find("checkpoint is locked"), std::string::npos) << text;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/other.pvs"));
+  ::close(fd);
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/other.pvs") + " --resume --checkpoint " + ckpt, &text), 0)
+      << text;
 }

@@ -339,7 +339,7 @@ TEST(SceneInfo, CountsDuplicatesNonFiniteAndOutOfRange) {
     EXPECT_TRUE(j.contains(key)) << key;
 }
 
-TEST(ImportMesh, OffThroughOpenMeshKeepsFaceOrder) {
+TEST(ImportMesh, OffKeepsFaceOrder) {
   std::string dir = temp_dir("off_ok");
   std::string path = write_text(dir + "/q.off",
                                 "OFF\n5 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n3 0 1 2\n4 1 3 4 2\n");

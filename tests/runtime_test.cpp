@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -298,4 +300,92 @@ TEST(Runtime, LooksUpCellsOfABakedCity) {
   std::snprintf(fp_hex, sizeof fp_hex, "%016llx", static_cast<unsigned long long>(fp));
   EXPECT_EQ(run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs " + fp_hex + " --frames 50"), 0);
   EXPECT_NE(run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs 0123 --frames 50"), 0);
+}
+
+namespace {
+
+// A small box-list file: 40 random boxes (the layout whose lookup converts coordinates to bucket
+// indices).
+std::string box_list_file(const std::string& dir) {
+  pvs::FileInfo info;
+  info.scene_fingerprint = kScene;
+  info.universe = 10;
+  info.layout.kind = pvs::LayoutKind::Boxes;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> pos(-20, 20), side(0.5, 4);
+  for (int i = 0; i < 40; ++i) {
+    pvs::Box b;
+    for (int k = 0; k < 3; ++k) {
+      b.min[k] = pos(rng);
+      b.max[k] = b.min[k] + side(rng);
+    }
+    info.layout.boxes.push_back(b);
+  }
+  std::string path = dir + "/boxes.pvs";
+  write_file(path, pvs::write_pvs(info, std::vector<pvs::CellSet>(40, std::vector<uint32_t>{2})));
+  return path;
+}
+
+}  // namespace
+
+// NaN and infinite positions are rejected before any conversion (UBSan flagged the cast of NaN to
+// int in the box-list bucket lookup); huge finite ones are simply outside every cell.
+TEST(RuntimeC, FindCellRejectsNonFinitePositionsOnBothLayouts) {
+  std::string dir = temp_dir("c_nonfinite");
+  write_file(dir + "/grid.pvs", make_grid_file().bytes);
+  for (std::string path : {dir + "/grid.pvs", box_list_file(dir)}) {
+    pvs_rt* h = nullptr;
+    ASSERT_EQ(pvs_rt_open(path.c_str(), 0, 0, &h), PVS_RT_OK) << pvs_rt_last_error();
+    const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+    uint32_t cell = 77;
+    for (double bad : {nan, inf, -inf}) {
+      for (int k = 0; k < 3; ++k) {
+        double p[3] = {1, 1, 1};
+        p[k] = bad;
+        EXPECT_EQ(pvs_rt_find_cell(h, p, &cell), PVS_RT_INVALID_ARGUMENT) << path << " axis " << k;
+        EXPECT_NE(std::string(pvs_rt_last_error()).find("not finite"), std::string::npos);
+      }
+    }
+    for (double far : {1e300, -1e300, 3e9}) {
+      double p[3] = {far, far, far};
+      EXPECT_EQ(pvs_rt_find_cell(h, p, &cell), PVS_RT_NOT_FOUND) << path;
+    }
+    EXPECT_EQ(cell, 77u);
+    pvs_rt_close(h);
+  }
+}
+
+TEST(RuntimeC, InfiniteMarginMakesEveryOtherCellANeighbour) {
+  std::string dir = temp_dir("c_inf_margin");
+  write_file(dir + "/grid.pvs", make_grid_file().bytes);
+  for (std::string path : {dir + "/grid.pvs", box_list_file(dir)}) {
+    pvs_rt* h = nullptr;
+    ASSERT_EQ(pvs_rt_open(path.c_str(), 0, 0, &h), PVS_RT_OK) << pvs_rt_last_error();
+    pvs_rt_info info;
+    ASSERT_EQ(pvs_rt_get_info(h, &info), PVS_RT_OK);
+    std::vector<uint32_t> out(info.cell_count);
+    for (uint32_t c : {0u, 5u, info.cell_count - 1}) {
+      size_t count = 0;
+      ASSERT_EQ(pvs_rt_neighbours(h, c, std::numeric_limits<double>::infinity(), out.data(),
+                                  out.size(), &count),
+                PVS_RT_OK)
+          << pvs_rt_last_error();
+      ASSERT_EQ(count, size_t(info.cell_count - 1)) << path << " cell " << c;
+      for (uint32_t i = 0, k = 0; i < info.cell_count; ++i)
+        if (i != c) EXPECT_EQ(out[k++], i);
+      // A huge finite margin reaches every cell too; NaN is an invalid argument.
+      ASSERT_EQ(pvs_rt_neighbours(h, c, 1e308, out.data(), out.size(), &count), PVS_RT_OK);
+      EXPECT_EQ(count, size_t(info.cell_count - 1));
+      EXPECT_EQ(pvs_rt_neighbours(h, c, std::nan(""), out.data(), out.size(), &count),
+                PVS_RT_INVALID_ARGUMENT);
+    }
+    pvs_rt_close(h);
+  }
+}
+
+TEST(RuntimeC, StatusNameOfAnUnknownValueIsUnknown) {
+  EXPECT_STREQ(pvs_rt_status_name(PVS_RT_OK), "ok");
+  EXPECT_STREQ(pvs_rt_status_name(PVS_RT_INTERNAL), "internal");
+  for (int v : {-1, 10, 16, 1000, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()})
+    EXPECT_STREQ(pvs_rt_status_name(v), "unknown") << v;
 }

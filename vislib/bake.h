@@ -59,6 +59,9 @@ struct BakeFiles {
   std::string output;      // the PVS file (a partial file when sharded); written atomically
   std::string checkpoint;  // checkpoint file, "" for none; deleted once `output` is in place
   bool resume = false;     // continue from `checkpoint` if it exists
+  // Hold an exclusive lock on `output`.lock (FileLock, file_util.h) for the whole bake, so that a
+  // second bake of the same output is refused. false if the caller holds that lock already.
+  bool lock = true;
 };
 
 struct BakeReport {
@@ -67,15 +70,23 @@ struct BakeReport {
   uint32_t resumed = 0;      // taken from the checkpoint
   uint32_t baked = 0;        // computed in this run
   std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
-  double seconds = 0;        // wall time of this run's baking
-  pvs::WriteStats stats;     // sizes of the written file
+  double seconds = 0;                // wall time of this run's baking
+  pvs::WriteStats stats;             // sizes of the written file
+  // Damaged records skipped (and a torn tail) when the checkpoint was reopened, and their bytes.
+  size_t checkpoint_dropped_records = 0;
+  uint64_t checkpoint_dropped_bytes = 0;
 };
 
-// Bakes the cells of `shard` in parallel (TBB over cells; the kernel is parallel inside too),
-// records each finished cell in the checkpoint before counting it done, writes `files.output`
-// through a temporary file renamed into place, then deletes the checkpoint. Throws InputError for
-// a checkpoint of another bake, std::runtime_error on I/O failure (the checkpoint is kept).
-BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,
-                const BakeFiles& files, const BakeProgressFn& progress = {});
+// Bakes the cells of `shard` in parallel (a TBB pipeline over cells; the kernel is parallel inside
+// too), records each finished cell in the checkpoint before counting it done, and streams the
+// blocks to a temporary file in cell order as cells finish (index and header patched at the end;
+// pvs::StreamWriter), renamed over `files.output` once complete; then deletes the checkpoint.
+// Memory: the cells in flight (4 per thread at most) and the delta references of StreamWriter,
+// plus O(cells) bytes of index and timings; not the sets of all cells (on resume, the recovered
+// cells are held until written). Throws InputError for a checkpoint of another bake or a bake
+// already running on the output or checkpoint (locks), std::runtime_error on I/O failure (the
+// checkpoint is kept).
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
+                Shard shard, const BakeFiles& files, const BakeProgressFn& progress = {});
 
 }  // namespace vislib

@@ -563,6 +563,115 @@ void check_extensions(const Ctx& ctx) {
                               "geometry that relies on it is missing");
 }
 
+// --- External resources stay inside the asset's folder (issue 18) -------------------------------
+// A buffer or image `uri` that is not a data URI names a file relative to the folder of the .gltf
+// or .glb. tinygltf would open whatever it names ("../../../../etc/hostname", "/etc/passwd", a
+// symbolic link to anywhere) and its error would echo the size of that file. We reject, before
+// tinygltf sees the document, a uri that is absolute, has a `..` component (after tinygltf's own
+// %-decoding, '+' as a space), or resolves through a symbolic link to a file outside the folder;
+// the message names the uri only. tinygltf's file callbacks enforce the same containment again on
+// the path it actually opens.
+
+// tinygltf 2.7's URI decoding (dlib::urldecode): '+' is a space, %XX a byte.
+std::string decode_uri(const std::string& s) {
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+  };
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '+') {
+      out += ' ';
+    } else if (s[i] == '%' && s.size() > i + 2) {
+      out += char((hex(s[i + 1]) << 4) | hex(s[i + 2]));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+// The canonical asset folder (symbolic links resolved), or "" if it cannot be resolved.
+std::filesystem::path asset_folder(const std::string& path) {
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  std::filesystem::path real = std::filesystem::canonical(dir, ec);
+  return ec ? std::filesystem::path() : real;
+}
+
+// True if `p` (an existing file or not) resolves to a path inside `root` (canonical).
+bool resolves_inside(const std::filesystem::path& root, const std::filesystem::path& p) {
+  std::error_code ec;
+  std::filesystem::path real = std::filesystem::weakly_canonical(p, ec);
+  if (ec || root.empty()) return false;
+  std::filesystem::path rel = real.lexically_relative(root);
+  return !rel.empty() && *rel.begin() != ".." && !rel.is_absolute();
+}
+
+void check_external_uris(const Ctx& ctx) {
+  const std::filesystem::path root = asset_folder(ctx.path);
+  for (const char* kind : {"buffers", "images"}) {
+    if (!ctx.doc.contains(kind) || !ctx.doc[kind].is_array()) continue;
+    const json& list = ctx.doc[kind];
+    for (size_t i = 0; i < list.size(); ++i) {
+      if (!list[i].is_object() || !list[i].contains("uri") || !list[i]["uri"].is_string()) continue;
+      const std::string uri = list[i]["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0) continue;
+      std::string who = std::string(kind).substr(0, std::strlen(kind) - 1) + " " +
+                        std::to_string(i) + ": uri '" + uri.substr(0, 200) + "'";
+      const std::string decoded = decode_uri(uri);
+      std::filesystem::path rel(decoded);
+      if (decoded.empty()) ctx.fail(who + " is empty");
+      if (decoded.find('\0') != std::string::npos) ctx.fail(who + " contains a NUL byte");
+      if (rel.is_absolute() || rel.has_root_name() || rel.has_root_directory())
+        ctx.fail(who + " is an absolute path: external files must lie in the asset's folder");
+      for (const auto& part : rel)
+        if (part == "..") ctx.fail(who + " leaves the asset's folder ('..' is not allowed)");
+      if (!resolves_inside(root, root / rel))
+        ctx.fail(who + " resolves (through a symbolic link) outside the asset's folder");
+    }
+  }
+}
+
+// tinygltf file callbacks: only files that resolve inside the asset folder (user data) are seen.
+bool fs_file_exists(const std::string& abs, void* root) {
+  const auto& r = *static_cast<const std::filesystem::path*>(root);
+  std::error_code ec;
+  return resolves_inside(r, abs) && std::filesystem::is_regular_file(abs, ec);
+}
+
+std::string fs_expand(const std::string& p, void*) {
+  return p;
+}
+
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& abs,
+             void* root) {
+  const auto& r = *static_cast<const std::filesystem::path*>(root);
+  std::error_code ec;
+  std::filesystem::path real = std::filesystem::canonical(abs, ec);
+  if (ec || !resolves_inside(r, real) || !std::filesystem::is_regular_file(real, ec)) {
+    if (err) *err += "external file outside the asset's folder or not a regular file\n";
+    return false;
+  }
+  try {
+    std::string bytes = read_file(real.string());
+    out->assign(bytes.begin(), bytes.end());
+  } catch (const std::exception&) {
+    if (err) *err += "cannot read an external file\n";
+    return false;
+  }
+  return true;
+}
+
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is not allowed\n";
+  return false;
+}
+
 // Parses the container, rewrites meshopt fallback buffers and hands the file to tinygltf.
 void parse_file(Ctx& ctx) {
   const std::string bytes = read_file(ctx.path);
@@ -613,8 +722,12 @@ void parse_file(Ctx& ctx) {
   for (const auto& v : ctx.doc["bufferViews"])
     if (!v.is_object()) ctx.fail("invalid glTF: a bufferView is not an object");
 
+  check_external_uris(ctx);
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(image_loader_noop, nullptr);
+  const std::filesystem::path root = asset_folder(ctx.path);
+  loader.SetFsCallbacks({&fs_file_exists, &fs_expand, &fs_read, &fs_write,
+                         const_cast<std::filesystem::path*>(&root)});
   std::string err, warn, text = ctx.doc.dump();
   std::string base = std::filesystem::path(ctx.path).parent_path().string();
   bool ok;
