@@ -9,7 +9,7 @@
 #   bash scripts/fuzz.sh merge [TARGET]   # minimise seeds + new inputs into fuzz/corpus/<name>
 #
 # Before fuzzing, every seed (the issue-18 repros among them) is run once through its target, and
-# when ../shared/repros and build/pvs exist, `pvs info` must exit 2 on each repro.
+# when ../shared/repros and build/cli/pvs exist, `pvs info` must exit 2 on each repro.
 # Needs clang++ and the libFuzzer runtime (Debian: clang, libclang-rt-14-dev), and for the scene
 # loaders the Debian packages of tinygltf, meshoptimizer and nlohmann-json (as vislib itself).
 set -euo pipefail
@@ -44,11 +44,11 @@ if [[ $mode == merge ]]; then
 fi
 
 # The repros of issue 18 through the CLI: exit 2 with a message, quickly.
-if [[ -d ../shared/repros && -x build/pvs ]]; then
+if [[ -d ../shared/repros && -x build/cli/pvs ]]; then
   for f in ../shared/repros/ply-*.ply ../shared/repros/off-oom.off; do
     [[ -e $f ]] || continue
     t0=$(date +%s%N)
-    rc=0; msg=$(timeout 10 build/pvs info "$f" 2>&1 >/dev/null) || rc=$?
+    rc=0; msg=$(timeout 10 build/cli/pvs info "$f" 2>&1 >/dev/null) || rc=$?
     ms=$(( ($(date +%s%N) - t0) / 1000000 ))
     [[ $rc == 2 ]] || { echo "fuzz: repro $f: exit $rc (expected 2) after $ms ms: $msg"; exit 1; }
     echo "fuzz: repro $(basename "$f"): exit 2 in $ms ms: $msg"
