@@ -9,6 +9,9 @@
 
 #include "vislib/error.h"
 
+// Under AddressSanitizer the sanitizer's own operator new stays (it checks new/delete pairing).
+#if !defined(__SANITIZE_ADDRESS__)
+
 void* operator new(std::size_t size) {
   if (size == 0) size = 1;
   while (true) {
@@ -60,3 +63,5 @@ void operator delete(void* p, const std::nothrow_t&) noexcept {
 void operator delete[](void* p, const std::nothrow_t&) noexcept {
   std::free(p);
 }
+
+#endif  // !__SANITIZE_ADDRESS__

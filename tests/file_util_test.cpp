@@ -129,3 +129,30 @@ TEST(FileLock, SecondHolderIsRefusedAndTheLockFileGoesAway) {
   EXPECT_THROW(FileLock(link, "x"), std::runtime_error);
   EXPECT_FALSE(fs::exists(dir + "/target"));
 }
+
+// error.h: a std::bad_alloc crossing a stage boundary becomes OutOfMemory naming the stage and the
+// size of the failed request (recorded by the `pvs` executable's operator new); an inner stage's
+// OutOfMemory passes through outer stages unchanged.
+TEST(OutOfMemory, StageAndRequestSizeAreNamed) {
+  record_failed_allocation(3u << 30);
+  try {
+    with_memory_stage("loading city.glb", []() -> int { throw std::bad_alloc(); });
+    FAIL() << "no exception";
+  } catch (const OutOfMemory& e) {
+    std::string what = e.what();
+    EXPECT_EQ(e.stage(), "loading city.glb");
+    EXPECT_EQ(e.requested_bytes(), size_t(3) << 30);
+    EXPECT_NE(what.find("out of memory while loading city.glb"), std::string::npos) << what;
+    EXPECT_NE(what.find("3072.0 MiB"), std::string::npos) << what;
+  }
+  try {
+    with_memory_stage("baking", [] {
+      with_memory_stage("baking cell 7 of 9", []() -> int { throw std::bad_alloc(); });
+    });
+    FAIL() << "no exception";
+  } catch (const OutOfMemory& e) {
+    EXPECT_EQ(e.stage(), "baking cell 7 of 9");
+  }
+  EXPECT_EQ(with_memory_stage("a stage", [] { return 42; }), 42);
+  record_failed_allocation(0);
+}

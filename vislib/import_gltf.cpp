@@ -168,6 +168,11 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
              ") exceed buffer " + std::to_string(buffer) + " of " + std::to_string(data.size()) + " bytes");
   if (stride == 0 || stride > 256 || count > (uint64_t(1) << 31) / stride)
     ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " + std::to_string(count));
+  // meshoptimizer's codecs compress at most 64:1 (2 header bits per 16 bytes of zero deltas):
+  // a larger claim is rejected before the output is allocated (issue 18: memory amplification).
+  if (count * stride > 128 * length + 4096)
+    ctx.fail(who + std::to_string(count) + " elements of " + std::to_string(stride) + " bytes cannot come from " +
+             std::to_string(length) + " compressed bytes");
   auto& out = ctx.decoded[view];
   out.assign(size_t(count * stride), 0);
   const unsigned char* src = data.data() + offset;
@@ -303,6 +308,21 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
     ctx.fail(who + ": unexpected type with " + std::to_string(ncomp) + " components");
   if (a.count > (size_t(1) << 28))
     ctx.fail(who + ": count " + std::to_string(a.count) + " is too large");
+  // Bound the count by the data before allocating (issue 18): with a bufferView, the elements must
+  // fit in it (checked exactly by read_elements); without one (zeros, maybe sparse), at most 2^24
+  // values, so that a small file cannot ask for gigabytes.
+  if (a.bufferView >= 0 && a.count > 0) {
+    Bytes b = view_bytes(ctx, a.bufferView, who);
+    size_t esize = size_t(component_size(a.componentType)) * size_t(ncomp);
+    size_t stride = size_t(a.bufferView) < ctx.model.bufferViews.size() ? ctx.model.bufferViews[a.bufferView].byteStride : 0;
+    if (stride < esize) stride = esize;
+    if (a.byteOffset > b.size || b.size - a.byteOffset < esize || a.count - 1 > (b.size - a.byteOffset - esize) / stride)
+      ctx.fail(who + ": " + std::to_string(a.count) + " elements of " + std::to_string(esize) + " bytes (stride " +
+               std::to_string(stride) + ") from byte " + std::to_string(a.byteOffset) + " do not fit in bufferView " +
+               std::to_string(a.bufferView) + " (" + std::to_string(b.size) + " bytes)");
+  } else if (a.bufferView < 0 && a.count * size_t(ncomp) > (size_t(1) << 24)) {
+    ctx.fail(who + ": " + std::to_string(a.count) + " elements without a bufferView (more than 2^24 values)");
+  }
   std::vector<double> out(a.count * size_t(ncomp), 0.0);
   if (a.bufferView >= 0) {
     size_t stride = ctx.model.bufferViews.size() > size_t(a.bufferView)
@@ -674,10 +694,14 @@ bool fs_write(std::string* err, const std::string&, const std::vector<unsigned c
 
 // Parses the container, rewrites meshopt fallback buffers and hands the file to tinygltf.
 void parse_file(Ctx& ctx) {
-  const std::string bytes = read_file(ctx.path);
+  // Memory (issue 18: a 200 MB .glb peaked at 1.29 GB): the file is read once and the GLB handed to
+  // tinygltf is rebuilt inside the same string (the BIN chunk is never copied); tinygltf's own copy
+  // of the BIN chunk is the only other one.
+  std::string bytes = read_file(ctx.path);
   bool glb = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
-  std::string json_text, bin;
+  std::string json_text;
   bool has_bin = false;
+  size_t bin_at = 0, bin_len = 0;  // the BIN chunk's payload in `bytes`
   if (glb) {
     if (bytes.size() < 20)
       ctx.fail("truncated .glb: " + std::to_string(bytes.size()) + " bytes, less than a GLB header");
@@ -694,16 +718,18 @@ void parse_file(Ctx& ctx) {
                  " declares " + std::to_string(clen) + " bytes, past the end of the file");
       if (chunk == 0 && ctype != 0x4E4F534Au) ctx.fail("malformed .glb: the first chunk is not JSON");
       if (chunk == 0) json_text = bytes.substr(at + 8, clen);
-      if (chunk == 1 && ctype == 0x004E4942u) bin = bytes.substr(at + 8, clen), has_bin = true;
+      if (chunk == 1 && ctype == 0x004E4942u) bin_at = at + 8, bin_len = clen, has_bin = true;
       at += 8 + size_t(clen);
       at = (at + 3) & ~size_t(3);
     }
     if (at == 12) ctx.fail("malformed .glb: no JSON chunk");
   } else {
-    json_text = bytes;
+    json_text.swap(bytes);
   }
   try {
     ctx.doc = json::parse(json_text);
+    json_text.clear();
+    json_text.shrink_to_fit();
   } catch (const json::exception& e) {
     ctx.fail(std::string("invalid JSON: ") + e.what());
   }
@@ -733,23 +759,32 @@ void parse_file(Ctx& ctx) {
   bool ok;
   try {
     if (glb) {
-      std::string out(12, '\0');
-      auto put = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+      // [header 12][JSON chunk header 8][text][BIN chunk header 8][BIN], built in `bytes`: the
+      // part before the BIN payload is replaced, what follows the BIN chunk is cut.
       while (text.size() % 4) text += ' ';
-      put(uint32_t(text.size()));
-      put(0x4E4F534Au);
-      out += text;
+      std::string head(12, '\0');
+      auto put = [](std::string& o, uint32_t v) { o.append(reinterpret_cast<const char*>(&v), 4); };
+      put(head, uint32_t(text.size()));
+      put(head, 0x4E4F534Au);
+      head += text;
       if (has_bin) {
-        while (bin.size() % 4) bin += '\0';
-        put(uint32_t(bin.size()));
-        put(0x004E4942u);
-        out += bin;
+        size_t padded = (bin_len + 3) & ~size_t(3);
+        put(head, uint32_t(padded));
+        put(head, 0x004E4942u);
+        bytes.resize(bin_at + bin_len);
+        bytes.replace(0, bin_at, head);
+        bytes.resize(head.size() + padded, '\0');
+      } else {
+        bytes.swap(head);
       }
-      uint32_t head[3] = {0x46546C67u, 2u, uint32_t(out.size())};
-      std::memcpy(&out[0], head, 12);
+      text.clear();
+      text.shrink_to_fit();
+      if (bytes.size() > 0xFFFFFFFFu) ctx.fail(".glb larger than 4 GiB");
+      uint32_t header[3] = {0x46546C67u, 2u, uint32_t(bytes.size())};
+      std::memcpy(&bytes[0], header, 12);
       ok = loader.LoadBinaryFromMemory(&ctx.model, &err, &warn,
-                                       reinterpret_cast<const unsigned char*>(out.data()),
-                                       unsigned(out.size()), base);
+                                       reinterpret_cast<const unsigned char*>(bytes.data()),
+                                       unsigned(bytes.size()), base);
     } else {
       ok = loader.LoadASCIIFromString(&ctx.model, &err, &warn, text.c_str(), unsigned(text.size()), base);
     }
@@ -905,6 +940,30 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
 
   Scene scene;
   scene.positions.resize(K);
+  // Memory: the scene's arrays are reserved from the accessor counts (an upper bound: skipped
+  // primitives are counted too), so they never grow by doubling; a decoded mesh is released after
+  // its last instance.
+  std::vector<size_t> uses(model.meshes.size(), 0);
+  size_t vertex_bound = 0, triangle_bound = 0;
+  for (int n : instances) {
+    const auto& mesh = model.meshes[size_t(model.nodes[n].mesh)];
+    ++uses[size_t(model.nodes[n].mesh)];
+    for (const auto& prim : mesh.primitives) {
+      auto count = [&](int acc) {
+        return acc >= 0 && size_t(acc) < model.accessors.size() ? model.accessors[size_t(acc)].count : size_t(0);
+      };
+      auto pos = prim.attributes.find("POSITION");
+      size_t nv = pos == prim.attributes.end() ? 0 : count(pos->second);
+      size_t ni = prim.indices >= 0 ? count(prim.indices) : nv;
+      vertex_bound += nv;
+      triangle_bound += prim.mode == 4 || prim.mode == -1 ? ni / 3 : prim.mode == 5 || prim.mode == 6 ? ni : 0;
+    }
+  }
+  if (vertex_bound < (size_t(1) << 32) && triangle_bound < (size_t(1) << 32)) {
+    for (auto& state : scene.positions) state.reserve(vertex_bound);
+    scene.triangles.reserve(triangle_bound);
+    scene.triangle_object.reserve(triangle_bound);
+  }
   std::vector<std::vector<Prim>> mesh_cache(model.meshes.size());
   std::vector<char> mesh_cached(model.meshes.size(), 0);
   for (int n : instances) {
@@ -914,6 +973,14 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       mesh_cache[nd.mesh] = decode_mesh(ctx, nd.mesh, skinned);
       mesh_cached[nd.mesh] = 1;
     }
+    // Released at the end of this iteration if this is the mesh's last instance.
+    struct Release {
+      std::vector<Prim>& prims;
+      bool last;
+      ~Release() {
+        if (last) std::vector<Prim>().swap(prims);
+      }
+    } release{mesh_cache[nd.mesh], --uses[size_t(nd.mesh)] == 0};
     std::string name = !nd.name.empty() ? nd.name
                        : !model.meshes[nd.mesh].name.empty() ? model.meshes[nd.mesh].name
                                                              : "node" + std::to_string(n);
