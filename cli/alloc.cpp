@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <new>
 
-#include "vislib/error.h"
+#include "vislib/base/error.h"
 
 // Under AddressSanitizer the sanitizer's own operator new stays (it checks new/delete pairing).
 #if !defined(__SANITIZE_ADDRESS__)

@@ -17,8 +17,8 @@
 #include <filesystem>
 #include <string>
 
-#include "vislib/error.h"
-#include "vislib/import.h"
+#include "vislib/base/error.h"
+#include "vislib/scene/import.h"
 
 #ifndef VISLIB_FUZZ_EXT
 #error "define VISLIB_FUZZ_EXT, the file extension of the format to fuzz"

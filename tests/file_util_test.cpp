@@ -1,7 +1,7 @@
 // Tests of file_util.h: AtomicFile / write_file_atomic never follow a planted symbolic link, use
 // unpredictable exclusive temporaries, clean up stale temporaries of a killed writer, and FileLock
 // refuses a second holder.
-#include "vislib/file_util.h"
+#include "vislib/base/file_util.h"
 
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 #include <filesystem>
 
 #include "tests/test_support.h"
-#include "vislib/error.h"
+#include "vislib/base/error.h"
 
 using namespace vislib;
 using vislib_test::temp_dir;

@@ -8,8 +8,8 @@
 
 #include "tests/import_test_files.h"
 #include "tests/test_support.h"
-#include "vislib/error.h"
-#include "vislib/import.h"
+#include "vislib/base/error.h"
+#include "vislib/scene/import.h"
 
 using namespace vislib;
 using namespace vislib_test;

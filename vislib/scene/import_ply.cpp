@@ -16,9 +16,9 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "vislib/error.h"
-#include "vislib/file_util.h"
-#include "vislib/import_formats.h"
+#include "vislib/base/error.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/import_formats.h"
 #include "vislib/scene/mesh_reader_support.h"
 
 namespace vislib {

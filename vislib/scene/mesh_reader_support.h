@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "vislib/error.h"
-#include "vislib/scene.h"
+#include "vislib/base/error.h"
+#include "vislib/scene/scene.h"
 
 namespace vislib {
 namespace mesh_reader {
