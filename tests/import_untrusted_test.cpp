@@ -237,8 +237,9 @@ TEST(ImportGltfUris, UrisLeavingTheAssetFolderAreRejectedWithoutTouchingTheFile)
   std::string dir = top + "/asset";
   std::filesystem::create_directories(dir);
   write_text(top + "/secret.bin", std::string(36, 'S') + "SECRET");
-  for (std::string uri : {"../secret.bin", "%2e%2e/secret.bin", "sub/../../secret.bin",
-                          top + "/secret.bin", "../../../../../../../../etc/hostname"})
+  for (std::string uri :
+       std::vector<std::string>{"../secret.bin", "%2e%2e/secret.bin", "sub/../../secret.bin",
+                                top + "/secret.bin", "../../../../../../../../etc/hostname"})
     expect_uri_rejected(gltf_with_uri(dir, uri), uri);
   // A symbolic link inside the folder that points outside it.
   std::filesystem::create_symlink(top + "/secret.bin", dir + "/link.bin");
