@@ -7,6 +7,7 @@
 #include <new>
 #include <string>
 
+#include "runtime/c_api_support.h"
 #include "runtime/pvs_runtime.h"
 
 struct pvs_rt {
@@ -17,10 +18,7 @@ namespace {
 
 thread_local std::string g_last_error;  // per thread, so calls on distinct handles never race
 
-pvs_rt_status fail(pvs_rt_status s, const std::string& message) {
-  g_last_error = message;
-  return s;
-}
+using pvs_runtime::detail::fail;
 
 // Runs f() and maps exceptions to status codes.
 template <class F>
@@ -50,7 +48,26 @@ pvs_rt_status check_cell(const pvs_rt* h, uint32_t cell) {
   return PVS_RT_OK;
 }
 
+void put_u32(std::string& out, uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
+}
+void put_u64(std::string& out, uint64_t v) {
+  for (int i = 0; i < 8; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
+}
+void put_f64(std::string& out, double v) {
+  uint64_t bits;
+  std::memcpy(&bits, &v, 8);
+  put_u64(out, bits);
+}
+
 }  // namespace
+
+namespace pvs_runtime::detail {
+pvs_rt_status fail(pvs_rt_status s, const std::string& message) {
+  g_last_error = message;
+  return s;
+}
+}  // namespace pvs_runtime::detail
 
 extern "C" {
 
@@ -167,6 +184,95 @@ pvs_rt_status pvs_rt_prefetch(pvs_rt* h, uint32_t cell) {
   if (pvs_rt_status s = check_cell(h, cell)) return s;
   h->pvs.prefetch(cell);
   return PVS_RT_OK;
+}
+
+uint32_t pvs_rt_version(void) {
+  return VISLIB_VERSION;
+}
+
+const char* pvs_rt_version_string(void) {
+  return VISLIB_VERSION_STRING;
+}
+
+// The byte stream of docs/pvs-format.md, "The scene fingerprint" (the same stream as
+// vislib::scene_fingerprint, which the fingerprint test compares against), hashed in chunks.
+pvs_rt_status pvs_rt_scene_fingerprint(const pvs_rt_mesh* meshes, size_t mesh_count,
+                                       uint32_t state_count, uint32_t object_count,
+                                       uint64_t* fingerprint) {
+  if (!fingerprint || (mesh_count && !meshes))
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_scene_fingerprint: null argument");
+  if (state_count < 1)
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_scene_fingerprint: state_count must be >= 1");
+  uint64_t vertices = 0, triangles = 0;
+  for (size_t m = 0; m < mesh_count; ++m) {
+    const pvs_rt_mesh& mesh = meshes[m];
+    const std::string where = "pvs_rt_scene_fingerprint: mesh " + std::to_string(m) + ": ";
+    if (bool(mesh.positions_f32) == bool(mesh.positions_f64) && mesh.vertex_count)
+      return fail(PVS_RT_INVALID_ARGUMENT,
+                  where + "give exactly one of positions_f32 and positions_f64");
+    if (mesh.triangle_count && !mesh.indices)
+      return fail(PVS_RT_INVALID_ARGUMENT, where + "indices is null");
+    for (size_t t = 0; t < mesh.triangle_count; ++t) {
+      const uint32_t ob = mesh.triangle_objects ? mesh.triangle_objects[t] : mesh.object_id;
+      if (ob >= object_count)
+        return fail(PVS_RT_INVALID_ARGUMENT,
+                    where + "object " + std::to_string(ob) + " of triangle " + std::to_string(t) +
+                        " >= object_count " + std::to_string(object_count));
+      if (!mesh.triangle_objects) break;
+    }
+    for (size_t i = 0; i < 3 * mesh.triangle_count; ++i)
+      if (mesh.indices[i] >= mesh.vertex_count)
+        return fail(PVS_RT_INVALID_ARGUMENT, where + "index " + std::to_string(mesh.indices[i]) +
+                                                 " of triangle " + std::to_string(i / 3) +
+                                                 " >= vertex_count " +
+                                                 std::to_string(mesh.vertex_count));
+    vertices += mesh.vertex_count;
+    triangles += mesh.triangle_count;
+  }
+  if (vertices + triangles > 0 && vertices + mesh_count > (uint64_t(1) << 32))
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_scene_fingerprint: more than 2^32 vertices");
+  return guarded([&] {
+    static const char kTag[] = "vislib-scene-fingerprint-1";
+    std::string buf(kTag, sizeof kTag - 1);
+    // A scene without vertices has no state (vislib::Scene::positions is empty).
+    put_u64(buf, vertices ? state_count : 0);
+    put_u64(buf, vertices);
+    put_u64(buf, triangles);
+    put_u64(buf, object_count);
+    uint64_t hash = pvs::fnv1a64(buf.data(), buf.size());
+    const size_t kChunk = 1 << 16;
+    auto flush = [&](bool force) {
+      if (force || buf.size() >= kChunk) {
+        hash = pvs::fnv1a64(buf.data(), buf.size(), hash);
+        buf.clear();
+      }
+    };
+    buf.clear();
+    for (uint32_t s = 0; vertices && s < state_count; ++s) {
+      for (size_t m = 0; m < mesh_count; ++m) {
+        const pvs_rt_mesh& mesh = meshes[m];
+        const size_t base = 3 * size_t(s) * mesh.vertex_count;
+        for (size_t i = 0; i < 3 * mesh.vertex_count; ++i) {
+          put_f64(buf, mesh.positions_f64 ? mesh.positions_f64[base + i]
+                                          : double(mesh.positions_f32[base + i]));
+          flush(false);
+        }
+      }
+    }
+    uint32_t offset = 0;
+    for (size_t m = 0; m < mesh_count; ++m) {
+      const pvs_rt_mesh& mesh = meshes[m];
+      for (size_t t = 0; t < mesh.triangle_count; ++t) {
+        for (int k = 0; k < 3; ++k) put_u32(buf, offset + mesh.indices[3 * t + k]);
+        put_u32(buf, mesh.triangle_objects ? mesh.triangle_objects[t] : mesh.object_id);
+        flush(false);
+      }
+      offset += uint32_t(mesh.vertex_count);
+    }
+    flush(true);
+    *fingerprint = hash;
+    return PVS_RT_OK;
+  });
 }
 
 const char* pvs_rt_last_error(void) {

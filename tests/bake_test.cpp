@@ -7,6 +7,7 @@
 #include <tbb/global_control.h>
 
 #include <filesystem>
+#include <memory>
 
 #include "tests/test_support.h"
 #include "vislib/bake/checkpoint.h"
@@ -152,14 +153,15 @@ TEST(Checkpoint, TornAtAnyByteKeepsEveryCompleteRecord) {
   for (size_t n = 0; n <= full.size(); ++n) {
     write_file_atomic(path, full.substr(0, n));
     std::vector<std::optional<std::vector<uint32_t>>> got;
-    Checkpoint cp(path, 99, 10, true, &got, 5000);
+    auto cp = std::make_unique<Checkpoint>(path, 99, 10, true, &got, 5000);
     size_t complete = 0;
     while (complete + 1 < ends.size() && ends[complete + 1] <= n) ++complete;
     if (n < ends[0]) complete = 0;
-    EXPECT_EQ(cp.recovered_records(), complete) << "cut at " << n;
+    EXPECT_EQ(cp->recovered_records(), complete) << "cut at " << n;
     for (size_t i = 0; i < complete; ++i) EXPECT_EQ(got[2 * i], sets[i]) << "cut at " << n;
     // Appending after the cut continues a valid file.
-    cp.append(9, {42});
+    cp->append(9, {42});
+    cp.reset();  // release the checkpoint (and its lock) before reopening it
     std::vector<std::optional<std::vector<uint32_t>>> again;
     Checkpoint reread(path, 99, 10, true, &again, 5000);
     EXPECT_EQ(reread.recovered_records(), complete + 1) << "cut at " << n;
@@ -231,10 +233,10 @@ TEST(Checkpoint, FlippedByteAtAQuarterKeepsEveryOtherRecord) {
     f[at] ^= 0x5a;
     write_file_atomic(path, f);
     std::vector<std::optional<std::vector<uint32_t>>> got;
-    Checkpoint cp(path, 77, 40, true, &got, 1000);
-    EXPECT_EQ(cp.recovered_records(), 37u) << "byte " << at;
-    EXPECT_EQ(cp.dropped_records(), 1u) << "byte " << at;
-    EXPECT_EQ(cp.discarded_bytes(), ends[hit] - rec_start) << "byte " << at;
+    auto cp = std::make_unique<Checkpoint>(path, 77, 40, true, &got, 1000);
+    EXPECT_EQ(cp->recovered_records(), 37u) << "byte " << at;
+    EXPECT_EQ(cp->dropped_records(), 1u) << "byte " << at;
+    EXPECT_EQ(cp->discarded_bytes(), ends[hit] - rec_start) << "byte " << at;
     for (uint32_t c = 0; c < 38; ++c) {
       if (c == hit) {
         EXPECT_FALSE(got[c]) << "byte " << at;
@@ -244,7 +246,8 @@ TEST(Checkpoint, FlippedByteAtAQuarterKeepsEveryOtherRecord) {
       }
     }
     // The damaged cell is baked again and appended; a second reopen finds all 38.
-    cp.append(uint32_t(hit), sets[hit]);
+    cp->append(uint32_t(hit), sets[hit]);
+    cp.reset();  // release the checkpoint (and its lock) before reopening it
     std::vector<std::optional<std::vector<uint32_t>>> again;
     Checkpoint reread(path, 77, 40, true, &again, 1000);
     EXPECT_EQ(reread.recovered_records(), 38u) << "byte " << at;

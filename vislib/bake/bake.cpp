@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "vislib/bake/checkpoint.h"
+#include "vislib/bake/id_universe.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/scene_fingerprint.h"
@@ -25,10 +26,7 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
   info.scene_fingerprint = scene_fingerprint(scene);
   info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object
                                                                  : pvs::Granularity::Triangle;
-  // Triangle granularity: triangle ids, then sphere s as triangle_count + s.
-  info.universe = uint32_t(settings.granularity == Granularity::Object
-                               ? scene.objects.size()
-                               : scene.triangle_count() + scene.sphere_count());
+  info.universe = id_universe(scene, settings.granularity);  // the one id rule (bake/id_universe.h)
   info.layout = cells.layout;
   const SegmentOptions& s = settings.region.segment;
   nlohmann::json m = {
@@ -43,6 +41,8 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
       {"state", s.state},
       {"states", scene.state_count()},
       {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
+      {"coplanar", s.coplanar == CoplanarRule::First ? "first" : "both"},
+      {"eps_z", s.eps_z},
       {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
   info.metadata = m.dump();
   return info;
@@ -62,10 +62,7 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
                                 const BakeSettings& settings, double* seconds) {
   CellVisibility v = cell_visibility(scene, layout, cell, settings.region);
   if (seconds) *seconds = v.seconds;
-  if (settings.granularity == Granularity::Object) return objects_of(scene, v.triangles, v.spheres);
-  std::vector<uint32_t> ids = std::move(v.triangles);
-  for (uint32_t s : v.spheres) ids.push_back(uint32_t(scene.triangle_count() + s));
-  return ids;
+  return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
 BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
