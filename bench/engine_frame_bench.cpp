@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
                        0};
   pvs_rt_clovr* clovr = nullptr;
   pvs_rt_clovr_params params;
-  pvs_rt_clovr_default_params(1.0, &params);  // final radius set per cell below
+  pvs_rt_clovr_default_params(0.0, &params);  // final radius: the cell's r2, set below
   Stats all, entering, staying;
   uint32_t current = UINT32_MAX;
   double x = lo[0] + 1e-3, z = lo[2] + 0.5 * row_step, dir = 1;
@@ -135,9 +135,11 @@ int main(int argc, char** argv) {
       if ((s = pvs_rt_cell_near_far(pvs, cell, centre, &r1, &r2))) return fail("cell_near_far", s);
       if ((s = pvs_rt_partition_near_far(&g, ids.data(), n, centre, r1, r2, &part)))
         return fail("partition", s);
-      if (clovr) pvs_rt_clovr_destroy(clovr);
-      pvs_rt_clovr_default_params(r2, &params);
-      if ((s = pvs_rt_clovr_create(&g, &params, &clovr))) return fail("clovr_create", s);
+      if (!clovr || r2 != params.final_radius) {  // the scheduler is made once per cell size
+        if (clovr) pvs_rt_clovr_destroy(clovr);
+        pvs_rt_clovr_default_params(r2, &params);
+        if ((s = pvs_rt_clovr_create(&g, &params, &clovr))) return fail("clovr_create", s);
+      }
       if ((s = pvs_rt_clovr_start(clovr, ids.data(), n, centre))) return fail("clovr_start", s);
       ids_total += n;
     }
