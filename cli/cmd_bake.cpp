@@ -34,6 +34,8 @@ struct BakeArgs {
   double near = vislib::kDefaultNear, eps_len = vislib::kDefaultEpsLen;
   std::string granularity = "triangle";
   std::string mode = "diagonal";
+  std::string coplanar = "both";
+  double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
 };
 
@@ -150,8 +152,15 @@ void add_bake(CLI::App& app) {
                   "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))
       ->capture_default_str();
-  cmd->add_option("--granularity", a->granularity,
-                  "Store triangle ids (spheres after them) or object ids")
+  cmd->add_option("--coplanar", a->coplanar,
+                  "Depth ties: 'both' (within --eps-z) or 'first' (as for pvs segment)")
+      ->check(CLI::IsMember({"both", "first"}))
+      ->capture_default_str();
+  cmd->add_option("--eps-z", a->eps_z,
+                  "Depth tie tolerance, relative to the front depth (as for pvs segment)")
+      ->check(CLI::Range(0.0, 0.1))
+      ->capture_default_str();
+  cmd->add_option("--granularity", a->granularity, "Store triangle ids (spheres after them) or object ids")
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
   cmd->add_option("--threads", a->threads,
@@ -181,10 +190,8 @@ void add_bake(CLI::App& app) {
     }
     auto t0 = std::chrono::steady_clock::now();
     vislib::Scene scene = load_scene_for_cli(a->scene, a->states);
-    if (scene.sphere_count() > 0)
-      warn(a->scene + ": spheres are not handled by the static kernel; ignored");
-    if (scene.triangle_count() >= 0xFFFFFFFFull)
-      throw vislib::InputError(a->scene, "more than 2^32-1 triangles");
+    if (scene.triangle_count() + scene.sphere_count() >= 0xFFFFFFFFull)
+      throw vislib::InputError(a->scene, "more than 2^32-1 triangles and spheres");
     vislib::ViewCells cells = make_cells(*a, scene);
     double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     uint32_t n = cells.layout.cell_count();
@@ -220,6 +227,9 @@ void add_bake(CLI::App& app) {
         a->granularity == "object" ? vislib::Granularity::Object : vislib::Granularity::Triangle;
     s.region.segment.mode =
         a->mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
+    s.region.segment.coplanar =
+        a->coplanar == "first" ? vislib::CoplanarRule::First : vislib::CoplanarRule::Both;
+    s.region.segment.eps_z = a->eps_z;
     vislib::BakeFiles files{a->output, checkpoint, a->resume};
     vislib::BakeReport r = vislib::bake(scene, cells, s, shard, files, progress_printer());
 

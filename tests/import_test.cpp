@@ -313,6 +313,35 @@ TEST(ImportSpheres, MalformedLineNamesTheLineNumber) {
   }
 }
 
+// Issue 12 item 6: a `mesh` line adds a static mesh before the spheres (triangles first, then
+// spheres); a bad mesh line names the sphere file and its line.
+TEST(ImportSpheres, MeshLineAddsAGroundBeforeTheSpheres) {
+  std::string dir = temp_dir("spheres_mesh");
+  write_text(dir + "/ground.obj",
+             "o ground\nv -9 0 -9\nv 9 0 -9\nv 9 0 9\nv -9 0 9\nf 1 3 2\nf 1 4 3\n");
+  std::string path = write_text(dir + "/s.spheres",
+                                "vislib-spheres 1\nstates 2\nmesh ground.obj\n0.5 0 1 0 0 2 0\n");
+  Scene s = load(path);
+  EXPECT_EQ(s.triangle_count(), 2u);
+  ASSERT_EQ(s.sphere_count(), 1u);
+  EXPECT_EQ(s.state_count(), 2u);
+  EXPECT_EQ(s.objects.size(), 2u);
+  EXPECT_EQ(s.objects[s.sphere_object[0]].name, "sphere0");
+  EXPECT_EQ(s.sphere_center_at(0, 1.0), (Vec3{0, 2, 0}));
+  EXPECT_EQ(s.position_at(s.triangles[0][0], 1.0), (Vec3{-9, 0, -9}));
+  for (const char* bad : {"mesh missing.obj", "mesh a b", "mesh s.spheres"}) {
+    std::string p2 =
+        write_text(dir + "/bad.spheres", std::string("vislib-spheres 1\nstates 2\n") + bad + "\n");
+    try {
+      load(p2);
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.spheres"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+    }
+  }
+}
+
 TEST(Import, UnsupportedExtensionAndMissingFileThrowInputError) {
   std::string dir = temp_dir("import_misc");
   EXPECT_THROW(load(write_text(dir + "/a.fbx", "x")), InputError);
@@ -333,9 +362,9 @@ TEST(SceneInfo, CountsDuplicatesNonFiniteAndOutOfRange) {
   EXPECT_EQ(info.out_of_range_indices, 1u);
   EXPECT_EQ(info.degenerate_triangles, 1u);  // (0,1,3): zero area
   json j = json::parse(to_json(info));
-  for (const char* key : {"triangles", "objects", "states", "spheres", "bbox", "degenerate_triangles",
-                          "nonfinite_vertices", "duplicate_vertices", "out_of_range_indices",
-                          "units_guess"})
+  for (const char* key : {"triangles", "objects", "states", "spheres", "bbox",
+                          "degenerate_triangles", "nonfinite_vertices", "duplicate_vertices",
+                          "out_of_range_indices", "origin_offset", "far_from_origin"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 

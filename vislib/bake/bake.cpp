@@ -15,6 +15,7 @@
 #include "vislib/bake/checkpoint.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/bake/id_universe.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 namespace vislib {
@@ -24,23 +25,24 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const B
   pvs::FileInfo info;
   info.scene_fingerprint = scene_fingerprint(scene);
   info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object : pvs::Granularity::Triangle;
-  // Triangle granularity: triangle ids, then sphere s as triangle_count + s.
-  info.universe = uint32_t(settings.granularity == Granularity::Object ? scene.objects.size()
-                                                                        : scene.triangle_count() + scene.sphere_count());
+  info.universe = id_universe(scene, settings.granularity);  // the one id rule (bake/id_universe.h)
   info.layout = cells.layout;
   const SegmentOptions& s = settings.region.segment;
-  nlohmann::json m = {{"generator", "vislib pvs bake"},
-                      {"cells", nlohmann::json::parse(cells.description)},
-                      {"granularity", settings.granularity == Granularity::Object ? "object" : "triangle"},
-                      {"resolution", s.resolution},
-                      {"near", s.near},
-                      {"eps_len", s.eps_len},
-                      {"runs", settings.region.runs},
-                      {"seed", settings.region.seed},
-                      {"state", s.state},
-                      {"states", scene.state_count()},
-                      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
-                      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
+  nlohmann::json m = {
+      {"generator", "vislib pvs bake"},
+      {"cells", nlohmann::json::parse(cells.description)},
+      {"granularity", settings.granularity == Granularity::Object ? "object" : "triangle"},
+      {"resolution", s.resolution},
+      {"near", s.near},
+      {"eps_len", s.eps_len},
+      {"runs", settings.region.runs},
+      {"seed", settings.region.seed},
+      {"state", s.state},
+      {"states", scene.state_count()},
+      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
+      {"coplanar", s.coplanar == CoplanarRule::First ? "first" : "both"},
+      {"eps_z", s.eps_z},
+      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
   info.metadata = m.dump();
   return info;
 }
@@ -59,10 +61,7 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
                                 const BakeSettings& settings, double* seconds) {
   CellVisibility v = cell_visibility(scene, layout, cell, settings.region);
   if (seconds) *seconds = v.seconds;
-  if (settings.granularity == Granularity::Object) return objects_of(scene, v.triangles, v.spheres);
-  std::vector<uint32_t> ids = std::move(v.triangles);
-  for (uint32_t s : v.spheres) ids.push_back(uint32_t(scene.triangle_count() + s));
-  return ids;
+  return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
 BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,

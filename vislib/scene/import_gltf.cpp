@@ -761,6 +761,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
   double t_end = 0;
   for (const auto& c : channels) t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
   size_t K = options.states > 1 && !channels.empty() ? size_t(options.states) : 1;
+  if (options.states <= 1 && !model.animations.empty())
+    ctx.warnings->push_back(
+        ctx.path + ": " + std::to_string(model.animations.size()) +
+        " animation(s) ignored: loaded static, in the rest pose; sample them into key "
+        "states with --states K (e.g. --states 9)");
 
   // World matrices and morph weights of all nodes in each state.
   std::vector<std::vector<Mat4>> world(K, std::vector<Mat4>(N));
