@@ -127,8 +127,8 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
     pvs_runtime::Pvs pvs = pvs_runtime::Pvs::open(c.file, opt);
     const pvs::FileInfo& info = pvs.info();
     const bool object = info.granularity == pvs::Granularity::Object;
-    vislib::check_universe(c.file, info, full_scene);  // the bake's id rule (bake/id_universe.h)
-                                                       // const double q[3] = {eye.x, eye.y, eye.z};
+    vislib::check_universe(c.file, info, full_scene);  // the bake's id rule (id_universe.h)
+    const double q[3] = {eye.x, eye.y, eye.z};
     const std::optional<uint32_t> found = pvs.find_cell(q);
     if (!found) {
       std::fprintf(stderr, "pvs: error: no cell contains %s\n", c.at.c_str());
