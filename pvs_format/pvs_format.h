@@ -4,7 +4,8 @@
 // This library depends on the C++ standard library only (house style, "Which way the arrows
 // point"): an engine embeds it to load a PVS without vislib or its dependencies. It knows nothing
 // of scenes: it stores a 64-bit scene fingerprint computed by the caller (vislib's is
-// scene_fingerprint() in vislib/scene/scene_fingerprint.h, its byte stream is in the format document).
+// scene_fingerprint() in vislib/scene/scene_fingerprint.h, its byte stream is in the format
+// document).
 //
 // Errors: a malformed, truncated, corrupted or too new file throws pvs::FormatError carrying the
 // byte offset where the problem was found and what is wrong. The reader never crashes or reads
@@ -91,13 +92,13 @@ bool operator==(const CellLayout& a, const CellLayout& b);
 // Everything of a file except the visible sets.
 struct FileInfo {
   uint32_t version = kFormatVersion;
-  bool partial = false;         // some cells are Absent (a shard of a bake)
+  bool partial = false;  // some cells are Absent (a shard of a bake)
   uint64_t scene_fingerprint = 0;
-  uint32_t universe = 0;        // number of ids at this granularity (scene triangles or objects)
+  uint32_t universe = 0;  // number of ids at this granularity (scene triangles or objects)
   Granularity granularity = Granularity::Triangle;
   uint8_t max_delta_depth = 8;  // longest chain of Delta references a cell may need
   CellLayout layout;
-  std::string metadata;         // free text, by convention JSON with the bake settings
+  std::string metadata;  // free text, by convention JSON with the bake settings
 };
 
 // ---- Writing --------------------------------------------------------------------------------

@@ -105,8 +105,8 @@ class Pvs {
 
   // Asks the OS to page in the block of `cell` (madvise MADV_WILLNEED on its byte range, from the
   // index; returns immediately, reads nothing). The blocks of its Delta chain are not known
-  // without reading the block, so they are paged in when visible_ids() decodes it. Call it for the neighbours of the current cell so
-  // that crossing into one of them does not wait for the disk.
+  // without reading the block, so they are paged in when visible_ids() decodes it. Call it for the
+  // neighbours of the current cell so that crossing into one of them does not wait for the disk.
   void prefetch(uint32_t cell);
 
   struct Impl;

@@ -43,7 +43,8 @@ pvs_rt_status guarded(F&& f) {
 
 pvs_rt_status check_cell(const pvs_rt* h, uint32_t cell) {
   if (cell >= h->pvs.cell_count())
-    return fail(PVS_RT_INVALID_ARGUMENT, "cell " + std::to_string(cell) + " out of range (the file has " +
+    return fail(PVS_RT_INVALID_ARGUMENT, "cell " + std::to_string(cell) +
+                                             " out of range (the file has " +
                                              std::to_string(h->pvs.cell_count()) + " cells)");
   return PVS_RT_OK;
 }
@@ -55,7 +56,8 @@ extern "C" {
 pvs_rt_status pvs_rt_open(const char* path, int check_fingerprint, uint64_t expected_fingerprint,
                           pvs_rt** out) {
   if (out) *out = nullptr;
-  if (!path || !out) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_open: path and out must not be null");
+  if (!path || !out)
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_open: path and out must not be null");
   return guarded([&] {
     pvs_runtime::OpenOptions opt;
     if (check_fingerprint) opt.expected_fingerprint = expected_fingerprint;
@@ -64,7 +66,9 @@ pvs_rt_status pvs_rt_open(const char* path, int check_fingerprint, uint64_t expe
   });
 }
 
-void pvs_rt_close(pvs_rt* handle) { delete handle; }
+void pvs_rt_close(pvs_rt* handle) {
+  delete handle;
+}
 
 pvs_rt_status pvs_rt_get_info(const pvs_rt* h, pvs_rt_info* out) {
   if (!h || !out) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_get_info: null argument");
@@ -81,12 +85,14 @@ pvs_rt_status pvs_rt_get_info(const pvs_rt* h, pvs_rt_info* out) {
 }
 
 pvs_rt_status pvs_rt_find_cell(const pvs_rt* h, const double position[3], uint32_t* cell) {
-  if (!h || !position || !cell) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_find_cell: null argument");
+  if (!h || !position || !cell)
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_find_cell: null argument");
   return guarded([&] {
     auto c = h->pvs.find_cell(position);
     if (!c)
       return fail(PVS_RT_NOT_FOUND, "no cell contains (" + std::to_string(position[0]) + ", " +
-                                        std::to_string(position[1]) + ", " + std::to_string(position[2]) + ")");
+                                        std::to_string(position[1]) + ", " +
+                                        std::to_string(position[2]) + ")");
     *cell = *c;
     return PVS_RT_OK;
   });
@@ -105,8 +111,10 @@ pvs_rt_status pvs_rt_cell_box(const pvs_rt* h, uint32_t cell, double min[3], dou
 
 pvs_rt_status pvs_rt_neighbours(const pvs_rt* h, uint32_t cell, double margin, uint32_t* out,
                                 size_t capacity, size_t* count) {
-  if (!h || !count || (capacity && !out)) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_neighbours: null argument");
-  if (!(margin >= 0)) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_neighbours: margin must be >= 0");
+  if (!h || !count || (capacity && !out))
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_neighbours: null argument");
+  if (!(margin >= 0))
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_neighbours: margin must be >= 0");
   if (pvs_rt_status s = check_cell(h, cell)) return s;
   return guarded([&] {
     std::vector<uint32_t> n = h->pvs.neighbours(cell, margin);
@@ -126,18 +134,23 @@ pvs_rt_status pvs_rt_visible_count(const pvs_rt* h, uint32_t cell, uint32_t* cou
   return PVS_RT_OK;
 }
 
-pvs_rt_status pvs_rt_visible_ids(pvs_rt* h, uint32_t cell, uint32_t* out, size_t capacity, size_t* count) {
-  if (!h || !count || (capacity && !out)) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_visible_ids: null argument");
+pvs_rt_status pvs_rt_visible_ids(pvs_rt* h, uint32_t cell, uint32_t* out, size_t capacity,
+                                 size_t* count) {
+  if (!h || !count || (capacity && !out))
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_visible_ids: null argument");
   if (pvs_rt_status s = check_cell(h, cell)) return s;
   return guarded([&] {
     uint32_t n = h->pvs.visible_count(cell);
     *count = n;
     if (n > capacity)
-      return fail(PVS_RT_BUFFER_TOO_SMALL, "pvs_rt_visible_ids: cell " + std::to_string(cell) + " has " +
-                                               std::to_string(n) + " ids, capacity " + std::to_string(capacity));
+      return fail(PVS_RT_BUFFER_TOO_SMALL, "pvs_rt_visible_ids: cell " + std::to_string(cell) +
+                                               " has " + std::to_string(n) + " ids, capacity " +
+                                               std::to_string(capacity));
     if (h->pvs.info().partial && h->pvs.is_absent(cell))
-      return fail(PVS_RT_ABSENT, "cell " + std::to_string(cell) + " is absent (this file is a shard; merge the shards first)");
-    std::vector<uint32_t> ids = h->pvs.visible_ids(cell);  // checks the decoded count against the index
+      return fail(PVS_RT_ABSENT, "cell " + std::to_string(cell) +
+                                     " is absent (this file is a shard; merge the shards first)");
+    std::vector<uint32_t> ids =
+        h->pvs.visible_ids(cell);  // checks the decoded count against the index
     *count = ids.size();
     if (!ids.empty()) std::memcpy(out, ids.data(), ids.size() * sizeof(uint32_t));
     return PVS_RT_OK;
@@ -151,20 +164,32 @@ pvs_rt_status pvs_rt_prefetch(pvs_rt* h, uint32_t cell) {
   return PVS_RT_OK;
 }
 
-const char* pvs_rt_last_error(void) { return g_last_error.c_str(); }
+const char* pvs_rt_last_error(void) {
+  return g_last_error.c_str();
+}
 
 const char* pvs_rt_status_name(pvs_rt_status s) {
   switch (s) {
-    case PVS_RT_OK: return "ok";
-    case PVS_RT_INVALID_ARGUMENT: return "invalid argument";
-    case PVS_RT_IO: return "i/o";
-    case PVS_RT_FORMAT: return "format";
-    case PVS_RT_FINGERPRINT: return "fingerprint mismatch";
-    case PVS_RT_NOT_FOUND: return "not found";
-    case PVS_RT_BUFFER_TOO_SMALL: return "buffer too small";
-    case PVS_RT_ABSENT: return "absent";
-    case PVS_RT_OUT_OF_MEMORY: return "out of memory";
-    case PVS_RT_INTERNAL: return "internal";
+    case PVS_RT_OK:
+      return "ok";
+    case PVS_RT_INVALID_ARGUMENT:
+      return "invalid argument";
+    case PVS_RT_IO:
+      return "i/o";
+    case PVS_RT_FORMAT:
+      return "format";
+    case PVS_RT_FINGERPRINT:
+      return "fingerprint mismatch";
+    case PVS_RT_NOT_FOUND:
+      return "not found";
+    case PVS_RT_BUFFER_TOO_SMALL:
+      return "buffer too small";
+    case PVS_RT_ABSENT:
+      return "absent";
+    case PVS_RT_OUT_OF_MEMORY:
+      return "out of memory";
+    case PVS_RT_INTERNAL:
+      return "internal";
   }
   return "unknown";
 }

@@ -21,13 +21,13 @@ typedef struct pvs_rt pvs_rt; /* an open, memory-mapped PVS file */
 
 typedef enum pvs_rt_status {
   PVS_RT_OK = 0,
-  PVS_RT_INVALID_ARGUMENT = 1,  /* a null pointer, a cell id >= cell_count, margin < 0 */
-  PVS_RT_IO = 2,                /* the file cannot be opened, sized or memory-mapped */
-  PVS_RT_FORMAT = 3,            /* not a PVS file, truncated, corrupt (checksum), too new, ... */
-  PVS_RT_FINGERPRINT = 4,       /* a valid PVS, but baked for another scene */
-  PVS_RT_NOT_FOUND = 5,         /* no cell contains the position */
-  PVS_RT_BUFFER_TOO_SMALL = 6,  /* *count holds the capacity needed */
-  PVS_RT_ABSENT = 7,            /* the cell has no data in this (partial) file */
+  PVS_RT_INVALID_ARGUMENT = 1, /* a null pointer, a cell id >= cell_count, margin < 0 */
+  PVS_RT_IO = 2,               /* the file cannot be opened, sized or memory-mapped */
+  PVS_RT_FORMAT = 3,           /* not a PVS file, truncated, corrupt (checksum), too new, ... */
+  PVS_RT_FINGERPRINT = 4,      /* a valid PVS, but baked for another scene */
+  PVS_RT_NOT_FOUND = 5,        /* no cell contains the position */
+  PVS_RT_BUFFER_TOO_SMALL = 6, /* *count holds the capacity needed */
+  PVS_RT_ABSENT = 7,           /* the cell has no data in this (partial) file */
   PVS_RT_OUT_OF_MEMORY = 8,
   PVS_RT_INTERNAL = 9
 } pvs_rt_status;
@@ -35,10 +35,10 @@ typedef enum pvs_rt_status {
 typedef struct pvs_rt_info {
   uint32_t format_version;
   uint32_t cell_count;
-  uint32_t universe;          /* ids are < universe */
-  uint32_t granularity;       /* 0: triangle ids, 1: object ids */
-  uint32_t layout;            /* 0: grid, 1: box list */
-  uint32_t partial;           /* 1 if some cells may be absent */
+  uint32_t universe;    /* ids are < universe */
+  uint32_t granularity; /* 0: triangle ids, 1: object ids */
+  uint32_t layout;      /* 0: grid, 1: box list */
+  uint32_t partial;     /* 1 if some cells may be absent */
   uint64_t scene_fingerprint;
   uint64_t file_size;
 } pvs_rt_info;
@@ -64,7 +64,8 @@ pvs_rt_status pvs_rt_cell_box(const pvs_rt* handle, uint32_t cell, double min[3]
 
 /* The cells whose boxes come within `margin` (>= 0) of cell's box, sorted, without `cell`.
  * Writes at most `capacity` ids to `out`; *count receives the number of neighbours. If it
- * exceeds capacity, returns PVS_RT_BUFFER_TOO_SMALL (27 is always enough for margin 0 on a grid). */
+ * exceeds capacity, returns PVS_RT_BUFFER_TOO_SMALL (27 is always enough for margin 0 on a grid).
+ */
 pvs_rt_status pvs_rt_neighbours(const pvs_rt* handle, uint32_t cell, double margin, uint32_t* out,
                                 size_t capacity, size_t* count);
 

@@ -1,19 +1,20 @@
 // Tests of the bake (library): byte-identical output for any thread count, shards merged into
 // the same bytes, resume from a checkpoint (including one torn at any byte), refusal of another
 // bake's checkpoint, and the scene fingerprint and subset the PVS relies on.
+#include "vislib/bake/bake.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <filesystem>
 
 #include "tests/test_support.h"
-#include "vislib/bake/bake.h"
 #include "vislib/bake/checkpoint.h"
+#include "vislib/bake/scene_subset.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/generate.h"
 #include "vislib/scene/scene_fingerprint.h"
-#include "vislib/bake/scene_subset.h"
 
 using namespace vislib;
 using vislib_test::temp_dir;
@@ -41,12 +42,15 @@ BakeSettings settings() {
   return s;
 }
 
-std::string bake_bytes(const Scene& scene, const ViewCells& cells, const BakeSettings& s, const std::string& path,
-                       Shard shard = {}, int threads = 0) {
+std::string bake_bytes(const Scene& scene, const ViewCells& cells, const BakeSettings& s,
+                       const std::string& path, Shard shard = {}, int threads = 0) {
   std::unique_ptr<tbb::global_control> limit;
-  if (threads) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  if (threads)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  threads);
   bake(scene, cells, s, shard, {path, path + ".ckpt", false});
-  EXPECT_FALSE(std::filesystem::exists(path + ".ckpt")) << "the checkpoint must be gone after success";
+  EXPECT_FALSE(std::filesystem::exists(path + ".ckpt"))
+      << "the checkpoint must be gone after success";
   return read_file(path);
 }
 
@@ -63,7 +67,8 @@ TEST(Bake, OutputIsByteIdenticalForOneAndTwoThreads) {
   EXPECT_EQ(r.info().universe, scene.triangle_count());
   EXPECT_EQ(r.info().scene_fingerprint, scene_fingerprint(scene));
   // Each cell holds what bake_cell computes.
-  for (uint32_t c = 0; c < 9; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, r.info().layout, c, settings()));
+  for (uint32_t c = 0; c < 9; ++c)
+    EXPECT_EQ(r.read_cell(c), bake_cell(scene, r.info().layout, c, settings()));
 }
 
 TEST(Bake, ShardsMergeIntoTheSingleBakeByteForByte) {
@@ -72,7 +77,8 @@ TEST(Bake, ShardsMergeIntoTheSingleBakeByteForByte) {
   std::string whole = bake_bytes(scene, small_grid(), settings(), dir + "/whole.pvs");
   std::vector<pvs::Reader> shards;
   for (uint32_t i = 0; i < 4; ++i) {
-    std::string bytes = bake_bytes(scene, small_grid(), settings(), dir + "/s" + std::to_string(i) + ".pvs", {i, 4});
+    std::string bytes = bake_bytes(scene, small_grid(), settings(),
+                                   dir + "/s" + std::to_string(i) + ".pvs", {i, 4});
     shards.push_back(pvs::Reader::from_memory(bytes));
     EXPECT_TRUE(shards.back().info().partial);
   }
@@ -208,7 +214,8 @@ TEST(SceneSubset, KeepsExactlyTheSetAtEachGranularity) {
   Scene o = scene_subset(s, objs, Granularity::Object);
   EXPECT_EQ(o.objects.size(), objs.size());
   size_t expect = 0;
-  for (uint32_t obj : s.triangle_object) expect += std::binary_search(objs.begin(), objs.end(), obj);
+  for (uint32_t obj : s.triangle_object)
+    expect += std::binary_search(objs.begin(), objs.end(), obj);
   EXPECT_EQ(o.triangle_count(), expect);
   EXPECT_EQ(o.objects[0].name, s.objects[objs[0]].name);
 }

@@ -39,7 +39,8 @@ const std::string& city() {
 
 // 16 grid cells over the middle of the city, at a small resolution.
 std::string grid_bake(const std::string& out) {
-  return "bake " + city() + " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 -o " + out;
+  return "bake " + city() +
+         " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 -o " + out;
 }
 
 // Complete records in a checkpoint file (24-byte header, then size/cell/payload/CRC records).
@@ -68,8 +69,10 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
 
   // Start the same bake as a child process and kill -9 it once a few cells are checkpointed.
   std::string target = dir + "/killed.pvs";
-  std::vector<std::string> args = {"pvs", "bake", city(), "--box", "-60,0,-60,60,3,60", "--grid", "4,1,4",
-                                   "--eye-height", "1.5,1.8", "--res", "24", "--threads", "1", "-o", target};
+  std::vector<std::string> args = {
+      "pvs",          "bake",    city(),  "--box", "-60,0,-60,60,3,60", "--grid", "4,1,4",
+      "--eye-height", "1.5,1.8", "--res", "24",    "--threads",         "1",      "-o",
+      target};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -88,7 +91,8 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
       finished_early = true;
       break;
     }
-    ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60)) << "no checkpoint records";
+    ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60))
+        << "no checkpoint records";
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   ASSERT_FALSE(finished_early) << "the bake finished before it could be killed";
@@ -128,7 +132,10 @@ TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {
   ASSERT_EQ(run_pvs("merge " + shards + "-o " + dir + "/merged.pvs", &out), 0) << out;
   EXPECT_EQ(vislib::read_file(dir + "/merged.pvs"), vislib::read_file(dir + "/one.pvs"));
   // A missing shard is an error naming the cell.
-  ASSERT_EQ(run_pvs("merge " + dir + "/shard0.pvs " + dir + "/shard1.pvs -o " + dir + "/bad.pvs", &out), 2) << out;
+  ASSERT_EQ(
+      run_pvs("merge " + dir + "/shard0.pvs " + dir + "/shard1.pvs -o " + dir + "/bad.pvs", &out),
+      2)
+      << out;
   EXPECT_NE(out.find("absent from every shard"), std::string::npos) << out;
   EXPECT_EQ(run_pvs(grid_bake(dir + "/x.pvs") + " --shard 3/3", &out), 2) << out;
 }
@@ -136,7 +143,11 @@ TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {
 TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
   std::string dir = temp_dir("cli_inspect");
   std::string pvs = dir + "/city.pvs", out;
-  ASSERT_EQ(run_pvs("bake " + city() + " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 -o " + pvs, &out), 0) << out;
+  ASSERT_EQ(run_pvs("bake " + city() +
+                        " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 -o " + pvs,
+                    &out),
+            0)
+      << out;
   ASSERT_EQ(run_pvs("inspect --json " + pvs, &out), 0) << out;
   json s = json::parse(out);
   const unsigned cells = s["cells"];
@@ -156,7 +167,11 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
 
   // One cell, by point, with the scene: export the visible triangles and read them back.
   std::string glb = dir + "/cell.glb";
-  ASSERT_EQ(run_pvs("inspect " + pvs + " --at 0,1.6,0 --json --scene " + city() + " --export-gltf " + glb, &out), 0) << out;
+  ASSERT_EQ(
+      run_pvs("inspect " + pvs + " --at 0,1.6,0 --json --scene " + city() + " --export-gltf " + glb,
+              &out),
+      0)
+      << out;
   json c = json::parse(out);
   EXPECT_EQ(c["boundary_segments"].size(), 8u);
   EXPECT_GT(c["visible_count"].get<int>(), 0);
@@ -176,8 +191,18 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
 
   // Object granularity: whole objects are exported.
   std::string opvs = dir + "/objects.pvs";
-  ASSERT_EQ(run_pvs("bake " + city() + " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 --granularity object -o " + opvs, &out), 0) << out;
-  ASSERT_EQ(run_pvs("inspect " + opvs + " --at 0,1.6,0 --json --scene " + city() + " --export-gltf " + glb, &out), 0) << out;
+  ASSERT_EQ(run_pvs("bake " + city() +
+                        " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 "
+                        "--granularity object -o " +
+                        opvs,
+                    &out),
+            0)
+      << out;
+  ASSERT_EQ(run_pvs("inspect " + opvs + " --at 0,1.6,0 --json --scene " + city() +
+                        " --export-gltf " + glb,
+                    &out),
+            0)
+      << out;
   c = json::parse(out);
   EXPECT_EQ(c["granularity"], "object");
   EXPECT_EQ(vislib::load_scene(glb).objects.size(), c["visible_count"].get<size_t>());

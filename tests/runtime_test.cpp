@@ -24,7 +24,8 @@ namespace {
 constexpr uint64_t kScene = 0x1234abcd5678ef00ull;
 
 std::string temp_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("vislib_runtime_test_" + std::to_string(getpid())) / name;
+  fs::path d =
+      fs::temp_directory_path() / ("vislib_runtime_test_" + std::to_string(getpid())) / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d.string();
@@ -68,7 +69,8 @@ std::vector<uint32_t> brute_neighbours(const pvs::CellLayout& l, uint32_t cell, 
     if (c == cell) continue;
     pvs::Box b = l.cell_box(c);
     bool touch = true;
-    for (int k = 0; k < 3; ++k) touch = touch && b.min[k] <= me.max[k] + margin && me.min[k] - margin <= b.max[k];
+    for (int k = 0; k < 3; ++k)
+      touch = touch && b.min[k] <= me.max[k] + margin && me.min[k] - margin <= b.max[k];
     if (touch) out.push_back(c);
   }
   return out;
@@ -106,7 +108,8 @@ TEST(Runtime, GridNeighboursAreTheCellsThatTouchOrComeWithinTheMargin) {
   // Corner cell 0: 3 neighbours along x/y/z, 3 across edges, 1 across the corner.
   EXPECT_EQ(p.neighbours(0), (std::vector<uint32_t>{1, 4, 5, 8, 9, 12, 13}));
   for (double margin : {0.0, 1.0, 2.5})
-    for (uint32_t c = 0; c < 24; ++c) EXPECT_EQ(p.neighbours(c, margin), brute_neighbours(g.info.layout, c, margin)) << c;
+    for (uint32_t c = 0; c < 24; ++c)
+      EXPECT_EQ(p.neighbours(c, margin), brute_neighbours(g.info.layout, c, margin)) << c;
 }
 
 TEST(Runtime, BoxListLookupAndNeighboursMatchALinearScan) {
@@ -137,7 +140,8 @@ TEST(Runtime, BoxListLookupAndNeighboursMatchALinearScan) {
     found += bool(expect);
   }
   EXPECT_GT(found, 100);  // the sample does land in cells
-  for (uint32_t c = 0; c < 500; ++c) ASSERT_EQ(p.neighbours(c, 1.0), brute_neighbours(info.layout, c, 1.0)) << c;
+  for (uint32_t c = 0; c < 500; ++c)
+    ASSERT_EQ(p.neighbours(c, 1.0), brute_neighbours(info.layout, c, 1.0)) << c;
 }
 
 TEST(Runtime, RejectsAPvsOfAnotherScene) {
@@ -178,7 +182,8 @@ TEST(Runtime, RejectsCorruptAndTruncatedFilesWithTheByteOffset) {
   hdr[33] = char(hdr[33] ^ 1);
   write_file(dir + "/header.pvs", hdr);
   write_file(dir + "/truncated.pvs", g.bytes.substr(0, g.bytes.size() - 3));
-  write_file(dir + "/text.pvs", "hello, this is not a PVS file at all, just some text bytes for the test");
+  write_file(dir + "/text.pvs",
+             "hello, this is not a PVS file at all, just some text bytes for the test");
   write_file(dir + "/empty.pvs", "");
   struct Case {
     const char* file;
@@ -190,7 +195,8 @@ TEST(Runtime, RejectsCorruptAndTruncatedFilesWithTheByteOffset) {
       Pvs::open(dir + "/" + c.file);
       FAIL() << c.file << " opened";
     } catch (const pvs::FormatError& e) {
-      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << c.file << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos)
+          << c.file << ": " << e.what();
     }
   }
 }
@@ -212,13 +218,15 @@ TEST(RuntimeC, FingerprintMismatchAndCorruptFileReturnCodesAndMessages) {
   pvs_rt* h = reinterpret_cast<pvs_rt*>(1);
   EXPECT_EQ(pvs_rt_open((dir + "/ok.pvs").c_str(), 1, kScene ^ 0xff, &h), PVS_RT_FINGERPRINT);
   EXPECT_EQ(h, nullptr);
-  EXPECT_NE(std::string(pvs_rt_last_error()).find("baked for another scene"), std::string::npos) << pvs_rt_last_error();
+  EXPECT_NE(std::string(pvs_rt_last_error()).find("baked for another scene"), std::string::npos)
+      << pvs_rt_last_error();
 
   std::string bad = g.bytes;
   bad[70] = char(bad[70] ^ 0x10);  // inside the layout section
   write_file(dir + "/bad.pvs", bad);
   EXPECT_EQ(pvs_rt_open((dir + "/bad.pvs").c_str(), 1, kScene, &h), PVS_RT_FORMAT);
-  EXPECT_NE(std::string(pvs_rt_last_error()).find("layout section checksum mismatch"), std::string::npos)
+  EXPECT_NE(std::string(pvs_rt_last_error()).find("layout section checksum mismatch"),
+            std::string::npos)
       << pvs_rt_last_error();
 
   EXPECT_EQ(pvs_rt_open((dir + "/missing.pvs").c_str(), 0, 0, &h), PVS_RT_IO);
@@ -231,7 +239,8 @@ TEST(RuntimeC, EngineCallsReturnIdsNeighboursAndReportShortBuffers) {
   const GridFile g = make_grid_file();
   write_file(dir + "/ok.pvs", g.bytes);
   pvs_rt* h = nullptr;
-  ASSERT_EQ(pvs_rt_open((dir + "/ok.pvs").c_str(), 1, kScene, &h), PVS_RT_OK) << pvs_rt_last_error();
+  ASSERT_EQ(pvs_rt_open((dir + "/ok.pvs").c_str(), 1, kScene, &h), PVS_RT_OK)
+      << pvs_rt_last_error();
   pvs_rt_info info;
   ASSERT_EQ(pvs_rt_get_info(h, &info), PVS_RT_OK);
   EXPECT_EQ(info.cell_count, 24u);
@@ -269,9 +278,12 @@ TEST(RuntimeC, EngineCallsReturnIdsNeighboursAndReportShortBuffers) {
 TEST(Runtime, LooksUpCellsOfABakedCity) {
   const std::string dir = temp_dir("city");
   const std::string pvs_exe = VISLIB_PVS_EXE;
-  auto run = [](const std::string& cmd) { return std::system((cmd + " > /dev/null 2>&1").c_str()); };
+  auto run = [](const std::string& cmd) {
+    return std::system((cmd + " > /dev/null 2>&1").c_str());
+  };
   ASSERT_EQ(run(pvs_exe + " generate city --blocks 2,2 -o " + dir + "/city.glb"), 0);
-  ASSERT_EQ(run(pvs_exe + " bake " + dir + "/city.glb --box 0,0,0,40,3,40 --grid 3,1,3 --eye-height 1.5,1.8" +
+  ASSERT_EQ(run(pvs_exe + " bake " + dir +
+                "/city.glb --box 0,0,0,40,3,40 --grid 3,1,3 --eye-height 1.5,1.8" +
                 " --res 32 --threads 1 -o " + dir + "/city.pvs"),
             0);
   pvs::Reader reader = pvs::Reader::from_file(dir + "/city.pvs");
@@ -284,7 +296,8 @@ TEST(Runtime, LooksUpCellsOfABakedCity) {
   size_t total = 0;
   for (uint32_t c = 0; c < 9; ++c) {
     pvs::Box b = p.info().layout.cell_box(c);
-    double centre[3] = {(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2, (b.min[2] + b.max[2]) / 2};
+    double centre[3] = {(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2,
+                        (b.min[2] + b.max[2]) / 2};
     EXPECT_EQ(p.find_cell(centre), std::optional<uint32_t>(c));
     EXPECT_EQ(p.visible_ids(c), reader.read_cell(c));
     EXPECT_EQ(p.neighbours(c), brute_neighbours(p.info().layout, c, 0.0));
@@ -296,6 +309,8 @@ TEST(Runtime, LooksUpCellsOfABakedCity) {
 
   char fp_hex[17];
   std::snprintf(fp_hex, sizeof fp_hex, "%016llx", static_cast<unsigned long long>(fp));
-  EXPECT_EQ(run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs " + fp_hex + " --frames 50"), 0);
+  EXPECT_EQ(
+      run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs " + fp_hex + " --frames 50"),
+      0);
   EXPECT_NE(run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs 0123 --frames 50"), 0);
 }

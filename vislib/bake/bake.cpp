@@ -19,28 +19,32 @@
 
 namespace vislib {
 
-pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const BakeSettings& settings) {
+pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
+                             const BakeSettings& settings) {
   assert(scene.triangle_count() < 0xFFFFFFFFull && scene.objects.size() < 0xFFFFFFFFull);
   pvs::FileInfo info;
   info.scene_fingerprint = scene_fingerprint(scene);
-  info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object : pvs::Granularity::Triangle;
+  info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object
+                                                                 : pvs::Granularity::Triangle;
   // Triangle granularity: triangle ids, then sphere s as triangle_count + s.
-  info.universe = uint32_t(settings.granularity == Granularity::Object ? scene.objects.size()
-                                                                        : scene.triangle_count() + scene.sphere_count());
+  info.universe = uint32_t(settings.granularity == Granularity::Object
+                               ? scene.objects.size()
+                               : scene.triangle_count() + scene.sphere_count());
   info.layout = cells.layout;
   const SegmentOptions& s = settings.region.segment;
-  nlohmann::json m = {{"generator", "vislib pvs bake"},
-                      {"cells", nlohmann::json::parse(cells.description)},
-                      {"granularity", settings.granularity == Granularity::Object ? "object" : "triangle"},
-                      {"resolution", s.resolution},
-                      {"near", s.near},
-                      {"eps_len", s.eps_len},
-                      {"runs", settings.region.runs},
-                      {"seed", settings.region.seed},
-                      {"state", s.state},
-                      {"states", scene.state_count()},
-                      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
-                      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
+  nlohmann::json m = {
+      {"generator", "vislib pvs bake"},
+      {"cells", nlohmann::json::parse(cells.description)},
+      {"granularity", settings.granularity == Granularity::Object ? "object" : "triangle"},
+      {"resolution", s.resolution},
+      {"near", s.near},
+      {"eps_len", s.eps_len},
+      {"runs", settings.region.runs},
+      {"seed", settings.region.seed},
+      {"state", s.state},
+      {"states", scene.state_count()},
+      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
+      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
   info.metadata = m.dump();
   return info;
 }
@@ -65,8 +69,8 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
   return ids;
 }
 
-BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,
-                const BakeFiles& files, const BakeProgressFn& progress) {
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
+                Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
   assert(shard.count >= 1 && shard.index < shard.count);
   pvs::FileInfo info = bake_file_info(scene, cells, settings);
   info.partial = shard.count > 1;
@@ -79,12 +83,13 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   std::unique_ptr<Checkpoint> checkpoint;
   if (!files.checkpoint.empty()) {
     std::vector<std::optional<std::vector<uint32_t>>> recovered;
-    checkpoint = std::make_unique<Checkpoint>(files.checkpoint, bake_key(info, shard), n, files.resume,
-                                              &recovered, info.universe);
+    checkpoint = std::make_unique<Checkpoint>(files.checkpoint, bake_key(info, shard), n,
+                                              files.resume, &recovered, info.universe);
     for (uint32_t c = 0; c < n; ++c)
       if (recovered[c]) {
         if (!in_shard(c, shard))
-          throw InputError(files.checkpoint, "holds cell " + std::to_string(c) + ", which is not in this shard");
+          throw InputError(files.checkpoint,
+                           "holds cell " + std::to_string(c) + ", which is not in this shard");
         sets[c] = std::move(recovered[c]);
       }
   }
@@ -99,7 +104,9 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   }
 
   const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   std::mutex progress_mutex;
   uint32_t done = report.resumed;
   if (progress) progress({done, report.shard_cells, report.resumed, 0.0});

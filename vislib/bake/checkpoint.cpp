@@ -60,7 +60,8 @@ void write_all(int fd, const std::string& bytes, const std::string& path) {
 }  // namespace
 
 Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_count, bool resume,
-                       std::vector<std::optional<std::vector<uint32_t>>>* recovered, uint32_t universe)
+                       std::vector<std::optional<std::vector<uint32_t>>>* recovered,
+                       uint32_t universe)
     : path_(path) {
   if (recovered) recovered->assign(cell_count, std::nullopt);
   size_t keep = 0;  // bytes of the existing file to keep
@@ -73,9 +74,12 @@ Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_coun
       if (get_u32(bytes, 20) != pvs::crc32c(bytes.data(), 20))
         throw InputError(path, "byte 20: checkpoint header checksum mismatch");
       if (get_u32(bytes, 8) != 1)
-        throw InputError(path, "byte 8: checkpoint version " + std::to_string(get_u32(bytes, 8)) + " (this bake reads 1)");
+        throw InputError(path, "byte 8: checkpoint version " + std::to_string(get_u32(bytes, 8)) +
+                                   " (this bake reads 1)");
       if (get_u64(bytes, 12) != key)
-        throw InputError(path, "the checkpoint belongs to another bake (other scene, cells or settings); delete it or bake without --resume");
+        throw InputError(path,
+                         "the checkpoint belongs to another bake (other scene, cells or settings); "
+                         "delete it or bake without --resume");
       keep = kCheckpointHeader;
       while (bytes.size() - keep >= 12) {
         uint32_t size = get_u32(bytes, keep);
@@ -84,12 +88,16 @@ Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_coun
         if (crc != pvs::crc32c(bytes.data() + keep, 8 + size)) break;  // torn or damaged
         uint32_t cell = get_u32(bytes, keep + 4);
         if (cell >= cell_count)
-          throw InputError(path, "byte " + std::to_string(keep + 4) + ": record of cell " + std::to_string(cell) + ", the bake has " + std::to_string(cell_count));
+          throw InputError(path, "byte " + std::to_string(keep + 4) + ": record of cell " +
+                                     std::to_string(cell) + ", the bake has " +
+                                     std::to_string(cell_count));
         std::vector<uint32_t> ids;
         try {
-          ids = pvs::decode_sorted_delta(std::string_view(bytes).substr(keep + 8, size), universe, keep + 8);
+          ids = pvs::decode_sorted_delta(std::string_view(bytes).substr(keep + 8, size), universe,
+                                         keep + 8);
         } catch (const pvs::FormatError& e) {
-          throw InputError(path, std::string("record of cell ") + std::to_string(cell) + ": " + e.what());
+          throw InputError(path,
+                           std::string("record of cell ") + std::to_string(cell) + ": " + e.what());
         }
         if (recovered) (*recovered)[cell] = std::move(ids);
         ++recovered_records_;
@@ -104,14 +112,16 @@ Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_coun
   if (keep == 0) {
     write_all(fd_, header_bytes(key), path);
     // Make the new file's directory entry durable too (a power cut, not only a killed process).
-    std::string dir = path.find('/') == std::string::npos ? "." : path.substr(0, path.rfind('/') + 1);
+    std::string dir =
+        path.find('/') == std::string::npos ? "." : path.substr(0, path.rfind('/') + 1);
     int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) {
       ::fsync(dfd);
       ::close(dfd);
     }
   } else {
-    if (::ftruncate(fd_, off_t(keep)) != 0) io_error(path, "cannot cut the torn tail of the checkpoint");
+    if (::ftruncate(fd_, off_t(keep)) != 0)
+      io_error(path, "cannot cut the torn tail of the checkpoint");
     if (::lseek(fd_, 0, SEEK_END) < 0) io_error(path, "seek failed");
     if (::fdatasync(fd_) != 0) io_error(path, "fsync failed");
   }

@@ -59,7 +59,8 @@ Scene load_scene(const std::string& path, const LoadOptions& options,
   } else if (ext == ".spheres") {
     scene = load_spheres(path, warn);
   } else {
-    throw InputError(path, "unsupported file format '" + (ext.empty() ? std::string("(none)") : ext) +
+    throw InputError(path, "unsupported file format '" +
+                               (ext.empty() ? std::string("(none)") : ext) +
                                "' (supported: .gltf .glb .obj .ply .off .stl .spheres)");
   }
   check_scene(path, scene);

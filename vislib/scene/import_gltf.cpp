@@ -32,9 +32,8 @@
 //
 // Skinned meshes are deformed by linear-blend skinning (JOINTS_0/WEIGHTS_0, inverse bind
 // matrices) with the sampled joint transforms, also for K = 1 (the rest pose of the joints).
-#include <tiny_gltf.h>
-
 #include <meshoptimizer.h>
+#include <tiny_gltf.h>
 
 #include <algorithm>
 #include <cmath>
@@ -87,9 +86,10 @@ Mat4 to_matrix(const Trs& x) {
   double qx = x.r[0], qy = x.r[1], qz = x.r[2], qw = x.r[3];
   double n = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
   if (n > 0) qx /= n, qy /= n, qz /= n, qw /= n;
-  double R[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
-                    {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
-                    {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+  double R[3][3] = {
+      {1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+      {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+      {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
   Mat4 m;
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) m.m[c * 4 + r] = R[r][c] * x.s[c];
@@ -104,11 +104,12 @@ struct Bytes {
 
 struct Channel {
   int node = -1;
-  int path = 0;  // 0 translation, 1 rotation, 2 scale, 3 morph weights
-  int interp = 0;  // 0 LINEAR, 1 STEP, 2 CUBICSPLINE
+  int path = 0;      // 0 translation, 1 rotation, 2 scale, 3 morph weights
+  int interp = 0;    // 0 LINEAR, 1 STEP, 2 CUBICSPLINE
   size_t ncomp = 3;  // values per key element: 3, 4 (rotation) or the morph target count (weights)
   std::vector<double> times;
-  std::vector<double> values;  // per key: ncomp values (CUBICSPLINE: in-tangent, value, out-tangent)
+  std::vector<double>
+      values;  // per key: ncomp values (CUBICSPLINE: in-tangent, value, out-tangent)
 };
 
 // One primitive of a mesh, decoded once and shared by all instances of the mesh.
@@ -164,10 +165,12 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
     ctx.fail(who + "buffer " + std::to_string(buffer) + " does not exist");
   const auto& data = ctx.model.buffers[buffer].data;
   if (offset > data.size() || length > data.size() - offset)
-    ctx.fail(who + "source bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
-             ") exceed buffer " + std::to_string(buffer) + " of " + std::to_string(data.size()) + " bytes");
+    ctx.fail(who + "source bytes [" + std::to_string(offset) + ", " +
+             std::to_string(offset + length) + ") exceed buffer " + std::to_string(buffer) +
+             " of " + std::to_string(data.size()) + " bytes");
   if (stride == 0 || stride > 256 || count > (uint64_t(1) << 31) / stride)
-    ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " + std::to_string(count));
+    ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " +
+             std::to_string(count));
   auto& out = ctx.decoded[view];
   out.assign(size_t(count * stride), 0);
   const unsigned char* src = data.data() + offset;
@@ -183,7 +186,8 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
   } else {
     ctx.fail(who + "unknown mode '" + mode + "'");
   }
-  if (rc != 0) ctx.fail(who + "meshoptimizer could not decode the data (error " + std::to_string(rc) + ")");
+  if (rc != 0)
+    ctx.fail(who + "meshoptimizer could not decode the data (error " + std::to_string(rc) + ")");
   if (filter == "NONE") {
   } else if (mode != "ATTRIBUTES") {
     ctx.fail(who + "filter " + filter + " is only allowed with ATTRIBUTES");
@@ -194,7 +198,8 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
   } else if (filter == "EXPONENTIAL") {
     meshopt_decodeFilterExp(out.data(), count, stride);
   } else {
-    ctx.fail(who + "filter '" + filter + "' is unknown or does not fit byteStride " + std::to_string(stride));
+    ctx.fail(who + "filter '" + filter + "' is unknown or does not fit byteStride " +
+             std::to_string(stride));
   }
 }
 
@@ -222,32 +227,39 @@ Bytes view_bytes(Ctx& ctx, int view, const std::string& who) {
   const auto& data = ctx.model.buffers[bv.buffer].data;
   if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
     ctx.fail("bufferView " + std::to_string(view) + ": bytes [" + std::to_string(bv.byteOffset) +
-             ", " + std::to_string(bv.byteOffset + bv.byteLength) + ") are out of range of buffer " +
-             std::to_string(bv.buffer) + " (" + std::to_string(data.size()) + " bytes)");
+             ", " + std::to_string(bv.byteOffset + bv.byteLength) +
+             ") are out of range of buffer " + std::to_string(bv.buffer) + " (" +
+             std::to_string(data.size()) + " bytes)");
   return {data.data() + bv.byteOffset, bv.byteLength};
 }
 
 double read_component(const unsigned char* p, int type, bool normalized) {
   switch (type) {
     case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      int8_t v; std::memcpy(&v, p, 1);
+      int8_t v;
+      std::memcpy(&v, p, 1);
       return normalized ? std::max(v / 127.0, -1.0) : v;
     }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return normalized ? p[0] / 255.0 : p[0];
     case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      int16_t v; std::memcpy(&v, p, 2);
+      int16_t v;
+      std::memcpy(&v, p, 2);
       return normalized ? std::max(v / 32767.0, -1.0) : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v; std::memcpy(&v, p, 2);
+      uint16_t v;
+      std::memcpy(&v, p, 2);
       return normalized ? v / 65535.0 : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-      uint32_t v; std::memcpy(&v, p, 4);
+      uint32_t v;
+      std::memcpy(&v, p, 4);
       return v;
     }
     default: {
-      float v; std::memcpy(&v, p, 4);
+      float v;
+      std::memcpy(&v, p, 4);
       return v;
     }
   }
@@ -255,10 +267,17 @@ double read_component(const unsigned char* p, int type, bool normalized) {
 
 int component_size(int type) {
   switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
   }
 }
 
@@ -274,7 +293,8 @@ void read_elements(Ctx& ctx, const std::string& who, int view, size_t offset, si
     ctx.fail(who + ": byteStride " + std::to_string(stride) + " is smaller than the element (" +
              std::to_string(esize) + " bytes)");
   if (count == 0) return;
-  if (offset > b.size || esize > b.size - offset || (count - 1) > (b.size - offset - esize) / stride)
+  if (offset > b.size || esize > b.size - offset ||
+      (count - 1) > (b.size - offset - esize) / stride)
     ctx.fail(who + ": " + std::to_string(count) + " elements of " + std::to_string(esize) +
              " bytes (stride " + std::to_string(stride) + ") from byte " + std::to_string(offset) +
              " do not fit in bufferView " + std::to_string(view) + " (" + std::to_string(b.size) +
@@ -282,7 +302,8 @@ void read_elements(Ctx& ctx, const std::string& who, int view, size_t offset, si
   for (size_t i = 0; i < count; ++i) {
     const unsigned char* p = b.data + offset + i * stride;
     double* dst = out + (targets ? (*targets)[i] : i) * size_t(ncomp);
-    for (int c = 0; c < ncomp; ++c) dst[c] = read_component(p + size_t(c) * csize, ctype, normalized);
+    for (int c = 0; c < ncomp; ++c)
+      dst[c] = read_component(p + size_t(c) * csize, ctype, normalized);
   }
 }
 
@@ -306,7 +327,8 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
   std::vector<double> out(a.count * size_t(ncomp), 0.0);
   if (a.bufferView >= 0) {
     size_t stride = ctx.model.bufferViews.size() > size_t(a.bufferView)
-                        ? ctx.model.bufferViews[a.bufferView].byteStride : 0;
+                        ? ctx.model.bufferViews[a.bufferView].byteStride
+                        : 0;
     read_elements(ctx, who, a.bufferView, a.byteOffset, stride, a.count, ncomp, a.componentType,
                   a.normalized, out.data());
   }
@@ -314,12 +336,14 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
     size_t n = size_t(std::max(a.sparse.count, 0));
     if (n > a.count) ctx.fail(who + ": sparse count exceeds the accessor count");
     int itype = a.sparse.indices.componentType;
-    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
         itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
       ctx.fail(who + ": bad sparse index componentType");
     std::vector<double> idx(n);
     read_elements(ctx, who + " sparse indices", a.sparse.indices.bufferView,
-                  size_t(std::max(a.sparse.indices.byteOffset, 0)), 0, n, 1, itype, false, idx.data());
+                  size_t(std::max(a.sparse.indices.byteOffset, 0)), 0, n, 1, itype, false,
+                  idx.data());
     std::vector<size_t> targets(n);
     for (size_t i = 0; i < n; ++i) {
       if (idx[i] >= double(a.count)) ctx.fail(who + ": sparse index out of range");
@@ -366,7 +390,8 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
       const auto& accs = ctx.model.accessors;
       if (size_t(prim.indices) < accs.size()) {
         int ct = accs[prim.indices].componentType;
-        if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
             ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
           ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where +
                    "): componentType " + std::to_string(ct) + " is not an unsigned integer type");
@@ -380,9 +405,10 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
         idx[i] = uint32_t(raw[i]);
       }
       if (bad)
-        ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where + "): " +
-                 std::to_string(bad) + " indices out of range (largest " +
-                 std::to_string(uint64_t(worst)) + ", POSITION has " + std::to_string(nv) + " vertices)");
+        ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where +
+                 "): " + std::to_string(bad) + " indices out of range (largest " +
+                 std::to_string(uint64_t(worst)) + ", POSITION has " + std::to_string(nv) +
+                 " vertices)");
     } else {
       idx.resize(nv);
       for (size_t i = 0; i < nv; ++i) idx[i] = uint32_t(i);
@@ -422,8 +448,9 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
       std::string what = "POSITION of morph target " + std::to_string(ti) + " of " + where;
       auto d = read_accessor(ctx, t_it->second, what, nc, {3});
       if (d.size() != 3 * nv)
-        ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what + "): " +
-                 std::to_string(d.size() / 3) + " elements, but POSITION has " + std::to_string(nv));
+        ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what +
+                 "): " + std::to_string(d.size() / 3) + " elements, but POSITION has " +
+                 std::to_string(nv));
       std::vector<Vec3> disp(nv);
       for (size_t v = 0; v < nv; ++v) {
         disp[v] = {d[3 * v], d[3 * v + 1], d[3 * v + 2]};
@@ -453,10 +480,14 @@ std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t
       const auto& ch = an.channels[ci];
       std::string where = "animation " + std::to_string(ai) + " channel " + std::to_string(ci);
       Channel c;
-      if (ch.target_path == "translation") c.path = 0;
-      else if (ch.target_path == "rotation") c.path = 1;
-      else if (ch.target_path == "scale") c.path = 2;
-      else if (ch.target_path == "weights") c.path = 3;
+      if (ch.target_path == "translation")
+        c.path = 0;
+      else if (ch.target_path == "rotation")
+        c.path = 1;
+      else if (ch.target_path == "scale")
+        c.path = 2;
+      else if (ch.target_path == "weights")
+        c.path = 3;
       else {
         ctx.warnings->push_back(ctx.path + ": " + where + ": target path '" + ch.target_path +
                                 "' is not supported; channel ignored");
@@ -467,8 +498,8 @@ std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t
       if (c.path == 3) {
         c.ncomp = node_targets[size_t(ch.target_node)];
         if (c.ncomp == 0)
-          ctx.fail(where + ": animates the morph weights of node " + std::to_string(ch.target_node) +
-                   ", which has no mesh with morph targets");
+          ctx.fail(where + ": animates the morph weights of node " +
+                   std::to_string(ch.target_node) + ", which has no mesh with morph targets");
       } else {
         c.ncomp = c.path == 1 ? 4 : 3;
       }
@@ -479,14 +510,14 @@ std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t
       c.interp = s.interpolation == "STEP" ? 1 : s.interpolation == "CUBICSPLINE" ? 2 : 0;
       int nc;
       c.times = read_accessor(ctx, s.input, "input of " + where, nc, {1});
-      c.values = read_accessor(ctx, s.output, "output of " + where, nc,
-                               {c.path == 3 ? 1 : int(c.ncomp)});
+      c.values =
+          read_accessor(ctx, s.output, "output of " + where, nc, {c.path == 3 ? 1 : int(c.ncomp)});
       size_t per_key = c.ncomp * (c.interp == 2 ? 3 : 1);
       if (c.times.empty() || c.values.size() != c.times.size() * per_key)
-        ctx.fail("accessor " + std::to_string(s.output) + " (output of " + where + "): " +
-                 std::to_string(c.values.size()) + " values, but " + std::to_string(c.times.size()) +
-                 " keys (accessor " + std::to_string(s.input) + ") need " +
-                 std::to_string(c.times.size() * per_key) +
+        ctx.fail("accessor " + std::to_string(s.output) + " (output of " + where +
+                 "): " + std::to_string(c.values.size()) + " values, but " +
+                 std::to_string(c.times.size()) + " keys (accessor " + std::to_string(s.input) +
+                 ") need " + std::to_string(c.times.size() * per_key) +
                  (c.path == 3 ? " (" + std::to_string(c.ncomp) + " morph weights per key" +
                                     (c.interp == 2 ? ", times 3 for CUBICSPLINE)" : ")")
                               : std::string()));
@@ -521,7 +552,7 @@ void sample(const Channel& c, double t, double* v) {
     for (size_t i = 0; i < n; ++i) {
       double p0 = val(k0, i), p1 = val(k, i);
       double m0 = dt * c.values[k0 * stride + 2 * n + i];  // out-tangent of k0
-      double m1 = dt * c.values[k * stride + i];          // in-tangent of k
+      double m1 = dt * c.values[k * stride + i];           // in-tangent of k
       v[i] = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 +
              (s3 - s2) * m1;
     }
@@ -559,7 +590,8 @@ void check_extensions(const Ctx& ctx) {
   }
   for (const auto& e : ctx.model.extensionsUsed)
     if (e == "EXT_mesh_gpu_instancing" || e == "KHR_draco_mesh_compression")
-      ctx.warnings->push_back(ctx.path + ": extension " + e + " is used but not supported; "
+      ctx.warnings->push_back(ctx.path + ": extension " + e +
+                              " is used but not supported; "
                               "geometry that relies on it is missing");
 }
 
@@ -571,7 +603,8 @@ void parse_file(Ctx& ctx) {
   bool has_bin = false;
   if (glb) {
     if (bytes.size() < 20)
-      ctx.fail("truncated .glb: " + std::to_string(bytes.size()) + " bytes, less than a GLB header");
+      ctx.fail("truncated .glb: " + std::to_string(bytes.size()) +
+               " bytes, less than a GLB header");
     uint32_t version = rd32(bytes, 4), length = rd32(bytes, 8);
     if (version != 2) ctx.fail("unsupported GLB version " + std::to_string(version));
     if (length > bytes.size())
@@ -581,9 +614,11 @@ void parse_file(Ctx& ctx) {
     for (int chunk = 0; at + 8 <= length; ++chunk) {
       uint32_t clen = rd32(bytes, at), ctype = rd32(bytes, at + 4);
       if (clen > length - at - 8)
-        ctx.fail("truncated .glb: chunk " + std::to_string(chunk) + " at byte " + std::to_string(at) +
-                 " declares " + std::to_string(clen) + " bytes, past the end of the file");
-      if (chunk == 0 && ctype != 0x4E4F534Au) ctx.fail("malformed .glb: the first chunk is not JSON");
+        ctx.fail("truncated .glb: chunk " + std::to_string(chunk) + " at byte " +
+                 std::to_string(at) + " declares " + std::to_string(clen) +
+                 " bytes, past the end of the file");
+      if (chunk == 0 && ctype != 0x4E4F534Au)
+        ctx.fail("malformed .glb: the first chunk is not JSON");
       if (chunk == 0) json_text = bytes.substr(at + 8, clen);
       if (chunk == 1 && ctype == 0x004E4942u) bin = bytes.substr(at + 8, clen), has_bin = true;
       at += 8 + size_t(clen);
@@ -638,7 +673,8 @@ void parse_file(Ctx& ctx) {
                                        reinterpret_cast<const unsigned char*>(out.data()),
                                        unsigned(out.size()), base);
     } else {
-      ok = loader.LoadASCIIFromString(&ctx.model, &err, &warn, text.c_str(), unsigned(text.size()), base);
+      ok = loader.LoadASCIIFromString(&ctx.model, &err, &warn, text.c_str(), unsigned(text.size()),
+                                      base);
     }
   } catch (const std::exception& e) {
     ok = false;
@@ -684,10 +720,13 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     std::copy(nd.translation.begin(), nd.translation.end(), rest[n].t);
     std::copy(nd.rotation.begin(), nd.rotation.end(), rest[n].r);
     std::copy(nd.scale.begin(), nd.scale.end(), rest[n].s);
-    if (nd.mesh >= int(model.meshes.size())) ctx.fail(who + ": mesh " + std::to_string(nd.mesh) + " does not exist");
-    if (nd.skin >= int(model.skins.size())) ctx.fail(who + ": skin " + std::to_string(nd.skin) + " does not exist");
+    if (nd.mesh >= int(model.meshes.size()))
+      ctx.fail(who + ": mesh " + std::to_string(nd.mesh) + " does not exist");
+    if (nd.skin >= int(model.skins.size()))
+      ctx.fail(who + ": skin " + std::to_string(nd.skin) + " does not exist");
     for (int c : nd.children) {
-      if (c < 0 || size_t(c) >= N) ctx.fail(who + ": child " + std::to_string(c) + " does not exist");
+      if (c < 0 || size_t(c) >= N)
+        ctx.fail(who + ": child " + std::to_string(c) + " does not exist");
       if (parent[c] != -1 || size_t(c) == n)
         ctx.fail("node " + std::to_string(c) + " has more than one parent (or is its own child)");
       parent[c] = int(n);
@@ -702,11 +741,12 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     for (size_t pi = 1; pi < mesh.primitives.size(); ++pi)
       if (mesh.primitives[pi].targets.size() != mesh_targets[m])
         ctx.fail("mesh " + std::to_string(m) + ": primitive " + std::to_string(pi) + " has " +
-                 std::to_string(mesh.primitives[pi].targets.size()) + " morph targets, primitive 0 has " +
-                 std::to_string(mesh_targets[m]));
+                 std::to_string(mesh.primitives[pi].targets.size()) +
+                 " morph targets, primitive 0 has " + std::to_string(mesh_targets[m]));
     if (!mesh.weights.empty() && mesh.weights.size() != mesh_targets[m])
-      ctx.fail("mesh " + std::to_string(m) + ": weights has " + std::to_string(mesh.weights.size()) +
-               " numbers, but the mesh has " + std::to_string(mesh_targets[m]) + " morph targets");
+      ctx.fail("mesh " + std::to_string(m) + ": weights has " +
+               std::to_string(mesh.weights.size()) + " numbers, but the mesh has " +
+               std::to_string(mesh_targets[m]) + " morph targets");
   }
   std::vector<size_t> node_targets(N, 0);
   std::vector<std::vector<double>> rest_weights(N);
@@ -733,9 +773,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
   std::vector<int> roots;
   if (!model.scenes.empty()) {
     int si = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (size_t(si) >= model.scenes.size()) ctx.fail("default scene " + std::to_string(si) + " does not exist");
+    if (size_t(si) >= model.scenes.size())
+      ctx.fail("default scene " + std::to_string(si) + " does not exist");
     for (int r : model.scenes[si].nodes) {
-      if (r < 0 || size_t(r) >= N) ctx.fail("scene " + std::to_string(si) + ": node " + std::to_string(r) + " does not exist");
+      if (r < 0 || size_t(r) >= N)
+        ctx.fail("scene " + std::to_string(si) + ": node " + std::to_string(r) + " does not exist");
       roots.push_back(r);
     }
   } else {
@@ -757,9 +799,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
 
   // Animation channels and sample times.
   std::vector<Channel> channels;
-  if (options.states > 1 || options.animation >= 0) channels = read_channels(ctx, options.animation, node_targets);
+  if (options.states > 1 || options.animation >= 0)
+    channels = read_channels(ctx, options.animation, node_targets);
   double t_end = 0;
-  for (const auto& c : channels) t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
+  for (const auto& c : channels)
+    t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
   size_t K = options.states > 1 && !channels.empty() ? size_t(options.states) : 1;
 
   // World matrices and morph weights of all nodes in each state.
@@ -775,7 +819,10 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
           continue;
         }
         if (local[c.node].has_matrix) continue;  // animated nodes must use TRS (glTF 2.0 §5.25)
-        sample(c, t, c.path == 0 ? local[c.node].t : c.path == 1 ? local[c.node].r : local[c.node].s);
+        sample(c, t,
+               c.path == 0   ? local[c.node].t
+               : c.path == 1 ? local[c.node].r
+                             : local[c.node].s);
       }
     }
     std::vector<char> done(N, 0);
@@ -801,7 +848,7 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       mesh_cache[nd.mesh] = decode_mesh(ctx, nd.mesh, skinned);
       mesh_cached[nd.mesh] = 1;
     }
-    std::string name = !nd.name.empty() ? nd.name
+    std::string name = !nd.name.empty()                      ? nd.name
                        : !model.meshes[nd.mesh].name.empty() ? model.meshes[nd.mesh].name
                                                              : "node" + std::to_string(n);
     uint32_t obj = uint32_t(scene.objects.size());
@@ -813,14 +860,16 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       std::vector<double> ibm;
       int nc;
       if (skin.inverseBindMatrices >= 0)
-        ibm = read_accessor(ctx, skin.inverseBindMatrices, "inverseBindMatrices of skin " +
-                            std::to_string(nd.skin), nc, {16});
+        ibm = read_accessor(ctx, skin.inverseBindMatrices,
+                            "inverseBindMatrices of skin " + std::to_string(nd.skin), nc, {16});
       if (!ibm.empty() && ibm.size() < 16 * skin.joints.size())
         ctx.fail("skin " + std::to_string(nd.skin) + ": fewer inverse bind matrices than joints");
       joint_m.assign(K, std::vector<Mat4>(skin.joints.size()));
       for (size_t j = 0; j < skin.joints.size(); ++j) {
         int jn = skin.joints[j];
-        if (jn < 0 || size_t(jn) >= N) ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) + " does not exist");
+        if (jn < 0 || size_t(jn) >= N)
+          ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) +
+                   " does not exist");
         Mat4 inv;
         if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inv.m);
         for (size_t k = 0; k < K; ++k) joint_m[k][j] = world[k][jn] * inv;
@@ -839,7 +888,8 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
           morphed = p.local;
           for (size_t ti = 0; ti < p.targets.size(); ++ti) {
             if (w[ti] == 0 || p.targets[ti].empty()) continue;
-            for (size_t v = 0; v < morphed.size(); ++v) morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
+            for (size_t v = 0; v < morphed.size(); ++v)
+              morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
           }
           local = &morphed;
         }
@@ -865,7 +915,8 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
         }
       }
       for (auto t : p.tris) {
-        scene.triangles.push_back({uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
+        scene.triangles.push_back(
+            {uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
         scene.triangle_object.push_back(obj);
       }
     }
