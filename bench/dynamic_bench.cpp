@@ -17,8 +17,8 @@
 #include <functional>
 #include <map>
 
-#include "vislib/scene/generate.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/generate.h"
 
 using namespace vislib;
 
@@ -29,11 +29,11 @@ const int kN = 128;
 // Icosphere of `subdiv` subdivisions around the origin, radius 1.
 void icosphere(int subdiv, std::vector<Vec3>& verts, std::vector<std::array<uint32_t, 3>>& tris) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  verts = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-           {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  tris = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-          {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-          {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  verts = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+           {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  tris = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+          {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
+          {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (auto& v : verts) v = v * (1.0 / length(v));
   for (int s = 0; s < subdiv; ++s) {
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> mid;
@@ -67,7 +67,8 @@ Scene tessellate(const Scene& s, int subdiv) {
   for (size_t i = 0; i < s.sphere_count(); ++i) {
     uint32_t base = uint32_t(out.positions[0].size());
     for (size_t k = 0; k < s.sphere_centers.size(); ++k)
-      for (const Vec3& v : uv) out.positions[k].push_back(s.sphere_centers[k][i] + v * s.sphere_radius[i]);
+      for (const Vec3& v : uv)
+        out.positions[k].push_back(s.sphere_centers[k][i] + v * s.sphere_radius[i]);
     for (auto f : ut) out.triangles.push_back({base + f[0], base + f[1], base + f[2]});
     out.triangle_object.insert(out.triangle_object.end(), ut.size(), uint32_t(i));
     out.objects.push_back({"sphere" + std::to_string(i)});
@@ -111,16 +112,19 @@ const Vec3 kSphereA{-5, 2, 0}, kSphereB{5, 2, 0};
 const Vec3 kGrassA{-4, 1.0, 0}, kGrassB{4, 1.2, 1};
 
 void BM_Spheres(benchmark::State& st) {
-  for (auto _ : st) benchmark::DoNotOptimize(run(scenes().spheres, kSphereA, kSphereB).visible_spheres.size());
+  for (auto _ : st)
+    benchmark::DoNotOptimize(run(scenes().spheres, kSphereA, kSphereB).visible_spheres.size());
 }
 void BM_TessellatedSpheres(benchmark::State& st) {
-  for (auto _ : st) benchmark::DoNotOptimize(run(scenes().tessellated, kSphereA, kSphereB).visible.size());
+  for (auto _ : st)
+    benchmark::DoNotOptimize(run(scenes().tessellated, kSphereA, kSphereB).visible.size());
 }
 void BM_GrassDynamic(benchmark::State& st) {
   for (auto _ : st) benchmark::DoNotOptimize(run(scenes().grass, kGrassA, kGrassB).visible.size());
 }
 void BM_GrassStatic(benchmark::State& st) {
-  for (auto _ : st) benchmark::DoNotOptimize(run(scenes().grass_static, kGrassA, kGrassB).visible.size());
+  for (auto _ : st)
+    benchmark::DoNotOptimize(run(scenes().grass_static, kGrassA, kGrassB).visible.size());
 }
 BENCHMARK(BM_Spheres)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TessellatedSpheres)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -150,15 +154,18 @@ int table() {
     vt = size_t(std::unique(obj.begin(), obj.end()) - obj.begin());
   });
   std::setvbuf(stdout, nullptr, _IONBF, 0);
-  std::printf("spheres: %zu spheres x %zu states, N=%d: direct %.3f s (%zu visible), tessellated "
-              "(%zu triangles) %.3f s (%zu spheres visible): speedup %.1fx\n",
-              s.spheres.sphere_count(), s.spheres.state_count(), kN, ts, vs, s.tessellated.triangle_count(), tt, vt,
-              tt / ts);
+  std::printf(
+      "spheres: %zu spheres x %zu states, N=%d: direct %.3f s (%zu visible), tessellated "
+      "(%zu triangles) %.3f s (%zu spheres visible): speedup %.1fx\n",
+      s.spheres.sphere_count(), s.spheres.state_count(), kN, ts, vs, s.tessellated.triangle_count(),
+      tt, vt, tt / ts);
   double td = median3([&] { vd = run(s.grass, kGrassA, kGrassB).visible.size(); });
   double tst = median3([&] { vst = run(s.grass_static, kGrassA, kGrassB).visible.size(); });
-  std::printf("grass: %zu triangles, N=%d: dynamic (%zu states) %.3f s (%zu visible), static (state 0) %.3f s "
-              "(%zu visible): dynamic/static %.1fx\n",
-              s.grass.triangle_count(), kN, s.grass.state_count(), td, vd, tst, vst, td / tst);
+  std::printf(
+      "grass: %zu triangles, N=%d: dynamic (%zu states) %.3f s (%zu visible), static (state 0) "
+      "%.3f s "
+      "(%zu visible): dynamic/static %.1fx\n",
+      s.grass.triangle_count(), kN, s.grass.state_count(), td, vd, tst, vst, td / tst);
   return 0;
 }
 

@@ -7,9 +7,9 @@
 #include <tbb/global_control.h>
 
 #include "vislib/base/cubemap.h"
+#include "vislib/base/random.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/point_visibility.h"
-#include "vislib/base/random.h"
 
 using namespace vislib;
 
@@ -34,8 +34,8 @@ Scene box_city(int grid, uint64_t seed) {
       const double cx = i * pitch, cy = j * pitch, h = rng.uniform(2.0, 30.0);
       const uint32_t b = uint32_t(p.size());
       for (int k = 0; k < 8; ++k)
-        p.push_back({cx + ((k & 1) ? half : -half), cy + ((k & 2) ? half : -half),
-                     (k & 4) ? h : 0.0});
+        p.push_back(
+            {cx + ((k & 1) ? half : -half), cy + ((k & 2) ? half : -half), (k & 4) ? h : 0.0});
       quad(b + 0, b + 1, b + 3, b + 2);  // bottom
       quad(b + 4, b + 5, b + 7, b + 6);  // top
       quad(b + 0, b + 1, b + 5, b + 4);  // y-

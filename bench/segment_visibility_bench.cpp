@@ -19,10 +19,10 @@
 #include <memory>
 
 #include "vislib/eval/embree_scene.h"
-#include "vislib/scene/generate.h"
-#include "vislib/scene/import.h"
 #include "vislib/eval/point_visibility.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/generate.h"
+#include "vislib/scene/import.h"
 
 using namespace vislib;
 
@@ -54,7 +54,8 @@ std::vector<std::unique_ptr<BenchScene>>& scenes() {
       b->v1 = {0, 1.7, 10};
       v.push_back(std::move(b));
     }
-    std::string pandora = std::string(VISLIB_SOURCE_DIR) + "/../shared/scenes/sauer_pandora/pandora.obj";
+    std::string pandora =
+        std::string(VISLIB_SOURCE_DIR) + "/../shared/scenes/sauer_pandora/pandora.obj";
     if (std::filesystem::exists(pandora)) {
       auto b = std::make_unique<BenchScene>();
       b->name = "pandora";
@@ -124,7 +125,8 @@ int ratio_table() {
     double seg = median_seconds([&] { r = run_segment(*b); }, 3);
     EmbreeScene es(b->scene, 0.0, b->v0);
     size_t pv = 0;
-    double pt = median_seconds([&] { pv = visible_set(point_cubemap(es, b->v0, Mat3{}, kN, kNear)).size(); }, 3);
+    double pt = median_seconds(
+        [&] { pv = visible_set(point_cubemap(es, b->v0, Mat3{}, kN, kNear)).size(); }, 3);
     std::printf("%-10s %10zu %12.3f %12.4f %8.1f %10zu %10zu %12llu %10.2f\n", b->name.c_str(),
                 b->scene.triangle_count(), seg, pt, seg / pt, r.visible.size(), pv,
                 (unsigned long long)r.stats.pair_tests, r.stats.pieces_per_pixel());
@@ -143,7 +145,8 @@ int main(int argc, char** argv) {
     benchmark::RegisterBenchmark(("Segment512/" + b->name).c_str(), BM_Segment512, b.get())
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    benchmark::RegisterBenchmark(("PointCubemap512/" + b->name).c_str(), BM_PointCubemap512, b.get())
+    benchmark::RegisterBenchmark(("PointCubemap512/" + b->name).c_str(), BM_PointCubemap512,
+                                 b.get())
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }

@@ -1,4 +1,5 @@
-/* engine_loop.c: how an engine applies a PVS each frame, through the C API (runtime/pvs_runtime_c.h).
+/* engine_loop.c: how an engine applies a PVS each frame, through the C API
+ * (runtime/pvs_runtime_c.h).
  *
  *   engine_loop FILE.pvs [FINGERPRINT_HEX] [--frames N]
  *
@@ -16,7 +17,8 @@
 #include "runtime/pvs_runtime_c.h"
 
 static int die(const char* what, pvs_rt_status s) {
-  fprintf(stderr, "engine_loop: %s failed (%s): %s\n", what, pvs_rt_status_name(s), pvs_rt_last_error());
+  fprintf(stderr, "engine_loop: %s failed (%s): %s\n", what, pvs_rt_status_name(s),
+          pvs_rt_last_error());
   return 1;
 }
 
@@ -25,9 +27,14 @@ int main(int argc, char** argv) {
   int check = 0, frames = 600;
   uint64_t fingerprint = 0;
   for (int i = 1; i < argc; ++i) {
-    if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc) frames = atoi(argv[++i]);
-    else if (!path) path = argv[i];
-    else { fingerprint = strtoull(argv[i], NULL, 16); check = 1; }
+    if (strcmp(argv[i], "--frames") == 0 && i + 1 < argc)
+      frames = atoi(argv[++i]);
+    else if (!path)
+      path = argv[i];
+    else {
+      fingerprint = strtoull(argv[i], NULL, 16);
+      check = 1;
+    }
   }
   if (!path || frames < 1) {
     fprintf(stderr, "usage: engine_loop FILE.pvs [FINGERPRINT_HEX] [--frames N]\n");
@@ -63,7 +70,10 @@ int main(int argc, char** argv) {
 
     uint32_t cell;
     s = pvs_rt_find_cell(pvs, eye, &cell);
-    if (s == PVS_RT_NOT_FOUND) { ++outside; continue; } /* keep drawing the last cell's set */
+    if (s == PVS_RT_NOT_FOUND) {
+      ++outside;
+      continue;
+    } /* keep drawing the last cell's set */
     if (s != PVS_RT_OK) return die("find_cell", s);
     if (cell == current) continue;
     current = cell;
@@ -74,7 +84,10 @@ int main(int argc, char** argv) {
     if (n > ids_capacity) {
       ids_capacity = n;
       ids = (uint32_t*)realloc(ids, ids_capacity * sizeof *ids);
-      if (!ids) { fprintf(stderr, "engine_loop: out of memory\n"); return 1; }
+      if (!ids) {
+        fprintf(stderr, "engine_loop: out of memory\n");
+        return 1;
+      }
     }
     size_t count = 0;
     s = pvs_rt_visible_ids(pvs, cell, ids, ids_capacity, &count);
@@ -91,16 +104,20 @@ int main(int argc, char** argv) {
     if (s == PVS_RT_BUFFER_TOO_SMALL) { /* grow to the size it reported, ask again */
       neighbours_capacity = nn;
       neighbours = (uint32_t*)realloc(neighbours, neighbours_capacity * sizeof *neighbours);
-      if (!neighbours) { fprintf(stderr, "engine_loop: out of memory\n"); return 1; }
+      if (!neighbours) {
+        fprintf(stderr, "engine_loop: out of memory\n");
+        return 1;
+      }
       s = pvs_rt_neighbours(pvs, cell, 0.0, neighbours, neighbours_capacity, &nn);
     }
     if (s != PVS_RT_OK) return die("neighbours", s);
     for (size_t i = 0; i < nn; ++i) pvs_rt_prefetch(pvs, neighbours[i]);
-    printf("frame %4d eye (%.2f, %.2f, %.2f): cell %u, %zu visible ids, %zu neighbours prefetched\n", f, eye[0],
-           eye[1], eye[2], cell, count, nn);
+    printf(
+        "frame %4d eye (%.2f, %.2f, %.2f): cell %u, %zu visible ids, %zu neighbours prefetched\n",
+        f, eye[0], eye[1], eye[2], cell, count, nn);
   }
-  printf("%d frames, %ld cell changes, %ld frames outside every cell, %llu ids fetched\n", frames, changes, outside,
-         ids_total);
+  printf("%d frames, %ld cell changes, %ld frames outside every cell, %llu ids fetched\n", frames,
+         changes, outside, ids_total);
   free(ids);
   free(neighbours);
   pvs_rt_close(pvs);

@@ -42,7 +42,8 @@ void exercise(std::string_view bytes, bool checksums) {
         cells[c] = r.read_cell(c);
         const auto& ids = *cells[c];
         check(ids.size() == r.entry(c).count);
-        for (size_t i = 0; i < ids.size(); ++i) check(ids[i] < info.universe && (i == 0 || ids[i - 1] < ids[i]));
+        for (size_t i = 0; i < ids.size(); ++i)
+          check(ids[i] < info.universe && (i == 0 || ids[i - 1] < ids[i]));
       } catch (const pvs::FormatError&) {
         complete = false;
       }

@@ -8,7 +8,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libstb-dev
   python3 python3-matplotlib python3-numpy
-  clang libclang-rt-14-dev
+  clang libclang-rt-14-dev clang-format
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -51,10 +51,12 @@ TEST(CliInfo, BadInputsExitWithCode2AndNameTheFile) {
   g = triangle();
   g.positions[8] = INFINITY;
   expect_bad_input(write_gltf(dir + "/inf.gltf", g), "vertex 2 is not finite");
-  expect_bad_input(write_text(dir + "/nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"), "line 2");
+  expect_bad_input(write_text(dir + "/nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"),
+                   "line 2");
   expect_bad_input(write_text(dir + "/scene.fbx", "Kaydara"), "unsupported file format '.fbx'");
   expect_bad_input(write_text(dir + "/s.spheres", "vislib-spheres 1\nstates 1\n1 0 0\n"), "line 3");
-  expect_bad_input(write_text(dir + "/garbage.glb", "glTF\x02\0\0\0garbage-garbage-garbage"), "glb");
+  expect_bad_input(write_text(dir + "/garbage.glb", "glTF\x02\0\0\0garbage-garbage-garbage"),
+                   "glb");
   expect_bad_input(write_text(dir + "/garbage.gltf", "{ not json"), "invalid JSON");
 }
 
@@ -76,7 +78,10 @@ TEST(CliInfo, SharedScenesReportTheReadmeTriangleCounts) {
   std::string out;
   ASSERT_EQ(run_pvs("info --json " + shared + "/scenes/sauer_fdm6/fdm6.obj", &out), 0) << out;
   EXPECT_EQ(json::parse(out)["triangles"], 9779);
-  ASSERT_EQ(run_pvs("info --json --states 5 " + shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf", &out), 0);
+  ASSERT_EQ(
+      run_pvs("info --json --states 5 " + shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf",
+              &out),
+      0);
   EXPECT_EQ(json::parse(out)["states"], 5);
   EXPECT_EQ(json::parse(out)["dynamic"], true);
 }
@@ -104,8 +109,8 @@ TEST(CliExport, RoundTripKeepsTrianglesObjectsAndExactCoordinates) {
 
 TEST(CliExport, SpheresGoBesideTheObjAndRoundTrip) {
   std::string dir = temp_dir("cli_export_spheres");
-  std::string in = write_text(dir + "/s.spheres",
-                              "vislib-spheres 1\nstates 2\n0.25 0.1 0.2 0.3 1 2 3\n2 0 0 0 0 0 1e-9\n");
+  std::string in = write_text(
+      dir + "/s.spheres", "vislib-spheres 1\nstates 2\n0.25 0.1 0.2 0.3 1 2 3\n2 0 0 0 0 0 1e-9\n");
   std::string out;
   ASSERT_EQ(run_pvs("export '" + in + "' -o '" + dir + "/o.obj'", &out), 0) << out;
   vislib::Scene a = vislib::load_scene(in), b = vislib::load_scene(dir + "/o.obj.spheres");
@@ -121,10 +126,12 @@ TEST(CliExport, TimeSamplesTheAnimation) {
   VISLIB_REQUIRE_SHARED(shared);
   std::string dir = temp_dir("cli_export_time");
   std::string in = shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf", out;
-  ASSERT_EQ(run_pvs("export '" + in + "' --states 5 --time 0.5 -o '" + dir + "/m.obj'", &out), 0) << out;
+  ASSERT_EQ(run_pvs("export '" + in + "' --states 5 --time 0.5 -o '" + dir + "/m.obj'", &out), 0)
+      << out;
   vislib::LoadOptions o;
   o.states = 5;
   vislib::Scene a = vislib::load_scene(in, o), b = vislib::load_scene(dir + "/m.obj");
   ASSERT_EQ(a.vertex_count(), b.vertex_count());
-  for (uint32_t v = 0; v < a.vertex_count(); ++v) ASSERT_EQ(a.position_at(v, 0.5), b.positions[0][v]);
+  for (uint32_t v = 0; v < a.vertex_count(); ++v)
+    ASSERT_EQ(a.position_at(v, 0.5), b.positions[0][v]);
 }

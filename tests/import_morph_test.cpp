@@ -38,15 +38,18 @@ struct Builder {
     doc["accessors"] = json::array();
   }
   size_t view(const void* data, size_t bytes) {
-    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes}});
+    doc["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes}});
     bin.append(static_cast<const char*>(data), bytes);
     return doc["bufferViews"].size() - 1;
   }
   // Float accessor of `type` ("SCALAR", "VEC3") over `v`.
   int floats(const std::vector<float>& v, const char* type) {
     size_t n = std::string(type) == "VEC3" ? 3 : 1;
-    json a = {{"bufferView", view(v.data(), 4 * v.size())}, {"componentType", 5126},
-              {"count", v.size() / n}, {"type", type}};
+    json a = {{"bufferView", view(v.data(), 4 * v.size())},
+              {"componentType", 5126},
+              {"count", v.size() / n},
+              {"type", type}};
     if (n == 1 && !v.empty()) {
       a["min"] = {*std::min_element(v.begin(), v.end())};
       a["max"] = {*std::max_element(v.begin(), v.end())};
@@ -55,18 +58,23 @@ struct Builder {
     return int(doc["accessors"].size() - 1);
   }
   // VEC3 float accessor of `count` zeros (no bufferView) with sparse replacements.
-  int sparse_vec3(size_t count, const std::vector<uint32_t>& indices, const std::vector<float>& values) {
-    size_t iv = view(indices.data(), 4 * indices.size()), vv = view(values.data(), 4 * values.size());
-    doc["accessors"].push_back(
-        {{"componentType", 5126}, {"count", count}, {"type", "VEC3"},
-         {"sparse", {{"count", indices.size()},
-                     {"indices", {{"bufferView", iv}, {"componentType", 5125}}},
-                     {"values", {{"bufferView", vv}}}}}});
+  int sparse_vec3(size_t count, const std::vector<uint32_t>& indices,
+                  const std::vector<float>& values) {
+    size_t iv = view(indices.data(), 4 * indices.size()),
+           vv = view(values.data(), 4 * values.size());
+    doc["accessors"].push_back({{"componentType", 5126},
+                                {"count", count},
+                                {"type", "VEC3"},
+                                {"sparse",
+                                 {{"count", indices.size()},
+                                  {"indices", {{"bufferView", iv}, {"componentType", 5125}}},
+                                  {"values", {{"bufferView", vv}}}}}});
     return int(doc["accessors"].size() - 1);
   }
   std::string write(const std::string& path) {
-    doc["buffers"] = json::array(
-        {{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+    doc["buffers"] =
+        json::array({{{"byteLength", bin.size()},
+                      {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
     return write_text(path, doc.dump());
   }
 };
@@ -78,10 +86,11 @@ std::string one_target_gltf(const std::string& path,
   Builder b;
   int pos = b.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
   int target = b.floats({0, 0, 2, 0, 0, 2, 0, 0, 2}, "VEC3");
-  b.doc["meshes"] = json::array({{{"name", "m"},
-                                  {"weights", {0.5}},
-                                  {"primitives", json::array({{{"attributes", {{"POSITION", pos}}},
-                                                                {"targets", json::array({{{"POSITION", target}}})}}})}}});
+  b.doc["meshes"] = json::array(
+      {{{"name", "m"},
+        {"weights", {0.5}},
+        {"primitives", json::array({{{"attributes", {{"POSITION", pos}}},
+                                     {"targets", json::array({{{"POSITION", target}}})}}})}}});
   b.doc["nodes"] = json::array({{{"name", "n"}, {"mesh", 0}}});
   b.doc["scenes"] = json::array({{{"nodes", {0}}}});
   b.doc["scene"] = 0;
@@ -95,7 +104,8 @@ void add_weights_animation(Builder& b, const std::vector<float>& times,
                            const std::vector<float>& values, const char* interp) {
   int in = b.floats(times, "SCALAR"), out = b.floats(values, "SCALAR");
   b.doc["animations"] = json::array(
-      {{{"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}})},
+      {{{"channels",
+         json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}})},
         {"samplers", json::array({{{"input", in}, {"output", out}, {"interpolation", interp}}})}}});
 }
 
@@ -121,9 +131,8 @@ TEST(ImportGltfMorph, DefaultWeightHalfGivesHalfWayPositions) {
 
 TEST(ImportGltfMorph, NodeWeightsOverrideMeshWeights) {
   std::string dir = temp_dir("morph_node");
-  Scene s = load(one_target_gltf(dir + "/node.gltf", [](Builder& b) {
-    b.doc["nodes"][0]["weights"] = {0.25};
-  }));
+  Scene s = load(one_target_gltf(dir + "/node.gltf",
+                                 [](Builder& b) { b.doc["nodes"][0]["weights"] = {0.25}; }));
   EXPECT_EQ(s.positions[0][1], (Vec3{1, 0, 0.5}));
 }
 
@@ -195,20 +204,30 @@ TEST(ImportGltfMorph, BadTargetsAndWeightsThrowInputErrorNamingTheAccessor) {
   } cases[] = {
       {"target_count",
        [](Builder& b) {
-         b.doc["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] = b.floats({0, 0, 2, 0, 0, 2}, "VEC3");
+         b.doc["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] =
+             b.floats({0, 0, 2, 0, 0, 2}, "VEC3");
        },
        "accessor 2 (POSITION of morph target 0 of mesh 0 primitive 0): 2 elements"},
       {"target_type",
        [](Builder& b) {
-         b.doc["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] = b.floats({0, 0, 2}, "SCALAR");
+         b.doc["meshes"][0]["primitives"][0]["targets"][0]["POSITION"] =
+             b.floats({0, 0, 2}, "SCALAR");
        },
        "accessor 2 (POSITION of morph target 0"},
-      {"mesh_weights", [](Builder& b) { b.doc["meshes"][0]["weights"] = {0.5, 0.5}; },
+      {"mesh_weights",
+       [](Builder& b) {
+         b.doc["meshes"][0]["weights"] = {0.5, 0.5};
+       },
        "mesh 0: weights has 2 numbers"},
-      {"node_weights", [](Builder& b) { b.doc["nodes"][0]["weights"] = {1, 2, 3}; },
+      {"node_weights",
+       [](Builder& b) {
+         b.doc["nodes"][0]["weights"] = {1, 2, 3};
+       },
        "node 0: weights has 3 numbers"},
       {"animated_weights",
-       [](Builder& b) { add_weights_animation(b, {0, 1}, {0, 1, 1}, "LINEAR"); },
+       [](Builder& b) {
+         add_weights_animation(b, {0, 1}, {0, 1, 1}, "LINEAR");
+       },
        "accessor 3 (output of animation 0 channel 0): 3 values"},
   };
   for (auto& c : cases) {
@@ -217,7 +236,8 @@ TEST(ImportGltfMorph, BadTargetsAndWeightsThrowInputErrorNamingTheAccessor) {
       load(path, 3);
       ADD_FAILURE() << c.name << ": no error";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << c.name << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos)
+          << c.name << ": " << e.what();
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
     }
   }
@@ -243,7 +263,8 @@ TEST(ImportGltfMorph, GeneratedGrassRoundTripsThroughGlbInEveryState) {
   EXPECT_EQ(s.vertex_count(), g.vertex_count());
   // Positions go through float: state 0 as float, later states as float displacements from it.
   const Box3 box = g.bounds();
-  const double size = std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
+  const double size =
+      std::max({box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z});
   const double tol = 1e-5 * size;
   double worst = 0;
   for (size_t k = 0; k < 4; ++k)
@@ -253,13 +274,16 @@ TEST(ImportGltfMorph, GeneratedGrassRoundTripsThroughGlbInEveryState) {
         worst = std::max({worst, std::abs(a[i].x - b[i].x), std::abs(a[i].y - b[i].y),
                           std::abs(a[i].z - b[i].z)});
     }
-  EXPECT_LE(worst, tol) << "largest coordinate error " << worst << " m, scene size " << size << " m";
+  EXPECT_LE(worst, tol) << "largest coordinate error " << worst << " m, scene size " << size
+                        << " m";
 }
 
 TEST(ImportGltfMorph, PvsInfoReportsTenDynamicStatesOfGeneratedGrass) {
   std::string dir = temp_dir("morph_cli");
   std::string out;
-  ASSERT_EQ(run_pvs("generate grass --size 10 --target-triangles 2000 -o '" + dir + "/g.glb'", &out), 0) << out;
+  ASSERT_EQ(
+      run_pvs("generate grass --size 10 --target-triangles 2000 -o '" + dir + "/g.glb'", &out), 0)
+      << out;
   ASSERT_EQ(run_pvs("info '" + dir + "/g.glb' --states 10", &out), 0) << out;
   EXPECT_NE(out.find("10 (dynamic)"), std::string::npos) << out;
 }

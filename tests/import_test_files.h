@@ -28,11 +28,13 @@ inline std::string base64(const std::string& in) {
   std::string out;
   size_t i = 0;
   for (; i + 2 < in.size(); i += 3) {
-    uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8 | uint8_t(in[i + 2]);
+    uint32_t v =
+        uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8 | uint8_t(in[i + 2]);
     for (int s = 18; s >= 0; s -= 6) out += t[(v >> s) & 63];
   }
   if (i < in.size()) {
-    uint32_t v = uint32_t(uint8_t(in[i])) << 16 | (i + 1 < in.size() ? uint32_t(uint8_t(in[i + 1])) << 8 : 0);
+    uint32_t v = uint32_t(uint8_t(in[i])) << 16 |
+                 (i + 1 < in.size() ? uint32_t(uint8_t(in[i + 1])) << 8 : 0);
     out += t[(v >> 18) & 63];
     out += t[(v >> 12) & 63];
     out += i + 1 < in.size() ? t[(v >> 6) & 63] : '=';
@@ -70,15 +72,18 @@ inline std::string write_gltf(const std::string& path, const GltfSpec& g) {
   doc["buffers"] = json::array({buffer});
   doc["bufferViews"] = json::array(
       {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", pos_bytes + g.view_length_extra}}});
-  doc["accessors"] = json::array({{{"bufferView", 0},
-                                   {"componentType", g.position_component_type},
-                                   {"count", g.position_count_override ? g.position_count_override
-                                                                       : g.positions.size() / 3},
-                                   {"type", "VEC3"}}});
+  doc["accessors"] = json::array(
+      {{{"bufferView", 0},
+        {"componentType", g.position_component_type},
+        {"count", g.position_count_override ? g.position_count_override : g.positions.size() / 3},
+        {"type", "VEC3"}}});
   json prim = {{"attributes", {{"POSITION", g.position_accessor}}}, {"mode", g.mode}};
   if (!g.indices.empty()) {
-    doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", pos_bytes}, {"byteLength", g.indices.size() * 4}});
-    doc["accessors"].push_back({{"bufferView", 1}, {"componentType", 5125}, {"count", g.indices.size()},
+    doc["bufferViews"].push_back(
+        {{"buffer", 0}, {"byteOffset", pos_bytes}, {"byteLength", g.indices.size() * 4}});
+    doc["accessors"].push_back({{"bufferView", 1},
+                                {"componentType", 5125},
+                                {"count", g.indices.size()},
                                 {"type", "SCALAR"}});
     prim["indices"] = 1;
   }

@@ -31,7 +31,8 @@ std::pair<double, double> project(const vislib::Camera& cam, Vec3 p) {
   Vec3 u = cross(r, f);
   Vec3 d = p - cam.eye;
   const double t = std::tan(cam.vfov_degrees * M_PI / 360.0);
-  const double sx = dot(d, r) / dot(d, f) / (t * cam.width / cam.height), sy = dot(d, u) / dot(d, f) / t;
+  const double sx = dot(d, r) / dot(d, f) / (t * cam.width / cam.height),
+               sy = dot(d, u) / dot(d, f) / t;
   return {(sx + 1) * cam.width / 2 - 0.5, (1 - sy) * cam.height / 2 - 0.5};
 }
 
@@ -141,7 +142,8 @@ TEST(NearFarRender, DynamicFarTriangleBehindAStationaryFarWallIsHidden) {
   const uint32_t base = uint32_t(s.positions[0].size());
   for (double z : {-10.0, -6.0}) {
     const size_t k = z < -8 ? 0 : 1;
-    for (Vec3 p : {Vec3{-0.8, 0.0, z}, Vec3{0.8, 0.0, z}, Vec3{0.0, 1.2, z}}) s.positions[k].push_back(p);
+    for (Vec3 p : {Vec3{-0.8, 0.0, z}, Vec3{0.8, 0.0, z}, Vec3{0.0, 1.2, z}})
+      s.positions[k].push_back(p);
   }
   s.objects.push_back({"mover"});
   s.triangles.push_back({base, base + 1, base + 2});  // triangle 2 (moving)
@@ -185,8 +187,10 @@ TEST(NearFarRender, DynamicFarTriangleBehindAStationaryFarWallIsHidden) {
 TEST(NearFarRender, DynamicFarTriangleWithNothingBehindIsDrawnByEq2) {
   vislib::Scene s;
   s.positions.resize(2);
-  for (Vec3 p : {Vec3{-0.8, 0.0, -10}, Vec3{0.8, 0.0, -10}, Vec3{0.0, 1.2, -10}}) s.positions[0].push_back(p);
-  for (Vec3 p : {Vec3{-0.8, 0.0, -6}, Vec3{0.8, 0.0, -6}, Vec3{0.0, 1.2, -6}}) s.positions[1].push_back(p);
+  for (Vec3 p : {Vec3{-0.8, 0.0, -10}, Vec3{0.8, 0.0, -10}, Vec3{0.0, 1.2, -10}})
+    s.positions[0].push_back(p);
+  for (Vec3 p : {Vec3{-0.8, 0.0, -6}, Vec3{0.8, 0.0, -6}, Vec3{0.0, 1.2, -6}})
+    s.positions[1].push_back(p);
   s.objects.push_back({"mover"});
   s.triangles.push_back({0, 1, 2});
   s.triangle_object.push_back(0);
@@ -212,22 +216,29 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   const std::string dir = vislib_test::temp_dir("pvs_view");
   std::string out;
   ASSERT_EQ(run_pvs("generate city --blocks 2,2 -o " + dir + "/city.glb", &out), 0) << out;
-  ASSERT_EQ(run_pvs("bake " + dir + "/city.glb --box -10,0,-10,10,3,10 --grid 2,1,2 --eye-height 1.5,1.8 --res 32 -o " +
-                        dir + "/city.pvs",
-                    &out),
-            0)
+  ASSERT_EQ(
+      run_pvs(
+          "bake " + dir +
+              "/city.glb --box -10,0,-10,10,3,10 --grid 2,1,2 --eye-height 1.5,1.8 --res 32 -o " +
+              dir + "/city.pvs",
+          &out),
+      0)
       << out;
-  ASSERT_EQ(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/city.glb --at 5,1.6,5 --look 40,1.6,5 "
-                    "--near-far 10,30 --grow --rings 4 --frame 96x64 -o " + dir + "/v.png --json " + dir + "/v.json",
+  ASSERT_EQ(run_pvs("view " + dir + "/city.pvs --scene " + dir +
+                        "/city.glb --at 5,1.6,5 --look 40,1.6,5 "
+                        "--near-far 10,30 --grow --rings 4 --frame 96x64 -o " +
+                        dir + "/v.png --json " + dir + "/v.json",
                     &out),
             0)
       << out;
   for (const char* name : {"/v.png", "/v_truth.png", "/v_heat.png", "/v_nomorph.png"})
     EXPECT_TRUE(std::ifstream(dir + name).good()) << name;
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir + "/v.json"));
-  for (const char* key : {"psnr", "ssim", "epsilon", "ovc", "ofc", "triangles", "without_morph", "continuity"})
+  for (const char* key :
+       {"psnr", "ssim", "epsilon", "ovc", "ofc", "triangles", "without_morph", "continuity"})
     EXPECT_TRUE(j.contains(key)) << key;
-  for (const char* key : {"near", "intermediate", "far", "visible"}) EXPECT_TRUE(j["triangles"].contains(key)) << key;
+  for (const char* key : {"near", "intermediate", "far", "visible"})
+    EXPECT_TRUE(j["triangles"].contains(key)) << key;
   EXPECT_EQ(j["triangles"]["near"].get<size_t>() + j["triangles"]["intermediate"].get<size_t>() +
                 j["triangles"]["far"].get<size_t>(),
             j["triangles"]["visible"].get<size_t>());
@@ -248,9 +259,12 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   EXPECT_EQ(c["merged"]["frames"].get<size_t>(), 1 + 4 * (merged.size() - 1));
   EXPECT_EQ(c["min_consecutive_ssim"], c["merged"]["min_consecutive_ssim"]);
   // A PVS of another scene is rejected.
-  ASSERT_EQ(run_pvs("generate city --blocks 2,2 --seed 9 -o " + dir + "/other.glb", &out), 0) << out;
-  EXPECT_NE(run_pvs("view " + dir + "/city.pvs --scene " + dir + "/other.glb --at 5,1.6,5 --look 40,1.6,5 "
-                    "--near-far 10,30 --frame 32x32 -o " + dir + "/w.png",
+  ASSERT_EQ(run_pvs("generate city --blocks 2,2 --seed 9 -o " + dir + "/other.glb", &out), 0)
+      << out;
+  EXPECT_NE(run_pvs("view " + dir + "/city.pvs --scene " + dir +
+                        "/other.glb --at 5,1.6,5 --look 40,1.6,5 "
+                        "--near-far 10,30 --frame 32x32 -o " +
+                        dir + "/w.png",
                     &out),
             0)
       << out;

@@ -1,4 +1,6 @@
 // Tests of the near-far partition and the progressive near region (runtime/near_far.h).
+#include "runtime/near_far.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -7,17 +9,21 @@
 #include <limits>
 #include <vector>
 
-#include "runtime/near_far.h"
-
 using namespace pvs_runtime;
 
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Point3 sub(const Point3& a, const Point3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-double len(const Point3& a) { return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z); }
-double dist(const Point3& a, const Point3& b) { return len(sub(a, b)); }
+Point3 sub(const Point3& a, const Point3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+double len(const Point3& a) {
+  return std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+}
+double dist(const Point3& a, const Point3& b) {
+  return len(sub(a, b));
+}
 double angle(const Point3& a, const Point3& b) {
   double c = (a.x * b.x + a.y * b.y + a.z * b.z) / (len(a) * len(b));
   return std::acos(std::clamp(c, -1.0, 1.0));
@@ -88,7 +94,7 @@ TEST(NearFar, VertexOnR2LandsOnTheRayFromOAtTheEnvironmentMapRange) {
         ASSERT_NEAR(axis_distance(p, kO), kR2, 1e-9);
         Point3 q = morph_vertex(p, kU, kO, kR1, kR2);
         Point3 uq = sub(q, kU);
-        EXPECT_LT(sin_angle(uq, sub(p, kO)), 1e-12);             // on the ray from U parallel to OP
+        EXPECT_LT(sin_angle(uq, sub(p, kO)), 1e-12);  // on the ray from U parallel to OP
         EXPECT_GT(uq.x * dir.x + uq.y * dir.y + uq.z * dir.z, 0);  // same way along it
         EXPECT_NEAR(len(uq), cube_range(map, dir), 1e-5 * range);  // at the map's range (a float)
         EXPECT_TRUE(passes_range_test(q, kU, map));
@@ -106,8 +112,9 @@ TEST(NearFar, VertexOnR2LandsOnTheRayFromOAtTheEnvironmentMapRange) {
 TEST(NearFar, RangeTestHidesADynamicFarTriangleBehindStationaryFarGeometry) {
   const int n = 128;
   auto wall = [](const Point3& d) {
-    return d.x > 0 && std::fabs(kO.y + d.y * (70 - kO.x) / d.x) < 40 ? (70 - kO.x) / d.x
-                                                                     : std::numeric_limits<double>::infinity();
+    return d.x > 0 && std::fabs(kO.y + d.y * (70 - kO.x) / d.x) < 40
+               ? (70 - kO.x) / d.x
+               : std::numeric_limits<double>::infinity();
   };
   std::vector<float> ranges = make_range_map(n, wall);
   RangeCubeMap map{n, ranges.data()};
@@ -117,7 +124,8 @@ TEST(NearFar, RangeTestHidesADynamicFarTriangleBehindStationaryFarGeometry) {
     for (int i = 0; i <= 10; ++i)
       for (int j = 0; i + j <= 10; ++j) {  // barycentric samples, vertices included
         double u = i / 10.0, v = j / 10.0, w = 1 - u - v;
-        Point3 p{a.x * u + b.x * v + c.x * w, a.y * u + b.y * v + c.y * w, a.z * u + b.z * v + c.z * w};
+        Point3 p{a.x * u + b.x * v + c.x * w, a.y * u + b.y * v + c.y * w,
+                 a.z * u + b.z * v + c.z * w};
         EXPECT_EQ(vertex_region(axis_distance(p, kO), kR1, kR2), Region::Far);
         pass += passes_range_test(displace_far(p, kU, kO), kU, map);
         ++total;
@@ -140,9 +148,11 @@ TEST(NearFar, MorphIsContinuousAlongARadialLine) {
   for (double a : {0.3, 2.5, 4.4})
     for (double y : {0.0, 6.0}) {
       double worst = 0;
-      Point3 prev = morph_vertex({kO.x + 25 * std::cos(a), y, kO.z + 25 * std::sin(a)}, kU, kO, kR1, kR2);
+      Point3 prev =
+          morph_vertex({kO.x + 25 * std::cos(a), y, kO.z + 25 * std::sin(a)}, kU, kO, kR1, kR2);
       for (double r = 25 + step; r <= 55; r += step) {
-        Point3 q = morph_vertex({kO.x + r * std::cos(a), y, kO.z + r * std::sin(a)}, kU, kO, kR1, kR2);
+        Point3 q =
+            morph_vertex({kO.x + r * std::cos(a), y, kO.z + r * std::sin(a)}, kU, kO, kR1, kR2);
         worst = std::max(worst, dist(q, prev));
         prev = q;
       }
@@ -167,8 +177,8 @@ TEST(NearFar, PartitionClassifiesByAllVerticesAndPutsTrianglesCrossingR2InBothSe
   };
   std::vector<uint8_t> dyn = {0, 0, 0, 0, 1, 1};
   std::vector<uint32_t> ids = {5, 4, 3, 2, 1, 0};
-  NearFarPartition p = partition_near_far(pos.data(), pos.size() / 3, idx.data(), 6, dyn.data(), ids.data(),
-                                          ids.size(), kO, kR1, kR2);
+  NearFarPartition p = partition_near_far(pos.data(), pos.size() / 3, idx.data(), 6, dyn.data(),
+                                          ids.data(), ids.size(), kO, kR1, kR2);
   EXPECT_EQ(p.near_ids, (std::vector<uint32_t>{0}));
   EXPECT_EQ(p.intermediate_ids, (std::vector<uint32_t>{1, 2, 5}));
   EXPECT_EQ(p.far_static_ids, (std::vector<uint32_t>{3}));
@@ -211,8 +221,10 @@ TEST(NearFarProgressive, RingRadiiGiveEqualAreasAndIncrease) {
   for (size_t k = 0; k < r.size(); ++k) {
     ASSERT_GT(r[k], prev);
     double ring = kPi * (r[k] * r[k] - prev * prev);
-    if (k + 1 < r.size()) EXPECT_NEAR(ring, area, 1e-9 * area) << k;
-    else EXPECT_LE(ring, area * (1 + 1e-12));
+    if (k + 1 < r.size())
+      EXPECT_NEAR(ring, area, 1e-9 * area) << k;
+    else
+      EXPECT_LE(ring, area * (1 + 1e-12));
     prev = r[k];
   }
   // A final radius on an exact ring boundary gives no sliver ring.
@@ -221,7 +233,8 @@ TEST(NearFarProgressive, RingRadiiGiveEqualAreasAndIncrease) {
 
 TEST(NearFarProgressive, RingsMergeUntilEachContributesEnoughAndFarRingsGrowThicker) {
   std::vector<double> r = {1, 2, 3, 4, 5, 6, 7};
-  EXPECT_EQ(merge_rings(r, {1, 1, 1, 1, 1, 1, 1}, 2), (std::vector<double>{2, 4, 7}));  // 7: short last joins
+  EXPECT_EQ(merge_rings(r, {1, 1, 1, 1, 1, 1, 1}, 2),
+            (std::vector<double>{2, 4, 7}));  // 7: short last joins
   EXPECT_EQ(merge_rings(r, {5, 0, 0, 5, 1, 1, 1}, 3), (std::vector<double>{1, 4, 7}));
   EXPECT_EQ(merge_rings(r, {0, 0, 0, 0, 0, 0, 0}, 3), (std::vector<double>{7}));
   // Uniform density, weight 1 / distance (foreshortening): equal-area rings from 10 m to 63 m.
@@ -232,15 +245,18 @@ TEST(NearFarProgressive, RingsMergeUntilEachContributesEnoughAndFarRingsGrowThic
     item_w.push_back(2 * kPi * d * 0.005 / std::max(d, 1.0));
   }
   std::vector<double> contrib = ring_contributions(radii, item_r, item_w);
-  for (size_t k = 1; k < contrib.size() - 1; ++k) ASSERT_LE(contrib[k], contrib[k - 1] * (1 + 1e-3)) << k;
+  for (size_t k = 1; k < contrib.size() - 1; ++k)
+    ASSERT_LE(contrib[k], contrib[k - 1] * (1 + 1e-3)) << k;
   std::vector<double> merged = merge_rings(radii, contrib, contrib[2]);
   ASSERT_GE(merged.size(), 4u);
   EXPECT_NEAR(merged[0], 10, 1e-9);
   // Contributions fall outward, so each merged ring takes at least as many equal-area rings as
   // the one inside it (the last group, which may have absorbed a short remainder, aside).
   std::vector<size_t> group;
-  for (double m : merged) group.push_back(size_t(std::find(radii.begin(), radii.end(), m) - radii.begin()));
-  for (size_t k = 2; k + 1 < group.size(); ++k) EXPECT_GE(group[k] - group[k - 1], group[k - 1] - group[k - 2]) << k;
+  for (double m : merged)
+    group.push_back(size_t(std::find(radii.begin(), radii.end(), m) - radii.begin()));
+  for (size_t k = 2; k + 1 < group.size(); ++k)
+    EXPECT_GE(group[k] - group[k - 1], group[k - 1] - group[k - 2]) << k;
   EXPECT_EQ(group[0], 0u);
   EXPECT_GT(group[group.size() - 2] - group[group.size() - 3], 1u);  // outer rings are merged ones
   std::printf("merged ring radii:");
@@ -276,8 +292,9 @@ TEST(NearFarProgressive, InjectedVertexStaysAtRnAndFollowsTheEnvironmentMapRayFr
 }
 
 // CloVR's growth from R = 14 to 17 m over 300 frames, R_n = 0.7 R, user 1 m beside O: the image
-// direction of every vertex of rings around it turns per frame by at most 2 theta dw_max, where theta is
-// the angle between d_U and d_O and dw_max = dR / (0.3 R_min) bounds Alg. 1's weight change per frame
+// direction of every vertex of rings around it turns per frame by at most 2 theta dw_max, where
+// theta is the angle between d_U and d_O and dw_max = dR / (0.3 R_min) bounds Alg. 1's weight
+// change per frame
 // (|d angle / dw| <= sin(theta) / cos^2(theta/2) <= 2 theta for theta <= 90 degrees). The discrete
 // switch (CloVRD) turns it by theta at once.
 TEST(NearFarProgressive, RingGrowthIsContinuous) {
@@ -303,21 +320,24 @@ TEST(NearFarProgressive, RingGrowthIsContinuous) {
       }
   EXPECT_LE(worst_ratio, 1.0);
   EXPECT_GT(largest_switch, 0.05);  // the jump that the gradual injection avoids is real
-  std::printf("worst per-frame turn / bound = %.3f; largest discrete-switch jump %.4f rad\n", worst_ratio,
-              largest_switch);
+  std::printf("worst per-frame turn / bound = %.3f; largest discrete-switch jump %.4f rad\n",
+              worst_ratio, largest_switch);
 }
 
 TEST(NearFarProgressive, PartitionIsPerObjectAndAnObjectEntersWithItsFirstVertex) {
   // Object 0: triangles 0 (near) and 1 (far); object 1: triangle 2 (far).
-  std::vector<float> pos = {1, 0, 0, 2, 0, 0, 1, 1, 0,  30, 0, 0, 31, 0, 0, 30, 1, 0,  40, 0, 0, 41, 0, 0, 40, 1, 0};
+  std::vector<float> pos = {1, 0,  0, 2, 0,  0, 1, 1,  0, 30, 0,  0, 31, 0,
+                            0, 30, 1, 0, 40, 0, 0, 41, 0, 0,  40, 1, 0};
   std::vector<uint32_t> idx = {0, 1, 2, 3, 4, 5, 6, 7, 8};
   std::vector<uint32_t> obj = {0, 0, 1};
   std::vector<uint32_t> ids = {0, 1, 2};
-  ProgressivePartition p =
-      partition_progressive(pos.data(), 9, idx.data(), 3, obj.data(), 2, ids.data(), 3, Point3{0, 0, 0}, 10);
+  ProgressivePartition p = partition_progressive(pos.data(), 9, idx.data(), 3, obj.data(), 2,
+                                                 ids.data(), 3, Point3{0, 0, 0}, 10);
   EXPECT_EQ(p.near_ids, (std::vector<uint32_t>{0, 1}));
   EXPECT_EQ(p.environment_map_ids, (std::vector<uint32_t>{2}));
-  std::vector<uint32_t> only_far = {1, 2};  // a visible subset: object 0 is near even if triangle 0 is not in it
-  p = partition_progressive(pos.data(), 9, idx.data(), 3, obj.data(), 2, only_far.data(), 2, Point3{0, 0, 0}, 10);
+  std::vector<uint32_t> only_far = {
+      1, 2};  // a visible subset: object 0 is near even if triangle 0 is not in it
+  p = partition_progressive(pos.data(), 9, idx.data(), 3, obj.data(), 2, only_far.data(), 2,
+                            Point3{0, 0, 0}, 10);
   EXPECT_EQ(p.near_ids, (std::vector<uint32_t>{1}));
 }

@@ -1,14 +1,15 @@
+#include "vislib/eval/point_visibility.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
 #include <stdexcept>
 
-#include "vislib/base/cubemap.h"
-#include "vislib/eval/embree_scene.h"
-#include "vislib/eval/point_visibility.h"
-#include "vislib/base/random.h"
 #include "tests/support/ray_oracle.h"
+#include "vislib/base/cubemap.h"
+#include "vislib/base/random.h"
+#include "vislib/eval/embree_scene.h"
 
 using namespace vislib;
 
@@ -32,8 +33,9 @@ Scene random_soup(int count, uint64_t seed, double half = 5.0, double size = 1.5
   for (int i = 0; i < count; ++i) {
     Vec3 c{rng.uniform(-half, half), rng.uniform(-half, half), rng.uniform(-half, half)};
     Vec3 v[3];
-    for (auto& q : v) q = c + Vec3{rng.uniform(-size, size), rng.uniform(-size, size),
-                                   rng.uniform(-size, size)} * 0.5;
+    for (auto& q : v)
+      q = c +
+          Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)} * 0.5;
     add_triangle(s, v[0], v[1], v[2]);
   }
   return s;
@@ -47,7 +49,9 @@ uint32_t add_small_triangle(Scene& s, Vec3 c, int axis, double h) {
   return add_triangle(s, c - u - w, c + u - w, c + w);
 }
 
-size_t pixel(int face, int x, int y, int n) { return (size_t(face) * n + y) * n + x; }
+size_t pixel(int face, int x, int y, int n) {
+  return (size_t(face) * n + y) * n + x;
+}
 
 }  // namespace
 
@@ -117,7 +121,7 @@ TEST(PointVisibility, HitCloserThanNearIsIgnored) {
   const Vec3 eye{0, 0, 0};
   // id 0: small, at depth 0.05 on +Z (too small to reach lambda > 0.1 on the side faces)
   add_triangle(s, {-0.02, -0.02, 0.05}, {0.02, -0.02, 0.05}, {0, 0.02, 0.05});
-  add_triangle(s, {-1, -1, 2.0}, {1, -1, 2.0}, {0, 1, 2.0});     // id 1, depth 2
+  add_triangle(s, {-1, -1, 2.0}, {1, -1, 2.0}, {0, 1, 2.0});  // id 1, depth 2
   const EmbreeScene es(s, 0.0, eye);
   const int n = 8;
   const Mat3 R;
@@ -200,8 +204,8 @@ TEST(PointVisibility, SegmentSamplingUnionGrowsAndEqualsUnionOfPointSets) {
   EXPECT_EQ(sv.viewpoints.back(), v1);
   std::vector<uint32_t> expect;
   for (int i = 0; i < 5; ++i) {
-    auto set = point_visible_set(es, sv.viewpoints[i], random_orientation(Rng::derive(4, i)),
-                                 32, 0.05);
+    auto set =
+        point_visible_set(es, sv.viewpoints[i], random_orientation(Rng::derive(4, i)), 32, 0.05);
     expect.insert(expect.end(), set.begin(), set.end());
   }
   EXPECT_EQ(sv.ids, visible_set(expect));

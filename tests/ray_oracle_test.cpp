@@ -1,9 +1,10 @@
+#include "tests/support/ray_oracle.h"
+
 #include <gtest/gtest.h>
 
 #include "vislib/base/cubemap.h"
-#include "vislib/eval/embree_scene.h"
 #include "vislib/base/random.h"
-#include "tests/support/ray_oracle.h"
+#include "vislib/eval/embree_scene.h"
 
 using namespace vislib;
 
@@ -37,7 +38,8 @@ TEST(RayOracle, AgreesWithBruteForceOnSegmentSamples) {
   for (int i = 0; i < 300; ++i) {
     Vec3 c{rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5)};
     Vec3 v[3];
-    for (auto& q : v) q = c + Vec3{rng.uniform(-.8, .8), rng.uniform(-.8, .8), rng.uniform(-.8, .8)};
+    for (auto& q : v)
+      q = c + Vec3{rng.uniform(-.8, .8), rng.uniform(-.8, .8), rng.uniform(-.8, .8)};
     add_triangle(scene, v[0], v[1], v[2]);
   }
   const Vec3 v0{-1, -0.5, 0.2}, v1{1.2, 0.7, -0.4};
@@ -110,8 +112,8 @@ TEST(RayOracle, NearlyCoplanarIsAmbiguousButSeparatedIsNot) {
     const EmbreeScene es(s, 0.0, Vec3{});
     const RayOracle oracle(es, Vec3{}, Vec3{}, Mat3{}, kN, 0.1);
     EXPECT_EQ(oracle.is_ambiguous(kFace, kX, kY, 0.0), gap < kOracleDepthGap) << gap;
-    EXPECT_EQ(brute_force_first_hit(s, 0.0, Vec3{}, kDir, 0.1).ambiguous,
-              gap < kReferenceDepthGap) << gap;
+    EXPECT_EQ(brute_force_first_hit(s, 0.0, Vec3{}, kDir, 0.1).ambiguous, gap < kReferenceDepthGap)
+        << gap;
   }
 }
 

@@ -1,4 +1,5 @@
-// Tests of vislib/eval/render.h: camera convention, analytic depth, shading, subset frames, determinism.
+// Tests of vislib/eval/render.h: camera convention, analytic depth, shading, subset frames,
+// determinism.
 #include "vislib/eval/render.h"
 
 #include <gtest/gtest.h>
@@ -7,8 +8,8 @@
 #include <cmath>
 
 #include "tests/scene_builders.h"
-#include "vislib/scene/generate.h"
 #include "vislib/eval/point_visibility.h"
+#include "vislib/scene/generate.h"
 
 using namespace vislib;
 using vislib_test::add_quad;

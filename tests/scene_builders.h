@@ -27,16 +27,20 @@ inline vislib::Scene random_soup(int n, uint64_t seed, double extent = 10, doubl
   vislib::Rng rng(seed);
   std::vector<std::array<vislib::Vec3, 3>> tris;
   for (int i = 0; i < n; ++i) {
-    vislib::Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent), rng.uniform(-extent, extent)};
+    vislib::Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent),
+                   rng.uniform(-extent, extent)};
     std::array<vislib::Vec3, 3> t;
-    for (auto& p : t) p = c + vislib::Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)};
+    for (auto& p : t)
+      p = c + vislib::Vec3{rng.uniform(-size, size), rng.uniform(-size, size),
+                           rng.uniform(-size, size)};
     tris.push_back(t);
   }
   return soup(tris);
 }
 
 // Appends an indexed quad (two triangles) a b c d (counter-clockwise) to `s` as one object.
-inline void add_quad(vislib::Scene& s, vislib::Vec3 a, vislib::Vec3 b, vislib::Vec3 c, vislib::Vec3 d) {
+inline void add_quad(vislib::Scene& s, vislib::Vec3 a, vislib::Vec3 b, vislib::Vec3 c,
+                     vislib::Vec3 d) {
   if (s.positions.empty()) s.positions.resize(1);
   uint32_t base = uint32_t(s.positions[0].size());
   for (auto p : {a, b, c, d}) s.positions[0].push_back(p);

@@ -1,6 +1,6 @@
-#include <gtest/gtest.h>
-
 #include "vislib/scene/scene.h"
+
+#include <gtest/gtest.h>
 
 using namespace vislib;
 

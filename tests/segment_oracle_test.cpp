@@ -11,10 +11,10 @@
 #include <mutex>
 
 #include "tests/scene_builders.h"
-#include "tests/test_support.h"
-#include "vislib/scene/import.h"
 #include "tests/support/ray_oracle.h"
+#include "tests/test_support.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/import.h"
 
 using namespace vislib;
 using vislib_test::random_soup;
@@ -63,7 +63,8 @@ OracleCounts check_segment(const Scene& scene, const EmbreeScene& embree, Vec3 v
   // On a disagreement with Embree (float): the double-precision brute-force reference decides.
   // 0 = the kernel is right (float error), 1 = ambiguous (skip), 2 = the kernel is wrong.
   auto resolve = [&](int face, int x, int y, double t, uint32_t ours) {
-    OracleSample ref = brute_force_first_hit(scene, 0.0, oracle.eye(t), oracle.direction(face, x, y), near);
+    OracleSample ref =
+        brute_force_first_hit(scene, 0.0, oracle.eye(t), oracle.direction(face, x, y), near);
     if (!ref.ambiguous && ref.tri == ours) {
       ++settled;
       return 0;
@@ -73,66 +74,71 @@ OracleCounts check_segment(const Scene& scene, const EmbreeScene& embree, Vec3 v
   };
   std::mutex m;
   std::string first;
-  auto fail = [&](const char* kind, int face, int x, int y, double t, uint32_t ours, uint32_t theirs) {
+  auto fail = [&](const char* kind, int face, int x, int y, double t, uint32_t ours,
+                  uint32_t theirs) {
     std::lock_guard<std::mutex> g(m);
     if (!first.empty()) return;
     char buf[256];
-    std::snprintf(buf, sizeof buf, "%s at face %d x %d y %d t %.17g: kernel %d, Embree %d", kind, face, x,
-                  y, t, int(ours), int(theirs));
+    std::snprintf(buf, sizeof buf, "%s at face %d x %d y %d t %.17g: kernel %d, Embree %d", kind,
+                  face, x, y, t, int(ours), int(theirs));
     first = buf;
   };
   const size_t pixels = size_t(6) * n * n;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 256), [&](const tbb::blocked_range<size_t>& br) {
-    uint64_t f = 0, fa = 0, mi = 0, c = 0, ca = 0, fpos = 0;
-    for (size_t p = br.begin(); p != br.end(); ++p) {
-      int face = int(p / (size_t(n) * n)), y = int(p / n % n), x = int(p % n);
-      const PieceList& list = r.pieces[p];
-      // Forward: at random t (away from piece boundaries) the first hit is the piece's id.
-      for (double t : ts) {
-        bool near_boundary = false;
-        for (const Piece& pc : list)
-          if (std::fabs(t - pc.t0) < 1e-9 || std::fabs(t - pc.t1) < 1e-9) near_boundary = true;
-        if (near_boundary) continue;
-        auto piece = lookup(list, t);
-        uint32_t ours = piece ? piece->id : kNoHit;
-        Hit h = oracle.first_hit(face, x, y, t);
-        ++f;
-        if (h.tri == ours) continue;
-        int verdict = resolve(face, x, y, t, ours);
-        if (verdict == 0) continue;
-        if (verdict == 1) {
-          ++fa;
-          continue;
-        }
-        ++mi;
-        fail("miss", face, x, y, t, ours, h.tri);
-      }
-      // Converse: the middle of every final piece that counts (longer than eps_len, so it puts
-      // its triangle in the set) shows that piece's triangle. Shorter pieces are rounding slivers
-      // at shared vertices (~1e-16 in t) that make nothing visible.
-      for (const Piece& pc : list) {
-        if (!(pc.t1 - pc.t0 > o.eps_len)) continue;
-        double t = 0.5 * (pc.t0 + pc.t1);
-        Hit h = oracle.first_hit(face, x, y, t);
-        ++c;
-        if (h.tri == pc.id) continue;
-        int verdict = resolve(face, x, y, t, pc.id);
-        if (verdict == 0) continue;
-        if (verdict == 1) {
-          ++ca;
-          continue;
-        }
-        ++fpos;
-        fail("false positive", face, x, y, t, pc.id, h.tri);
-      }
-    }
-    fwd += f;
-    fwd_amb += fa;
-    miss += mi;
-    conv += c;
-    conv_amb += ca;
-    fp += fpos;
-  });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, 256),
+                    [&](const tbb::blocked_range<size_t>& br) {
+                      uint64_t f = 0, fa = 0, mi = 0, c = 0, ca = 0, fpos = 0;
+                      for (size_t p = br.begin(); p != br.end(); ++p) {
+                        int face = int(p / (size_t(n) * n)), y = int(p / n % n), x = int(p % n);
+                        const PieceList& list = r.pieces[p];
+                        // Forward: at random t (away from piece boundaries) the first hit is the
+                        // piece's id.
+                        for (double t : ts) {
+                          bool near_boundary = false;
+                          for (const Piece& pc : list)
+                            if (std::fabs(t - pc.t0) < 1e-9 || std::fabs(t - pc.t1) < 1e-9)
+                              near_boundary = true;
+                          if (near_boundary) continue;
+                          auto piece = lookup(list, t);
+                          uint32_t ours = piece ? piece->id : kNoHit;
+                          Hit h = oracle.first_hit(face, x, y, t);
+                          ++f;
+                          if (h.tri == ours) continue;
+                          int verdict = resolve(face, x, y, t, ours);
+                          if (verdict == 0) continue;
+                          if (verdict == 1) {
+                            ++fa;
+                            continue;
+                          }
+                          ++mi;
+                          fail("miss", face, x, y, t, ours, h.tri);
+                        }
+                        // Converse: the middle of every final piece that counts (longer than
+                        // eps_len, so it puts its triangle in the set) shows that piece's triangle.
+                        // Shorter pieces are rounding slivers at shared vertices (~1e-16 in t) that
+                        // make nothing visible.
+                        for (const Piece& pc : list) {
+                          if (!(pc.t1 - pc.t0 > o.eps_len)) continue;
+                          double t = 0.5 * (pc.t0 + pc.t1);
+                          Hit h = oracle.first_hit(face, x, y, t);
+                          ++c;
+                          if (h.tri == pc.id) continue;
+                          int verdict = resolve(face, x, y, t, pc.id);
+                          if (verdict == 0) continue;
+                          if (verdict == 1) {
+                            ++ca;
+                            continue;
+                          }
+                          ++fpos;
+                          fail("false positive", face, x, y, t, pc.id, h.tri);
+                        }
+                      }
+                      fwd += f;
+                      fwd_amb += fa;
+                      miss += mi;
+                      conv += c;
+                      conv_amb += ca;
+                      fp += fpos;
+                    });
   OracleCounts out;
   out.forward = fwd;
   out.forward_ambiguous = fwd_amb;
@@ -148,8 +154,10 @@ OracleCounts check_segment(const Scene& scene, const EmbreeScene& embree, Vec3 v
     ++out.witnesses;
     Hit h = oracle.first_hit(w.face, w.x, w.y, w.t);
     if (h.tri == w.tri || resolve(w.face, w.x, w.y, w.t, w.tri) != 2) continue;
-    OracleSample ref = brute_force_first_hit(scene, 0.0, oracle.eye(w.t), oracle.direction(w.face, w.x, w.y), near);
-    double mine = triangle_depth(scene, w.tri, oracle.eye(w.t), oracle.direction(w.face, w.x, w.y), near);
+    OracleSample ref = brute_force_first_hit(scene, 0.0, oracle.eye(w.t),
+                                             oracle.direction(w.face, w.x, w.y), near);
+    double mine =
+        triangle_depth(scene, w.tri, oracle.eye(w.t), oracle.direction(w.face, w.x, w.y), near);
     if (ref.tri != kNoHit && std::fabs(mine - ref.lambda) <= 2 * o.eps_z * ref.lambda) {
       ++out.witness_ties;
       continue;
@@ -168,13 +176,15 @@ void check_scene(const std::string& name, const Scene& scene, int segments, int 
   Rng rng(seed);
   OracleCounts total;
   for (int s = 0; s < segments; ++s) {
-    Vec3 v0{rng.uniform(b.min.x, b.max.x), rng.uniform(b.min.y, b.max.y), rng.uniform(b.min.z, b.max.z)};
+    Vec3 v0{rng.uniform(b.min.x, b.max.x), rng.uniform(b.min.y, b.max.y),
+            rng.uniform(b.min.z, b.max.z)};
     Vec3 dir{rng.normal(), rng.normal(), rng.normal()};
     Vec3 v1 = v0 + dir * (0.1 * diag * rng.uniform() / length(dir));
     Mat3 R = s == 0 ? Mat3{} : random_orientation(Rng::derive(seed, s));
     double near = 1e-4 * diag;
     EmbreeScene embree(scene, 0.0, v0);
-    OracleCounts c = check_segment(scene, embree, v0, v1, R, n, near, samples, Rng::derive(seed, 100 + s));
+    OracleCounts c =
+        check_segment(scene, embree, v0, v1, R, n, near, samples, Rng::derive(seed, 100 + s));
     EXPECT_EQ(c.misses, 0u) << name << " segment " << s << ": " << c.first_failure;
     EXPECT_EQ(c.false_positives, 0u) << name << " segment " << s << ": " << c.first_failure;
     EXPECT_EQ(c.witness_failures, 0u) << name << " segment " << s;
@@ -191,16 +201,17 @@ void check_scene(const std::string& name, const Scene& scene, int segments, int 
   EXPECT_GT(total.forward, 0u);
   EXPECT_LT(double(total.forward_ambiguous), 0.01 * double(total.forward)) << name;
   EXPECT_LT(double(total.converse_ambiguous), 0.01 * double(total.converse) + 10) << name;
-  std::printf("[oracle] %s: %d segments N=%d: forward %llu (ambiguous %llu, misses %llu), converse %llu "
-              "(ambiguous %llu, false positives %llu), witnesses %llu, Embree disagreements settled by the double "
-              "reference %llu\n",
-              name.c_str(), segments, n, (unsigned long long)total.forward,
-              (unsigned long long)total.forward_ambiguous, (unsigned long long)total.misses,
-              (unsigned long long)total.converse, (unsigned long long)total.converse_ambiguous,
-              (unsigned long long)total.false_positives, (unsigned long long)total.witnesses,
-              (unsigned long long)total.settled_by_double);
+  std::printf(
+      "[oracle] %s: %d segments N=%d: forward %llu (ambiguous %llu, misses %llu), converse %llu "
+      "(ambiguous %llu, false positives %llu), witnesses %llu, Embree disagreements settled by the "
+      "double "
+      "reference %llu\n",
+      name.c_str(), segments, n, (unsigned long long)total.forward,
+      (unsigned long long)total.forward_ambiguous, (unsigned long long)total.misses,
+      (unsigned long long)total.converse, (unsigned long long)total.converse_ambiguous,
+      (unsigned long long)total.false_positives, (unsigned long long)total.witnesses,
+      (unsigned long long)total.settled_by_double);
 }
-
 
 }  // namespace
 
@@ -210,8 +221,12 @@ TEST(SegmentOracle, RandomSoupHasNoMissAndNoFalsePositive) {
 
 TEST(SegmentOracle, ClosedWavyGridsWithBackgroundHaveNoMissAndNoFalsePositive) {
   Scene s;
-  vislib_test::add_grid(s, 40, -20, 20, -20, 20, [](double x, double y) { return 3 + std::sin(x) * std::cos(0.7 * y); }, 3, 0.7);
-  vislib_test::add_grid(s, 20, -20, 20, -20, 20, [](double x, double y) { return -4 + 0.5 * std::cos(x + y); }, 4, 0.7);
+  vislib_test::add_grid(
+      s, 40, -20, 20, -20, 20,
+      [](double x, double y) { return 3 + std::sin(x) * std::cos(0.7 * y); }, 3, 0.7);
+  vislib_test::add_grid(
+      s, 20, -20, 20, -20, 20, [](double x, double y) { return -4 + 0.5 * std::cos(x + y); }, 4,
+      0.7);
   vislib_test::add_quad(s, {-30, -30, 12}, {30, -30, 12}, {30, 30, 12}, {-30, 30, 12});
   check_scene("grids", s, 4, 64, 6, 2);
 }
@@ -227,8 +242,10 @@ TEST_P(SharedSceneOracle, HasNoMissAndNoFalsePositiveAtN256) {
 }
 
 INSTANTIATE_TEST_SUITE_P(StaticScenes, SharedSceneOracle,
-                         ::testing::Values("sauer_fdm6/fdm6.obj", "godot_truck_town/town_model.gltf",
-                                           "sauer_pandora/pandora.obj", "godot_occlusion_room/room.glb",
+                         ::testing::Values("sauer_fdm6/fdm6.obj",
+                                           "godot_truck_town/town_model.gltf",
+                                           "sauer_pandora/pandora.obj",
+                                           "godot_occlusion_room/room.glb",
                                            "gk_dream_apartment/dream-apartment.glb",
                                            "khronos_boxanimated/BoxAnimated.gltf"),
                          [](const auto& info) {

@@ -1,8 +1,8 @@
 #include "tests/test_support.h"
 
 #include <sys/stat.h>
-#include <unistd.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -11,7 +11,9 @@
 
 namespace vislib_test {
 
-std::string source_dir() { return VISLIB_SOURCE_DIR; }
+std::string source_dir() {
+  return VISLIB_SOURCE_DIR;
+}
 
 std::optional<std::string> shared_dir() {
   const char* env = std::getenv("VISLIB_SHARED_DIR");
@@ -35,8 +37,8 @@ int run_pvs(const std::string& args, std::string* output) {
 }
 
 std::string temp_dir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("vislib_test_" + name + "_" +
-                                                        std::to_string(::getpid()));
+  auto dir = std::filesystem::temp_directory_path() /
+             ("vislib_test_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

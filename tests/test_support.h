@@ -19,7 +19,7 @@ std::string temp_dir(const std::string& name);
 
 }  // namespace vislib_test
 
-#define VISLIB_REQUIRE_SHARED(var)                                        \
-  auto var##_opt = vislib_test::shared_dir();                             \
+#define VISLIB_REQUIRE_SHARED(var)                                      \
+  auto var##_opt = vislib_test::shared_dir();                           \
   if (!var##_opt) GTEST_SKIP() << "../shared is absent: skipping test"; \
   const std::string var = *var##_opt

@@ -1,10 +1,11 @@
 // Tests of view cells: grid layout and eye band, walkable placement (floor only, slope limit,
 // winding, levels, headroom), boundary segments, and "from this cell A is seen, B is not".
+#include "vislib/bake/view_cells.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include "tests/scene_builders.h"
-#include "vislib/bake/view_cells.h"
 
 using namespace vislib;
 using vislib_test::add_quad;
@@ -98,7 +99,7 @@ TEST(ViewCells, SlopeLimitDecidesWhatIsFloor) {
   EXPECT_EQ(c.layout.cell_count(), 26u);
   const pvs::Box& ramp = c.layout.boxes[5];  // column (i 5, k 0), after 4 floor columns + 1 roof
   EXPECT_EQ(ramp.min[0], 10.0);
-  EXPECT_NEAR(ramp.min[1], 1.5, 1e-12);                            // ramp's low end
+  EXPECT_NEAR(ramp.min[1], 1.5, 1e-12);                                 // ramp's low end
   EXPECT_NEAR(ramp.max[1], 2 * std::tan(60 * M_PI / 180) + 1.8, 1e-9);  // its high end
 }
 
@@ -191,11 +192,13 @@ TEST(ViewCells, CellVisibilityIsTheSameWithOneAndTwoThreads) {
   std::vector<std::vector<uint32_t>> one, two;
   {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    for (uint32_t k = 0; k < c.layout.cell_count(); ++k) one.push_back(cell_visibility(s, c.layout, k, o).triangles);
+    for (uint32_t k = 0; k < c.layout.cell_count(); ++k)
+      one.push_back(cell_visibility(s, c.layout, k, o).triangles);
   }
   {
     tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    for (uint32_t k = 0; k < c.layout.cell_count(); ++k) two.push_back(cell_visibility(s, c.layout, k, o).triangles);
+    for (uint32_t k = 0; k < c.layout.cell_count(); ++k)
+      two.push_back(cell_visibility(s, c.layout, k, o).triangles);
   }
   EXPECT_EQ(one, two);
   EXPECT_NE(cell_seed(7, 0), cell_seed(7, 1));

@@ -39,7 +39,7 @@ bool RayOracle::is_ambiguous(int face, int x, int y, double t) const {
   // A surface just in front of the near plane (Embree decides lambda > z_near in float).
   if (scene_.first_hit(e, d, z_near_ * (1.0 - kOracleNearBand)).tri != base.tri) return true;
   const double sc = pixel_center(x, n_), tc = pixel_center(y, n_), j = kOracleDirJitter;
-  static const int kJitter[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1},
+  static const int kJitter[8][2] = {{1, 0}, {-1, 0}, {0, 1},  {0, -1},
                                     {1, 1}, {1, -1}, {-1, 1}, {-1, -1}};
   for (const auto& k : kJitter)
     if (scene_.first_hit(e, direction_at(face, sc + j * k[0], tc + j * k[1]), z_near_).tri !=

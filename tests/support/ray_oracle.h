@@ -14,17 +14,19 @@
 #include <cstdint>
 
 #include "vislib/base/cubemap.h"
+#include "vislib/base/vec.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/scene/scene.h"
-#include "vislib/base/vec.h"
 
 namespace vislib {
 
 // Tolerances of RayOracle::is_ambiguous. All err towards "ambiguous" (skip the sample).
-constexpr double kOracleDirJitter = 1e-5;  // jitter of sc and tc (face coordinates, face = [-1,1]^2)
+constexpr double kOracleDirJitter =
+    1e-5;  // jitter of sc and tc (face coordinates, face = [-1,1]^2)
 constexpr double kOracleTimeJitter = 1e-6;  // jitter of the segment parameter t (unitless)
 constexpr double kOracleDepthGap = 1e-6;    // next surface within this gap, relative to lambda
-constexpr double kOracleNearBand = 1e-6;    // a surface within this band of z_near, relative to z_near
+constexpr double kOracleNearBand =
+    1e-6;  // a surface within this band of z_near, relative to z_near
 
 // Tolerances of brute_force_first_hit (math note §8 "Reference").
 constexpr double kReferenceBarycentric = 1e-9;  // smallest barycentric (unitless)

@@ -66,7 +66,8 @@ ViewCells grid_cells(const Box3& box, uint32_t nx, uint32_t ny, uint32_t nz,
 ViewCells grid_cells_by_size(const Box3& box, double cell_size, const std::optional<EyeBand>& eye) {
   assert(cell_size > 0);
   uint32_t n[3];
-  for (int a = 0; a < 3; ++a) n[a] = uint32_t(std::max(1.0, std::ceil((box.max[a] - box.min[a]) / cell_size)));
+  for (int a = 0; a < 3; ++a)
+    n[a] = uint32_t(std::max(1.0, std::ceil((box.max[a] - box.min[a]) / cell_size)));
   ViewCells cells = grid_cells(box, n[0], n[1], n[2], eye);
   nlohmann::json d = nlohmann::json::parse(cells.description);
   d["cell_size"] = cell_size;
@@ -110,7 +111,9 @@ double area_xz(const Polygon& poly) {
 // Height of triangle `c` (non-vertical) above the point (x, z), if (x, z) lies in its xz
 // projection (edges included).
 std::optional<double> height_at(const std::array<Vec3, 3>& c, double x, double z) {
-  auto edge = [&](const Vec3& p, const Vec3& q) { return (q.x - p.x) * (z - p.z) - (q.z - p.z) * (x - p.x); };
+  auto edge = [&](const Vec3& p, const Vec3& q) {
+    return (q.x - p.x) * (z - p.z) - (q.z - p.z) * (x - p.x);
+  };
   double e0 = edge(c[0], c[1]), e1 = edge(c[1], c[2]), e2 = edge(c[2], c[0]);
   bool inside = (e0 >= 0 && e1 >= 0 && e2 >= 0) || (e0 <= 0 && e1 <= 0 && e2 <= 0);
   if (!inside) return std::nullopt;
@@ -144,8 +147,12 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
   const uint32_t nz = uint32_t(std::max(1.0, std::ceil((region.max.z - region.min.z) / S)));
   auto col_x0 = [&](uint32_t i) { return region.min.x + S * double(i); };
   auto col_z0 = [&](uint32_t k) { return region.min.z + S * double(k); };
-  auto col_x1 = [&](uint32_t i) { return std::min(region.min.x + S * double(i + 1), region.max.x); };
-  auto col_z1 = [&](uint32_t k) { return std::min(region.min.z + S * double(k + 1), region.max.z); };
+  auto col_x1 = [&](uint32_t i) {
+    return std::min(region.min.x + S * double(i + 1), region.max.x);
+  };
+  auto col_z1 = [&](uint32_t k) {
+    return std::min(region.min.z + S * double(k + 1), region.max.z);
+  };
 
   // Bin every non-vertical triangle by its xz bounding box; mark floors.
   const double cos_limit = std::cos(options.max_slope_degrees * M_PI / 180.0);
@@ -160,9 +167,9 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
     double x0 = std::min({c[0].x, c[1].x, c[2].x}), x1 = std::max({c[0].x, c[1].x, c[2].x});
     double z0 = std::min({c[0].z, c[1].z, c[2].z}), z1 = std::max({c[0].z, c[1].z, c[2].z});
     if (x1 < region.min.x || x0 > region.max.x || z1 < region.min.z || z0 > region.max.z) continue;
-    auto index = [&](double v, double lo, uint32_t n) {
+    auto index = [&](double v, double lo, uint32_t count) {
       double f = std::floor((v - lo) / S);
-      return uint32_t(std::clamp(f, 0.0, double(n - 1)));
+      return uint32_t(std::clamp(f, 0.0, double(count - 1)));
     };
     for (uint32_t k = index(z0, region.min.z, nz); k <= index(z1, region.min.z, nz); ++k)
       for (uint32_t i = index(x0, region.min.x, nx); i <= index(x1, region.min.x, nx); ++i)
@@ -262,7 +269,9 @@ std::vector<Segment> cell_boundary_segments(const Box3& view_region) {
   return out;
 }
 
-uint64_t cell_seed(uint64_t seed, uint32_t cell) { return Rng::derive(seed, cell); }
+uint64_t cell_seed(uint64_t seed, uint32_t cell) {
+  return Rng::derive(seed, cell);
+}
 
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
                                const RegionOptions& options) {
@@ -284,8 +293,8 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
                    std::back_inserter(merged));
     out.triangles = std::move(merged);
     merged.clear();
-    std::set_union(out.spheres.begin(), out.spheres.end(), rr.visible_spheres.begin(), rr.visible_spheres.end(),
-                   std::back_inserter(merged));
+    std::set_union(out.spheres.begin(), out.spheres.end(), rr.visible_spheres.begin(),
+                   rr.visible_spheres.end(), std::back_inserter(merged));
     out.spheres = std::move(merged);
     out.seconds += rr.seconds;
   }

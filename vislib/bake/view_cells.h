@@ -55,16 +55,16 @@ ViewCells grid_cells_by_size(const Box3& box, double cell_size,
                              const std::optional<EyeBand>& eye = std::nullopt);
 
 struct WalkableOptions {
-  double cell_size = 2;            // side of a column in x and z (scene units), > 0
-  EyeBand eye;                     // band above the floor
-  double max_slope_degrees = 45;   // floor triangles: angle between the normal and +y below this
+  double cell_size = 2;           // side of a column in x and z (scene units), > 0
+  EyeBand eye;                    // band above the floor
+  double max_slope_degrees = 45;  // floor triangles: angle between the normal and +y below this
   // Drop a floor level that has no headroom: at every one of a 4 x 4 grid of sample points in the
   // column where the level's floor is, some other surface lies within eye.lo above it (the ground
   // under a building, the floor inside a wall). Point-sampled: errs towards keeping cells.
   bool require_headroom = true;
   // Only place cells in this box (x and z range of the columns, y range of the floors), if set.
   std::optional<Box3> clip;
-  size_t state = 0;                // key state whose geometry is used
+  size_t state = 0;  // key state whose geometry is used
 };
 
 // (b) Walkable cells. Columns start at the x/z minimum of `clip` (or of the scene bounds) and are

@@ -41,7 +41,9 @@ inline FaceAxes face_axes(int k, const Mat3& R) {
 }
 
 // Pixel-centre coordinate of column/row `i` on an N-pixel side: (2i+1)/N - 1.
-inline double pixel_center(int i, int n) { return double(2 * i + 1) / double(n) - 1.0; }
+inline double pixel_center(int i, int n) {
+  return double(2 * i + 1) / double(n) - 1.0;
+}
 
 // World direction of pixel (x, y) of face axes `a` (F.d = 1 in the face frame).
 inline Vec3 pixel_direction(const FaceAxes& a, int x, int y, int n) {
@@ -50,10 +52,14 @@ inline Vec3 pixel_direction(const FaceAxes& a, int x, int y, int n) {
 }
 
 // Continuous pixel coordinate of a face coordinate u in [-1,1]: (u+1)N/2 - 1/2.
-inline double pixel_coord(double u, int n) { return (u + 1.0) * double(n) * 0.5 - 0.5; }
+inline double pixel_coord(double u, int n) {
+  return (u + 1.0) * double(n) * 0.5 - 0.5;
+}
 
 // Identity and a uniformly random rotation (from a seed; deterministic on every platform).
-inline Mat3 identity_orientation() { return Mat3{}; }
+inline Mat3 identity_orientation() {
+  return Mat3{};
+}
 Mat3 random_orientation(uint64_t seed);
 
 // True when R is a rotation (orthonormal rows, det +1) to within 1e-9.

@@ -12,13 +12,27 @@ struct Vec3 {
   double& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
 };
 
-inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
-inline Vec3 operator*(Vec3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-inline Vec3 operator*(double s, Vec3 a) { return {a.x * s, a.y * s, a.z * s}; }
-inline bool operator==(Vec3 a, Vec3 b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-inline bool operator!=(Vec3 a, Vec3 b) { return !(a == b); }
+inline Vec3 operator+(Vec3 a, Vec3 b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+inline Vec3 operator-(Vec3 a, Vec3 b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+inline Vec3 operator-(Vec3 a) {
+  return {-a.x, -a.y, -a.z};
+}
+inline Vec3 operator*(Vec3 a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+inline Vec3 operator*(double s, Vec3 a) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+inline bool operator==(Vec3 a, Vec3 b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+inline bool operator!=(Vec3 a, Vec3 b) {
+  return !(a == b);
+}
 // Lexicographic order (x, then y, then z): the canonical edge order of math note §2.5.
 inline bool lex_less(Vec3 a, Vec3 b) {
   if (a.x != b.x) return a.x < b.x;
@@ -28,12 +42,18 @@ inline bool lex_less(Vec3 a, Vec3 b) {
 
 // Fixed evaluation order (no FMA: the project builds with -ffp-contract=off) so that the same
 // inputs give bit-identical results at every call site.
-inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline double dot(Vec3 a, Vec3 b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 inline Vec3 cross(Vec3 a, Vec3 b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-inline double length(Vec3 a) { return std::sqrt(dot(a, a)); }
-inline Vec3 lerp(Vec3 a, Vec3 b, double t) { return a + (b - a) * t; }
+inline double length(Vec3 a) {
+  return std::sqrt(dot(a, a));
+}
+inline Vec3 lerp(Vec3 a, Vec3 b, double t) {
+  return a + (b - a) * t;
+}
 inline bool is_finite(Vec3 a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }

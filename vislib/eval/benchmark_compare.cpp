@@ -8,9 +8,9 @@
 #include <cmath>
 #include <iterator>
 
+#include "vislib/base/random.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/point_visibility.h"
-#include "vislib/base/random.h"
 
 namespace vislib {
 

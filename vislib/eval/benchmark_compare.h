@@ -30,8 +30,8 @@
 #include <vector>
 
 #include "vislib/eval/metrics.h"
-#include "vislib/kernel/region_visibility.h"
 #include "vislib/eval/render.h"
+#include "vislib/kernel/region_visibility.h"
 
 namespace vislib {
 

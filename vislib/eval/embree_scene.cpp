@@ -6,8 +6,8 @@
 #include <atomic>
 #include <cassert>
 #include <mutex>
-#include <vector>
 #include <stdexcept>
+#include <vector>
 
 namespace vislib {
 
@@ -151,8 +151,12 @@ EmbreeScene::~EmbreeScene() = default;
 EmbreeScene::EmbreeScene(EmbreeScene&&) noexcept = default;
 EmbreeScene& EmbreeScene::operator=(EmbreeScene&&) noexcept = default;
 
-Vec3 EmbreeScene::origin() const { return impl_->origin; }
-size_t EmbreeScene::triangle_count() const { return impl_->triangle_count; }
+Vec3 EmbreeScene::origin() const {
+  return impl_->origin;
+}
+size_t EmbreeScene::triangle_count() const {
+  return impl_->triangle_count;
+}
 
 Hit EmbreeScene::first_hit(Vec3 eye_world, Vec3 dir, double tnear) const {
   RTCIntersectContext ctx;

@@ -21,8 +21,8 @@
 #include <memory>
 #include <string>
 
-#include "vislib/scene/scene.h"
 #include "vislib/base/vec.h"
+#include "vislib/scene/scene.h"
 
 namespace vislib {
 
@@ -30,7 +30,7 @@ namespace vislib {
 constexpr uint32_t kNoHit = std::numeric_limits<uint32_t>::max();
 
 struct Hit {
-  uint32_t tri = kNoHit;                                // triangle id, or kNoHit
+  uint32_t tri = kNoHit;                                    // triangle id, or kNoHit
   double lambda = std::numeric_limits<double>::infinity();  // depth along d (inf when kNoHit)
 };
 

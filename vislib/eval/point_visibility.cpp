@@ -63,8 +63,8 @@ SampledVisibility sample_union(const EmbreeScene& scene, const PointSampling& op
   size_t count = 0;
   for (int i = 0; i < opt.runs; ++i) {
     const Vec3 eye = viewpoint(i);
-    const Mat3 R = opt.random_orientation ? random_orientation(Rng::derive(opt.seed, uint64_t(i)))
-                                          : opt.R;
+    const Mat3 R =
+        opt.random_orientation ? random_orientation(Rng::derive(opt.seed, uint64_t(i))) : opt.R;
     for (uint32_t id : point_visible_set(scene, eye, R, opt.n, opt.z_near))
       if (!seen[id]) seen[id] = uint32_t(i) + 1, ++count;
     out.viewpoints.push_back(eye);
@@ -83,21 +83,27 @@ SampledVisibility sample_union(const EmbreeScene& scene, const PointSampling& op
 
 SampledVisibility sample_segment(const EmbreeScene& scene, Vec3 v0, Vec3 v1,
                                  const PointSampling& opt, const SamplingProgress& progress) {
-  return sample_union(scene, opt, [&](int i) {
-    const double t = opt.runs == 1 ? 0.5 : double(i) / double(opt.runs - 1);
-    return lerp(v0, v1, t);
-  }, progress);
+  return sample_union(
+      scene, opt,
+      [&](int i) {
+        const double t = opt.runs == 1 ? 0.5 : double(i) / double(opt.runs - 1);
+        return lerp(v0, v1, t);
+      },
+      progress);
 }
 
 SampledVisibility sample_box(const EmbreeScene& scene, const Box3& box, const PointSampling& opt,
                              const SamplingProgress& progress) {
   assert(!box.empty());
   Rng rng(opt.seed);
-  return sample_union(scene, opt, [&](int) {
-    Vec3 p;
-    for (int k = 0; k < 3; ++k) p[k] = rng.uniform(box.min[k], box.max[k]);
-    return p;
-  }, progress);
+  return sample_union(
+      scene, opt,
+      [&](int) {
+        Vec3 p;
+        for (int k = 0; k < 3; ++k) p[k] = rng.uniform(box.min[k], box.max[k]);
+        return p;
+      },
+      progress);
 }
 
 }  // namespace vislib

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "vislib/base/cubemap.h"
-#include "vislib/eval/embree_scene.h"
 #include "vislib/base/vec.h"
+#include "vislib/eval/embree_scene.h"
 
 namespace vislib {
 
@@ -35,10 +35,10 @@ std::vector<uint32_t> point_visible_set(const EmbreeScene& scene, Vec3 eye, cons
 
 // Options of the sampled baselines.
 struct PointSampling {
-  int runs = 1;              // K viewpoints; must be >= 1
-  int n = 256;               // cubemap resolution per face
-  double z_near = 0.1;       // near distance (view depth, scene units)
-  Mat3 R;                    // orientation used when random_orientation is false
+  int runs = 1;                     // K viewpoints; must be >= 1
+  int n = 256;                      // cubemap resolution per face
+  double z_near = 0.1;              // near distance (view depth, scene units)
+  Mat3 R;                           // orientation used when random_orientation is false
   bool random_orientation = false;  // viewpoint i uses random_orientation(Rng::derive(seed, i))
   uint64_t seed = 1;
 };
@@ -47,11 +47,11 @@ struct PointSampling {
 // state after runs 0..i: union size and seconds elapsed since the start (wall clock; the only
 // non-reproducible field).
 struct SampledVisibility {
-  std::vector<uint32_t> ids;              // sorted unique union
-  std::vector<uint32_t> first_run;        // first_run[j]: the run that first found ids[j]
-  std::vector<Vec3> viewpoints;           // viewpoint of run i (world)
-  std::vector<size_t> union_size;         // |union| after run i
-  std::vector<double> elapsed_seconds;    // after run i
+  std::vector<uint32_t> ids;            // sorted unique union
+  std::vector<uint32_t> first_run;      // first_run[j]: the run that first found ids[j]
+  std::vector<Vec3> viewpoints;         // viewpoint of run i (world)
+  std::vector<size_t> union_size;       // |union| after run i
+  std::vector<double> elapsed_seconds;  // after run i
 };
 
 // Called after each run with (runs done, runs in all), from the calling thread; may be empty.

@@ -26,10 +26,10 @@
 #include <cstdint>
 #include <vector>
 
-#include "vislib/eval/embree_scene.h"
-#include "vislib/scene/scene.h"
 #include "vislib/base/tolerances.h"
 #include "vislib/base/vec.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/scene/scene.h"
 
 namespace vislib {
 

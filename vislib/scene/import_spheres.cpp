@@ -61,7 +61,8 @@ Scene load_spheres(const std::string& path, std::vector<std::string>& warnings) 
     if (stage == 0) {
       if (tok.size() != 2 || tok[0] != "vislib-spheres")
         fail("expected the header 'vislib-spheres 1'");
-      if (tok[1] != "1") fail("unsupported sphere format version '" + tok[1] + "' (this reader knows 1)");
+      if (tok[1] != "1")
+        fail("unsupported sphere format version '" + tok[1] + "' (this reader knows 1)");
       stage = 1;
     } else if (stage == 1) {
       char* end = nullptr;

@@ -81,13 +81,15 @@ void append_scene(Scene& scene, const Scene& other) {
     scene.sphere_centers[s].insert(scene.sphere_centers[s].end(), oc.begin(), oc.end());
   }
   for (auto t : other.triangles)
-    scene.triangles.push_back({uint32_t(t[0] + vbase), uint32_t(t[1] + vbase), uint32_t(t[2] + vbase)});
+    scene.triangles.push_back(
+        {uint32_t(t[0] + vbase), uint32_t(t[1] + vbase), uint32_t(t[2] + vbase)});
   for (auto o : other.triangle_object) scene.triangle_object.push_back(o + obase);
   for (auto o : other.sphere_object) scene.sphere_object.push_back(o + obase);
   scene.sphere_radius.insert(scene.sphere_radius.end(), other.sphere_radius.begin(),
                              other.sphere_radius.end());
   scene.objects.insert(scene.objects.end(), other.objects.begin(), other.objects.end());
-  if (scene.positions.size() == 1 && scene.positions[0].empty() && scene.sphere_centers[0].empty()) {
+  if (scene.positions.size() == 1 && scene.positions[0].empty() &&
+      scene.sphere_centers[0].empty()) {
     scene.positions.clear();
     scene.sphere_centers.clear();
   }

@@ -11,7 +11,8 @@ namespace vislib {
 struct SceneInfo {
   size_t triangles = 0, vertices = 0, objects = 0, states = 0, spheres = 0;
   bool dynamic = false;
-  Box3 bbox;  // over all states, spheres with their radius (Scene::bounds); empty for an empty scene
+  Box3
+      bbox;  // over all states, spheres with their radius (Scene::bounds); empty for an empty scene
   double diagonal = 0;  // length of the bbox diagonal (0 if empty)
   // No units claim: mesh formats record none, and a guess from the size alone was wrong on real
   // scenes (a millimetre hotel room taken for centimetres, Sauerbraten maps for metres).
@@ -23,7 +24,8 @@ struct SceneInfo {
   size_t degenerate_triangles = 0;  // a repeated index or zero area (|cross| == 0, in double)
   size_t nonfinite_vertices = 0;    // vertices with a NaN/inf coordinate in any state
   size_t duplicate_vertices = 0;    // bit-identical positions: each extra copy counts once
-  size_t out_of_range_indices = 0;  // triangle corners >= vertex count (0 after a successful import)
+  size_t out_of_range_indices =
+      0;  // triangle corners >= vertex count (0 after a successful import)
 };
 
 // True when a scene with bounding box `bbox` lies far from the origin: its centre farther than
