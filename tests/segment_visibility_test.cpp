@@ -247,8 +247,8 @@ Scene coplanar_rooms(uint64_t seed) {
   Scene s;
   auto wall = [&](Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
     vislib_test::add_quad(s, a, b, c, d);
-    vislib_test::add_quad(s, b, c, d, a);       // the same wall, the other diagonal
-    for (int k = 0; k < 4; ++k) {  // decals
+    vislib_test::add_quad(s, b, c, d, a);  // the same wall, the other diagonal
+    for (int k = 0; k < 4; ++k) {          // decals
       double u0 = rng.uniform(0, 0.8), w0 = rng.uniform(0, 0.8), du = rng.uniform(0.05, 0.2),
              dw = rng.uniform(0.05, 0.2);
       auto at = [&](double u, double w) { return a + (b - a) * u + (d - a) * w; };

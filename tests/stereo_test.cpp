@@ -512,9 +512,7 @@ TEST(StereoCli, ViewStereoWritesThePairTheHoleMaskAndTheJsonBlock) {
   std::string out;
   ASSERT_EQ(vislib_test::run_pvs("generate city --blocks 2,2 -o " + city, &out), 0) << out;
   ASSERT_EQ(vislib_test::run_pvs(
-                "bake " + city +
-                    " --box -60,0,-60,60,3,60 --grid 2,1,1 --res 24 -o " + pvs,
-                &out),
+                "bake " + city + " --box -60,0,-60,60,3,60 --grid 2,1,1 --res 24 -o " + pvs, &out),
             0)
       << out;
   const std::string view =

@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   const size_t n = pvs.visible_ids(0).size();
   if (n != pvs.visible_count(0)) return 1;
   const double w = pvs_runtime::morph_user_weight(1.5, 1.0, 2.0);
-  std::printf("consumer_cpp: vislib %s, %u cells, cell 0 sees %zu ids, w_U(1.5) = %g\n", VISLIB_VERSION_STRING,
-              pvs.cell_count(), n, w);
+  std::printf("consumer_cpp: vislib %s, %u cells, cell 0 sees %zu ids, w_U(1.5) = %g\n",
+              VISLIB_VERSION_STRING, pvs.cell_count(), n, w);
   return w == 0.5 ? 0 : 1;
 }

@@ -8,7 +8,7 @@ namespace vislib {
 
 uint32_t id_universe(const Scene& scene, Granularity g) {
   uint64_t n = g == Granularity::Object ? scene.objects.size()
-                                             : scene.triangle_count() + scene.sphere_count();
+                                        : scene.triangle_count() + scene.sphere_count();
   assert(n < 0xFFFFFFFFull);
   return uint32_t(n);
 }

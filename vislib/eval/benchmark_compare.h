@@ -97,9 +97,9 @@ struct QualityCheckpoint {
 };
 
 struct MethodRun {
-  std::vector<GrowthPoint> growth;      // after every run
+  std::vector<GrowthPoint> growth;             // after every run
   std::vector<QualityCheckpoint> checkpoints;  // in increasing runs
-  std::vector<uint32_t> set;            // final union, sorted
+  std::vector<uint32_t> set;                   // final union, sorted
   // Per triangle: the run index (0-based, in growth order) that first found it, or kNever.
   std::vector<uint32_t> first_run;
   static constexpr uint32_t kNever = std::numeric_limits<uint32_t>::max();

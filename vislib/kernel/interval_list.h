@@ -84,7 +84,8 @@ const PieceT<D>& front(const PieceT<D>& a, const PieceT<D>& b, double t) {
 // Records a tie when `loser` is within rule.eps_z (relative to the front depth) of `winner` at t0,
 // at the middle and at t1 (for linear depths: over the whole of [t0, t1)).
 template <class D>
-void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& loser, double t0, double t1) {
+void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& loser, double t0,
+                double t1) {
   for (double t : {0.5 * (t0 + t1), t0, t1}) {
     double w = winner.depth.at(t), l = loser.depth.at(t);
     if (!(std::fabs(l - w) <= rule.eps_z * std::fabs(w))) return;
@@ -107,7 +108,8 @@ bool continues(const PieceT<D>& a, const PieceT<D>& b) {
 template <class D>
 void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t1) {
   if (!(t0 < t1)) return;
-  if (!out.empty() && out.back().id == src.id && out.back().t1 == t0 && same_depth(out.back().depth, src.depth)) {
+  if (!out.empty() && out.back().id == src.id && out.back().t1 == t0 &&
+      same_depth(out.back().depth, src.depth)) {
     out.back().t1 = t1;
     return;
   }
@@ -125,7 +127,8 @@ void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t
 // comparison lies within ties.eps_z of the winner (the list is the same with or without it).
 // Not thread-safe for the same list; lists are per pixel.
 template <class D>
-bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p, const TieRule& ties = TieRule{}) {
+bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
+                  const TieRule& ties = TieRule{}) {
   assert(p.t0 < p.t1);
   const double s = p.t0, f = p.t1;
   // First piece ending after s (t1 increases along the list).
@@ -174,7 +177,8 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p, const TieRul
       for (int k = 0; k <= n; ++k) {
         const PieceT<D>& w = detail::front(I, p, 0.5 * (cuts[k] + cuts[k + 1]));
         detail::push(out, w, cuts[k], cuts[k + 1]);
-        if (ties.sink && cuts[k] < cuts[k + 1]) detail::record_tie(ties, w, &w == &p ? I : p, cuts[k], cuts[k + 1]);
+        if (ties.sink && cuts[k] < cuts[k + 1])
+          detail::record_tie(ties, w, &w == &p ? I : p, cuts[k], cuts[k + 1]);
       }
       if (I.t1 > f) detail::push(out, I, f, I.t1);
       cur = hi;

@@ -54,7 +54,8 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
       SegmentOptions so = options.segment;
       so.orientation = run_orientation(options.seed, s, k);
       so.want_pieces = false;
-      SegmentResult sr = segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
+      SegmentResult sr =
+          segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
       // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
       for (size_t i = 0; i < sr.visible.size(); ++i) {
         uint32_t id = sr.visible[i];

@@ -34,7 +34,7 @@ struct RegionOptions {
   // resolution, near, eps_len, tile size, want_witnesses... (orientation and want_pieces are
   // ignored)
   SegmentOptions segment;
-  int runs = 1;            // K orientations per segment, >= 1
+  int runs = 1;  // K orientations per segment, >= 1
   uint64_t seed = 1;
 };
 

@@ -122,14 +122,16 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
   tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
-    return TileScratch{std::vector<PieceList>(size_t(TS) * TS), std::vector<uint8_t>(size_t(TS) * TS),
-                       std::vector<double>(size_t(TS) * TS), std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
+    return TileScratch{std::vector<PieceList>(size_t(TS) * TS),
+                       std::vector<uint8_t>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS),
+                       std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
   });
   const bool keep_ties = opt.coplanar == CoplanarRule::Both;
   // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of it,
   // so only triangles beyond far * (1 + eps_z) are skipped (2 eps_z covers the rounding).
   const double far_scale = keep_ties ? 1 + 2 * opt.eps_z : 1.0;
-  tbb::enumerable_thread_specific<FoundMarks> found_by_thread([&] { return FoundMarks(ntri, opt.want_witnesses); });
+  tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
+      [&] { return FoundMarks(ntri, opt.want_witnesses); });
 
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
