@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cmd_view_ods.h"
+#include "cli/cmd_view_stereo.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/view_report.h"
@@ -76,7 +77,7 @@ ViewCell read_view_cell(const ViewArgs& a, vislib::Vec3 eye) {
   return v;
 }
 
-void run_view(const ViewArgs& a) {
+void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
   int fw = 0, fh = 0;
   if (std::sscanf(a.frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
       fh > 8192)
@@ -206,6 +207,7 @@ void run_view(const ViewArgs& a) {
                        {"equal_area", equal_json}};
   }
 
+  if (stereo.enabled()) j["stereo"] = run_view_stereo(stereo, a.file, scene, rt, cam, a.output);
   print_view(j, rc, !moving.empty() && v.full_scene.is_dynamic());
   if (a.json_path == "-") {
     std::printf("%s\n", j.dump(1).c_str());
@@ -280,12 +282,16 @@ void add_view(CLI::App& app) {
   cmd->add_option("--json", a->json_path, "Write the metrics as JSON ('-' = stdout)");
   auto ods = std::make_shared<OdsViewArgs>();
   add_ods_view_options(cmd, ods);
-  cmd->callback([a, ods] {
+  std::shared_ptr<ViewStereoArgs> stereo = add_view_stereo_options(cmd);
+  cmd->callback([a, ods, stereo] {
+    if (ods->enabled && stereo->enabled())
+      throw CLI::ValidationError("--stereo", "cannot be combined with --ods");
     if (ods->enabled)
       return run_view_ods(*ods,
                           {a->file, a->scene, a->at, a->output, a->json_path, a->states, a->tau});
     if (a->look.empty()) throw CLI::ValidationError("--look", "is required (except with --ods)");
-    run_view(*a);
+    stereo->ipd = ods->ipd_m * ods->units_per_metre;  // --ipd and --units-per-metre are shared
+    run_view(*a, *stereo);
   });
 }
 

@@ -11,6 +11,7 @@
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/visibility_common.h"
+#include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/import.h"
@@ -53,7 +54,10 @@ void add_segment(CLI::App& app) {
     vislib::Vec3 v0 = parse_vec3(*from, "--from"), v1 = parse_vec3(*to, "--to");
     double load_s;
     vislib::Scene scene = load(*a, load_s);
-    vislib::SegmentResult r = vislib::segment_visibility(scene, v0, v1, so);
+    vislib::SegmentResult r = vislib::with_memory_stage(
+        "computing from-segment visibility at N = " + std::to_string(so.resolution) + " on " +
+            std::to_string(scene.triangle_count()) + " triangles",
+        [&] { return vislib::segment_visibility(scene, v0, v1, so); });
     json j = {{"scene", a->scene},
               {"resolution", so.resolution},
               {"near", so.near},

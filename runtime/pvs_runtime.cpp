@@ -90,8 +90,16 @@ struct BucketGrid {
   int nx = 1, nz = 1;
   std::vector<std::vector<uint32_t>> buckets;
 
-  int bx(double x) const { return std::clamp(int(std::floor((x - min_x) / cell_x)), 0, nx - 1); }
-  int bz(double z) const { return std::clamp(int(std::floor((z - min_z) / cell_z)), 0, nz - 1); }
+  // The bucket of a coordinate, clamped in double before the conversion to int (a far, infinite
+  // or NaN coordinate must not overflow the conversion: undefined behaviour). NaN maps to 0.
+  static int bucket(double x, double min, double width, int n) {
+    double f = std::floor((x - min) / width);
+    if (!(f > 0)) return 0;
+    if (f >= double(n - 1)) return n - 1;
+    return int(f);
+  }
+  int bx(double x) const { return bucket(x, min_x, cell_x, nx); }
+  int bz(double z) const { return bucket(z, min_z, cell_z, nz); }
 
   void build(const std::vector<pvs::Box>& boxes) {
     if (boxes.empty()) return;
@@ -186,6 +194,9 @@ uint64_t Pvs::file_size() const {
 }
 
 std::optional<uint32_t> Pvs::find_cell(const double position[3]) const {
+  // NaN or infinite coordinates lie in no (finite) cell; checked before any arithmetic on them.
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(position[k])) return std::nullopt;
   const pvs::CellLayout& layout = info().layout;
   if (layout.kind == pvs::LayoutKind::Grid) return layout.find_cell(position);
   for (uint32_t c : impl_->buckets.candidates(position[0], position[0], position[2], position[2]))
@@ -207,7 +218,9 @@ std::vector<uint32_t> Pvs::neighbours(uint32_t cell, double margin) const {
     int64_t lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
       double w = (layout.grid_box.max[k] - layout.grid_box.min[k]) / n[k];
-      int64_t reach = w > 0 ? int64_t(std::ceil(margin / w)) + 1 : int64_t(n[k]);
+      // In double first: an infinite or huge margin reaches every cell (no overflowing cast).
+      double r = w > 0 ? std::ceil(margin / w) + 1 : double(n[k]);
+      int64_t reach = r >= double(n[k]) ? int64_t(n[k]) : int64_t(r);
       lo[k] = std::max<int64_t>(0, int64_t(idx[k]) - reach);
       hi[k] = std::min<int64_t>(int64_t(n[k]) - 1, int64_t(idx[k]) + reach);
     }

@@ -2,6 +2,7 @@
 // point catches every exception and maps it to a status code plus a per-thread message.
 #include "runtime/pvs_runtime_c.h"
 
+#include <cmath>
 #include <cstring>
 #include <new>
 #include <string>
@@ -104,6 +105,10 @@ pvs_rt_status pvs_rt_get_info(const pvs_rt* h, pvs_rt_info* out) {
 pvs_rt_status pvs_rt_find_cell(const pvs_rt* h, const double position[3], uint32_t* cell) {
   if (!h || !position || !cell)
     return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_find_cell: null argument");
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(position[k]))
+      return fail(PVS_RT_INVALID_ARGUMENT,
+                  "pvs_rt_find_cell: position[" + std::to_string(k) + "] is not finite");
   return guarded([&] {
     auto c = h->pvs.find_cell(position);
     if (!c)
@@ -274,8 +279,10 @@ const char* pvs_rt_last_error(void) {
   return g_last_error.c_str();
 }
 
-const char* pvs_rt_status_name(pvs_rt_status s) {
-  switch (s) {
+const char* pvs_rt_status_name(int status) {
+  // Compared as an int: loading an out-of-range value as the enum type is undefined behaviour.
+  if (status < PVS_RT_OK || status > PVS_RT_INTERNAL) return "unknown";
+  switch (static_cast<pvs_rt_status>(status)) {
     case PVS_RT_OK:
       return "ok";
     case PVS_RT_INVALID_ARGUMENT:

@@ -66,7 +66,7 @@ PVS_RT_API void pvs_rt_close(pvs_rt* handle);
 PVS_RT_API pvs_rt_status pvs_rt_get_info(const pvs_rt* handle, pvs_rt_info* out);
 
 /* The cell containing position (x, y, z; y up; boundaries inclusive, lowest id wins), or
- * PVS_RT_NOT_FOUND. */
+ * PVS_RT_NOT_FOUND. A NaN or infinite coordinate is PVS_RT_INVALID_ARGUMENT. */
 PVS_RT_API pvs_rt_status pvs_rt_find_cell(const pvs_rt* handle, const double position[3],
                                           uint32_t* cell);
 
@@ -74,7 +74,8 @@ PVS_RT_API pvs_rt_status pvs_rt_find_cell(const pvs_rt* handle, const double pos
 PVS_RT_API pvs_rt_status pvs_rt_cell_box(const pvs_rt* handle, uint32_t cell, double min[3],
                                          double max[3]);
 
-/* The cells whose boxes come within `margin` (>= 0) of cell's box, sorted, without `cell`.
+/* The cells whose boxes come within `margin` (>= 0, +INFINITY for all cells; NaN is
+ * PVS_RT_INVALID_ARGUMENT) of cell's box, sorted, without `cell`.
  * Writes at most `capacity` ids to `out`; *count receives the number of neighbours. If it
  * exceeds capacity, returns PVS_RT_BUFFER_TOO_SMALL (27 is always enough for margin 0 on a grid).
  */
@@ -97,8 +98,9 @@ PVS_RT_API pvs_rt_status pvs_rt_prefetch(pvs_rt* handle, uint32_t cell);
 /* The message of the last failing call on this thread ("" if none). */
 PVS_RT_API const char* pvs_rt_last_error(void);
 
-/* A short name of a status code ("ok", "format", ...). */
-PVS_RT_API const char* pvs_rt_status_name(pvs_rt_status status);
+/* A short name of a status code ("ok", "format", ...); "unknown" for any other value. Takes an
+ * int (a pvs_rt_status converts to it) so that any value can be passed safely. */
+PVS_RT_API const char* pvs_rt_status_name(int status);
 
 /* ---- Version -------------------------------------------------------------------------------- */
 
