@@ -116,13 +116,29 @@ inline void bins_of(double lo, double hi, int& b0, int& b1) {
   b1 = std::max(b0, std::min(kEnvBins - 1, int(std::ceil(hi * kEnvBins)) - 1));
 }
 
-inline bool envelope_hides(const float* env, double lo, double hi, const LinearDepth& depth) {
+// Bounds of LinearDepth::at(t) = (n0 - n1 t) / dn without its division: the same numerator times
+// inv = 1/dn is within 3 units in the last place of the quotient (one rounding for inv, one for the
+// product, one of the quotient), so widening it by 2^-50 relative (8 units) bounds at(t) from
+// above or below. Non-finite products (dn near 0) fall back to the division.
+inline double depth_upper(const LinearDepth& z, double inv, double t) {
+  const double num = z.n0 - z.n1 * t, v = num * inv;
+  if (!std::isfinite(v)) return z.at(t);
+  return v > 0 ? v * (1 + 0x1p-50) : v * (1 - 0x1p-50);
+}
+inline double depth_lower(const LinearDepth& z, double inv, double t) {
+  const double num = z.n0 - z.n1 * t, v = num * inv;
+  if (!std::isfinite(v)) return z.at(t);
+  return v > 0 ? v * (1 - 0x1p-50) : v * (1 + 0x1p-50);
+}
+
+inline bool envelope_hides(const float* env, double lo, double hi, const LinearDepth& depth,
+                           double inv) {
   int b0, b1;
   bins_of(lo, hi, b0, b1);
   float m = env[b0];
   for (int b = b0 + 1; b <= b1; ++b) m = std::max(m, env[b]);
   if (!(m < INFINITY)) return false;
-  return std::min(depth.at(lo), depth.at(hi)) > double(m);
+  return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > double(m);
 }
 
 // Recomputes the bins of `env` that [lo, hi) overlaps after an insertion there (the rest of the
@@ -131,35 +147,48 @@ inline bool envelope_hides(const float* env, double lo, double hi, const LinearD
 inline double update_envelope(const PieceList& l, float* env, double lo, double hi) {
   int b0, b1;
   bins_of(lo, hi, b0, b1);
-  const double blo0 = double(b0) / kEnvBins;
-  size_t i = size_t(std::upper_bound(l.begin(), l.end(), blo0,
-                                     [](double v, const Piece& q) { return v < q.t1; }) -
-                    l.begin());
-  for (int b = b0; b <= b1; ++b) {
-    const double blo = double(b) / kEnvBins, bhi = double(b + 1) / kEnvBins;
-    while (i < l.size() && l[i].t1 <= blo) ++i;
-    double cur = blo, mx = -INFINITY;
-    size_t j = i;
-    for (; cur < bhi; ++j) {
-      if (j == l.size() || l[j].t0 > cur) break;
-      const Piece& p = l[j];
-      mx = std::max({mx, p.depth.at(std::max(p.t0, blo)), p.depth.at(std::min(p.t1, bhi))});
-      cur = p.t1;
+  for (int b = b0; b <= b1; ++b) env[b] = -INFINITY;
+  const double blo0 = double(b0) / kEnvBins, bhi1 = double(b1 + 1) / kEnvBins;
+  size_t i = 0;
+  while (i < l.size() && l[i].t1 <= blo0) ++i;
+  // Walk the pieces over [blo0, bhi1]: each adds its depth at its ends clipped to every bin it
+  // overlaps; a gap (or an uncovered end) makes the bins it touches infinite.
+  double cur = blo0;
+  auto gap = [&](double a, double b) {  // [a, b) uncovered
+    int g0, g1;
+    bins_of(std::max(a, blo0), std::min(b, bhi1), g0, g1);
+    for (int g = std::max(g0, b0); g <= std::min(g1, b1); ++g) env[g] = INFINITY;
+  };
+  for (; i < l.size() && l[i].t0 < bhi1; ++i) {
+    const Piece& p = l[i];
+    if (p.t0 > cur) gap(cur, p.t0);
+    const double inv = 1.0 / p.depth.dn;
+    const double a = std::max(p.t0, blo0), e = std::min(p.t1, bhi1);
+    int q0, q1;
+    bins_of(a, e, q0, q1);
+    double left = depth_upper(p.depth, inv, a);
+    for (int b = q0; b <= q1; ++b) {
+      const double be = std::min(e, double(b + 1) / kEnvBins);
+      const double right = depth_upper(p.depth, inv, be);
+      const float m = round_up(std::max(left, right));
+      if (env[b] < m) env[b] = m;
+      left = right;
     }
-    env[b] = cur >= bhi ? round_up(mx) : INFINITY;
+    cur = p.t1;
   }
+  if (cur < bhi1) gap(cur, bhi1);
   float far = env[0];
   for (int b = 1; b < kEnvBins; ++b) far = std::max(far, env[b]);
   return double(far);
 }
 
-// True when the triangle's plane lies behind `far` along ray d for every t in [0, 1]: its depth
-// there is at(t) of LinearDepth{N0, N1, d.n} (as static_coverage would give), monotone in t, so
-// at(0) and at(1) bound it. Exact culling of a pair whose pixel list covers [0, 1] below `far`.
-inline bool plane_behind(const StaticTriangle& st, double Dn, double far) {
+// True when the triangle's plane lies behind `far` along the pixel ray for every t in [0, 1]: its
+// depth there is at(t) of LinearDepth{N0, N1, Dn} (as static_coverage would give), monotone in t,
+// so at(0) and at(1) bound it. Exact culling of a pair whose pixel list covers [0, 1] below `far`.
+inline bool plane_behind(const StaticTriangle& st, double Dn, double inv, double far) {
   if (Dn == 0) return true;  // never covers (static_coverage returns false)
   const LinearDepth z{st.N0, st.N1, Dn};
-  return std::min(z.at(0.0), z.at(1.0)) > far;
+  return std::min(depth_lower(z, inv, 0.0), depth_lower(z, inv, 1.0)) > far;
 }
 
 // ---- Coverage of one triangle at 4 consecutive pixels of a row (issue 13, item 3) ----------
@@ -169,7 +198,7 @@ inline bool plane_behind(const StaticTriangle& st, double Dn, double far) {
 // on an edge) are redone by the scalar function. AVX2 is chosen at run time; other CPUs and
 // SegmentOptions::simd = false take the scalar loop.
 struct Coverage4 {
-  double lo[4], hi[4], dn[4];
+  double lo[4], hi[4], dn[4], inv[4];  // inv = 1 / dn (bounds only)
   bool ok[4];
 };
 
@@ -180,6 +209,7 @@ void coverage4_scalar(const StaticTriangle& st, const FaceAxes& ax, const double
     LinearDepth z;
     out.ok[i] = static_coverage(st, d, ax.S, ax.T, near, out.lo[i], out.hi[i], z);
     out.dn[i] = dot(d, st.n);
+    out.inv[i] = 1.0 / out.dn[i];
   }
 }
 
@@ -236,6 +266,7 @@ VISLIB_AVX2 void coverage4_avx2(const StaticTriangle& st, const FaceAxes& ax, co
   _mm256_storeu_pd(out.lo, lo);
   _mm256_storeu_pd(out.hi, hi);
   _mm256_storeu_pd(out.dn, Dn);
+  _mm256_storeu_pd(out.inv, _mm256_div_pd(one, Dn));
   const int gm = _mm256_movemask_pd(good), tm = _mm256_movemask_pd(tie);
   for (int i = 0; i < lanes; ++i) {
     if (tm >> i & 1) {  // persistent on-edge tie in this lane: the scalar rule decides
@@ -406,8 +437,8 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                   for (int i = 0; i < lanes; ++i) {
                     const size_t k = kb + size_t(i);
                     if (opt.depth_culling &&
-                        (tz > sc.far[k] ||
-                         (sc.far[k] < INFINITY && plane_behind(st, cov.dn[i], sc.far[k])))) {
+                        (tz > sc.far[k] || (sc.far[k] < INFINITY &&
+                                            plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
                       ++stats.culled_pairs;
                       continue;
                     }
@@ -417,7 +448,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                     const double lo = cov.lo[i], hi = cov.hi[i];
                     const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
                     float* env = &sc.env[k * kEnvBins];
-                    if (opt.depth_culling && envelope_hides(env, lo, hi, depth)) {
+                    if (opt.depth_culling && envelope_hides(env, lo, hi, depth, cov.inv[i])) {
                       ++stats.hidden_pairs;
                       continue;
                     }
