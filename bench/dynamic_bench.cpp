@@ -17,8 +17,8 @@
 #include <functional>
 #include <map>
 
-#include "vislib/generate.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/scene/generate.h"
+#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 

@@ -6,10 +6,10 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
-#include "vislib/cubemap.h"
-#include "vislib/embree_scene.h"
-#include "vislib/point_visibility.h"
-#include "vislib/random.h"
+#include "vislib/base/cubemap.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/eval/point_visibility.h"
+#include "vislib/base/random.h"
 
 using namespace vislib;
 

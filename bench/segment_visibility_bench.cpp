@@ -18,11 +18,11 @@
 #include <map>
 #include <memory>
 
-#include "vislib/embree_scene.h"
-#include "vislib/generate.h"
-#include "vislib/import.h"
-#include "vislib/point_visibility.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/scene/generate.h"
+#include "vislib/scene/import.h"
+#include "vislib/eval/point_visibility.h"
+#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 

@@ -1,14 +1,14 @@
-// pvs generate {city,grass,spheres}: writes the procedural test scenes of vislib/generate.h
+// pvs generate {city,grass,spheres}: writes the procedural test scenes of vislib/scene/generate.h
 // (.glb for city and grass, the sphere text format for spheres).
 #include <chrono>
 #include <cstdio>
 #include <memory>
 
 #include "cli/commands.h"
-#include "vislib/file_util.h"
-#include "vislib/generate.h"
-#include "vislib/write_gltf.h"
-#include "vislib/write_spheres.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/generate.h"
+#include "vislib/scene/write_gltf.h"
+#include "vislib/scene/write_spheres.h"
 
 namespace pvs_cli {
 namespace {

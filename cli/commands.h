@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "vislib/vec.h"
+#include "vislib/base/vec.h"
 
 namespace pvs_cli {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "vislib/import.h"
+#include "vislib/scene/import.h"
 
 namespace pvs_cli {
 

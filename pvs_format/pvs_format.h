@@ -4,7 +4,7 @@
 // This library depends on the C++ standard library only (house style, "Which way the arrows
 // point"): an engine embeds it to load a PVS without vislib or its dependencies. It knows nothing
 // of scenes: it stores a 64-bit scene fingerprint computed by the caller (vislib's is
-// scene_fingerprint() in vislib/scene_fingerprint.h, its byte stream is in the format document).
+// scene_fingerprint() in vislib/scene/scene_fingerprint.h, its byte stream is in the format document).
 //
 // Errors: a malformed, truncated, corrupted or too new file throws pvs::FormatError carrying the
 // byte offset where the problem was found and what is wrong. The reader never crashes or reads

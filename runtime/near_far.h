@@ -100,7 +100,7 @@ NearFarPartition partition_near_far(const float* positions, size_t vertex_count,
 // ---- The range cube map and Eq. 3 -----------------------------------------------------------
 
 // A per-pixel range map from O: 6 square faces of size x size pixels, in vislib's binding cubemap
-// convention (vislib/cubemap.h, identity orientation): faces 0..5 = +X, -X, +Y, -Y, +Z, -Z with
+// convention (vislib/base/cubemap.h, identity orientation): faces 0..5 = +X, -X, +Y, -Y, +Z, -Z with
 // forward/S/T axes
 //   +X: F=(1,0,0)  S=(0,0,-1) T=(0,-1,0)     -X: F=(-1,0,0) S=(0,0,1)  T=(0,-1,0)
 //   +Y: F=(0,1,0)  S=(1,0,0)  T=(0,0,1)      -Y: F=(0,-1,0) S=(1,0,0)  T=(0,0,-1)

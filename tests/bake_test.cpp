@@ -7,13 +7,13 @@
 #include <filesystem>
 
 #include "tests/test_support.h"
-#include "vislib/bake.h"
-#include "vislib/checkpoint.h"
-#include "vislib/error.h"
-#include "vislib/file_util.h"
-#include "vislib/generate.h"
-#include "vislib/scene_fingerprint.h"
-#include "vislib/scene_subset.h"
+#include "vislib/bake/bake.h"
+#include "vislib/bake/checkpoint.h"
+#include "vislib/base/error.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/generate.h"
+#include "vislib/scene/scene_fingerprint.h"
+#include "vislib/bake/scene_subset.h"
 
 using namespace vislib;
 using vislib_test::temp_dir;

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
-#include "vislib/file_util.h"
+#include "vislib/base/file_util.h"
 
 using namespace vislib_test;
 using json = nlohmann::json;

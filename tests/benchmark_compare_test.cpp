@@ -1,12 +1,12 @@
-// Tests of vislib/benchmark_compare.h: test views, the equal-quality comparison and its
+// Tests of vislib/eval/benchmark_compare.h: test views, the equal-quality comparison and its
 // extrapolation, and one small run of the whole comparison.
-#include "vislib/benchmark_compare.h"
+#include "vislib/eval/benchmark_compare.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "vislib/generate.h"
+#include "vislib/scene/generate.h"
 
 using namespace vislib;
 

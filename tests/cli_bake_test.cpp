@@ -16,8 +16,8 @@
 #include <thread>
 
 #include "tests/test_support.h"
-#include "vislib/file_util.h"
-#include "vislib/import.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/import.h"
 
 extern char** environ;
 

@@ -7,7 +7,7 @@
 
 #include "tests/import_test_files.h"
 #include "tests/test_support.h"
-#include "vislib/import.h"
+#include "vislib/scene/import.h"
 
 using namespace vislib_test;
 using json = nlohmann::json;

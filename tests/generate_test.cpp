@@ -1,4 +1,4 @@
-#include "vislib/generate.h"
+#include "vislib/scene/generate.h"
 
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
@@ -8,9 +8,9 @@
 #include <utility>
 
 #include "tests/test_support.h"
-#include "vislib/file_util.h"
-#include "vislib/write_gltf.h"
-#include "vislib/write_spheres.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/write_gltf.h"
+#include "vislib/scene/write_spheres.h"
 
 using namespace vislib;
 

@@ -1,5 +1,5 @@
-// Tests of vislib/image_io.h: PNG and EXR round trips, atomic writes, bad input.
-#include "vislib/image_io.h"
+// Tests of vislib/eval/image_io.h: PNG and EXR round trips, atomic writes, bad input.
+#include "vislib/eval/image_io.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "tests/test_support.h"
-#include "vislib/error.h"
+#include "vislib/base/error.h"
 
 using namespace vislib;
 

@@ -11,10 +11,10 @@
 
 #include "tests/import_test_files.h"
 #include "tests/test_support.h"
-#include "vislib/error.h"
-#include "vislib/generate.h"
-#include "vislib/import.h"
-#include "vislib/write_gltf.h"
+#include "vislib/base/error.h"
+#include "vislib/scene/generate.h"
+#include "vislib/scene/import.h"
+#include "vislib/scene/write_gltf.h"
 
 using namespace vislib;
 using namespace vislib_test;

@@ -8,9 +8,9 @@
 
 #include "tests/import_test_files.h"
 #include "tests/test_support.h"
-#include "vislib/error.h"
-#include "vislib/import.h"
-#include "vislib/scene_info.h"
+#include "vislib/base/error.h"
+#include "vislib/scene/import.h"
+#include "vislib/scene/scene_info.h"
 
 using namespace vislib;
 using namespace vislib_test;

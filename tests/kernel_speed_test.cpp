@@ -5,10 +5,10 @@
 #include <cstring>
 
 #include "tests/scene_builders.h"
-#include "vislib/footprint.h"
-#include "vislib/generate.h"
-#include "vislib/random.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/base/random.h"
+#include "vislib/kernel/footprint.h"
+#include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/generate.h"
 
 using namespace vislib;
 using vislib_test::random_soup;

@@ -1,11 +1,11 @@
-// Tests of vislib/metrics.h against hand-computed values on tiny images.
-#include "vislib/metrics.h"
+// Tests of vislib/eval/metrics.h against hand-computed values on tiny images.
+#include "vislib/eval/metrics.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
-#include "vislib/random.h"
+#include "vislib/base/random.h"
 
 using namespace vislib;
 

@@ -1,5 +1,5 @@
-// Tests of the near-far reference renderer (vislib/near_far_render.h) and of `pvs view`.
-#include "vislib/near_far_render.h"
+// Tests of the near-far reference renderer (vislib/render/near_far_render.h) and of `pvs view`.
+#include "vislib/render/near_far_render.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "scene_builders.h"
 #include "test_support.h"
-#include "vislib/metrics.h"
+#include "vislib/eval/metrics.h"
 
 namespace {
 

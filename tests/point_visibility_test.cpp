@@ -4,11 +4,11 @@
 #include <algorithm>
 #include <stdexcept>
 
-#include "vislib/cubemap.h"
-#include "vislib/embree_scene.h"
-#include "vislib/point_visibility.h"
-#include "vislib/random.h"
-#include "vislib/ray_oracle.h"
+#include "vislib/base/cubemap.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/eval/point_visibility.h"
+#include "vislib/base/random.h"
+#include "tests/support/ray_oracle.h"
 
 using namespace vislib;
 

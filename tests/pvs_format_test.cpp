@@ -14,7 +14,7 @@
 
 #include "pvs_format/pvs_format.h"
 #include "tests/test_support.h"
-#include "vislib/file_util.h"
+#include "vislib/base/file_util.h"
 
 using namespace vislib_test;
 

@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 
-#include "vislib/cubemap.h"
-#include "vislib/embree_scene.h"
-#include "vislib/random.h"
-#include "vislib/ray_oracle.h"
+#include "vislib/base/cubemap.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/base/random.h"
+#include "tests/support/ray_oracle.h"
 
 using namespace vislib;
 

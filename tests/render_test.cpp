@@ -1,5 +1,5 @@
-// Tests of vislib/render.h: camera convention, analytic depth, shading, subset frames, determinism.
-#include "vislib/render.h"
+// Tests of vislib/eval/render.h: camera convention, analytic depth, shading, subset frames, determinism.
+#include "vislib/eval/render.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "tests/scene_builders.h"
-#include "vislib/generate.h"
-#include "vislib/point_visibility.h"
+#include "vislib/scene/generate.h"
+#include "vislib/eval/point_visibility.h"
 
 using namespace vislib;
 using vislib_test::add_quad;

@@ -3,8 +3,8 @@
 
 #include <vector>
 
-#include "vislib/random.h"
-#include "vislib/scene.h"
+#include "vislib/base/random.h"
+#include "vislib/scene/scene.h"
 
 namespace vislib_test {
 

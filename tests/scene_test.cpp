@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "vislib/scene.h"
+#include "vislib/scene/scene.h"
 
 using namespace vislib;
 

@@ -12,9 +12,9 @@
 
 #include "tests/scene_builders.h"
 #include "tests/test_support.h"
-#include "vislib/import.h"
-#include "vislib/ray_oracle.h"
-#include "vislib/segment_visibility.h"
+#include "vislib/scene/import.h"
+#include "tests/support/ray_oracle.h"
+#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 using vislib_test::random_soup;

@@ -4,7 +4,7 @@
 #include <tbb/global_control.h>
 
 #include "tests/scene_builders.h"
-#include "vislib/view_cells.h"
+#include "vislib/bake/view_cells.h"
 
 using namespace vislib;
 using vislib_test::add_quad;

@@ -1,0 +1,81 @@
+// bake.h: baking a scene's view cells into a PVS file (docs/bake.md), in parallel over cells,
+// with a crash-safe checkpoint to resume from and deterministic shards for cluster job arrays.
+//
+// Determinism: a cell's set depends only on the scene, its view region, the settings and its id
+// (view_cells.h: cell_visibility), and the file is written from the sets in cell order
+// (pvs::write_pvs), so the output is byte-identical for any thread count, for a bake resumed any
+// number of times, and for shards merged with pvs::merge_pvs.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "pvs_format/pvs_format.h"
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/scene.h"
+#include "vislib/bake/view_cells.h"
+
+namespace vislib {
+
+struct BakeSettings {
+  RegionOptions region;  // resolution, near, eps_len, tile size (segment); runs K; seed
+  Granularity granularity = Granularity::Triangle;
+};
+
+// Shard `index` of `count` bakes the cells c with c % count == index (round robin, so each shard
+// gets a share of every part of the scene and similar work). 0 <= index < count.
+struct Shard {
+  uint32_t index = 0, count = 1;
+};
+inline bool in_shard(uint32_t cell, Shard shard) { return cell % shard.count == shard.index; }
+
+// What the file will hold besides the sets: scene_fingerprint(scene), the universe (triangle or
+// object count), granularity, the cells' layout, and metadata: a JSON object with the cells'
+// description and every setting the sets depend on (not the thread count, not the shard).
+// Precondition: the scene has fewer than 2^32 triangles.
+pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const BakeSettings& settings);
+
+// Identifies a bake for its checkpoint: a digest of the file info and the shard.
+uint64_t bake_key(const pvs::FileInfo& info, Shard shard);
+
+// The visible set of one cell at the settings' granularity (sorted ids). `seconds` receives the
+// kernel time if given. Thread-safe.
+std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
+                                const BakeSettings& settings, double* seconds = nullptr);
+
+struct BakeProgress {
+  uint32_t done = 0;     // cells of the shard finished, resumed ones included
+  uint32_t total = 0;    // cells of the shard
+  uint32_t resumed = 0;  // of which taken from the checkpoint
+  double elapsed = 0;    // seconds since this run started baking
+};
+// Called once before the first cell (done = resumed) and after every finished cell, serialised
+// (never two calls at once) but from any worker thread.
+using BakeProgressFn = std::function<void(const BakeProgress&)>;
+
+struct BakeFiles {
+  std::string output;      // the PVS file (a partial file when sharded); written atomically
+  std::string checkpoint;  // checkpoint file, "" for none; deleted once `output` is in place
+  bool resume = false;     // continue from `checkpoint` if it exists
+};
+
+struct BakeReport {
+  uint32_t cells = 0;        // in the layout
+  uint32_t shard_cells = 0;  // in this shard
+  uint32_t resumed = 0;      // taken from the checkpoint
+  uint32_t baked = 0;        // computed in this run
+  std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
+  double seconds = 0;        // wall time of this run's baking
+  pvs::WriteStats stats;     // sizes of the written file
+};
+
+// Bakes the cells of `shard` in parallel (TBB over cells; the kernel is parallel inside too),
+// records each finished cell in the checkpoint before counting it done, writes `files.output`
+// through a temporary file renamed into place, then deletes the checkpoint. Throws InputError for
+// a checkpoint of another bake, std::runtime_error on I/O failure (the checkpoint is kept).
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,
+                const BakeFiles& files, const BakeProgressFn& progress = {});
+
+}  // namespace vislib

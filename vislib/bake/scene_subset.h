@@ -1,0 +1,21 @@
+// scene_subset.h: a scene reduced to a visible set, e.g. to look at one cell's PVS in a glTF
+// viewer (pvs inspect --export-gltf).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+// The scene reduced to `ids` (sorted or not; each < triangle_count() for Triangle granularity,
+// < objects.size() for Object): Triangle keeps exactly those triangles, Object keeps every
+// triangle of those objects. Objects left without triangles are dropped; the others keep their
+// names and their order, and triangles keep their relative order. Every state's positions are kept
+// (unused vertices too: writers such as scene_to_glb write only the vertices an object uses).
+// Spheres are dropped.
+Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granularity granularity);
+
+}  // namespace vislib

@@ -1,0 +1,104 @@
+// view_cells.h: where the view cells of a bake are, and the boundary a cell's visibility is
+// computed on.
+//
+// Two placements:
+//  (a) a user grid over a box (grid_cells), with an optional eye-height band above each cell's
+//      bottom face;
+//  (b) automatic cells over walkable surfaces (walkable_cells): upward-facing triangles within a
+//      slope limit are floor; the scene is cut into square columns of a given size (in x and z;
+//      y is up) and a cell is placed in a column only where there is floor in it, one per floor
+//      level, spanning the eye-height band above that floor (like Unreal's precomputed
+//      visibility cells, which are placed over the surfaces of the level).
+// Both give a pvs::CellLayout, the form the PVS file stores, so a cell's view region is the same
+// whether computed at bake time or read back from the file (pvs::CellLayout::view_region).
+//
+// A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeter of
+// the view region's bottom and top rectangles (the paper's perimeter heuristic, §4.1, applied at
+// the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pvs_format/pvs_format.h"
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+// The cells of a bake and a JSON object (text) saying how they were placed, for the metadata of
+// the PVS file.
+struct ViewCells {
+  pvs::CellLayout layout;
+  std::string description;
+};
+
+pvs::Box to_pvs_box(const Box3& b);
+Box3 to_box3(const pvs::Box& b);
+
+// Eye-height band [lo, hi] in scene units above a floor or a cell's bottom (lo <= hi).
+struct EyeBand {
+  double lo = 1.5, hi = 1.8;
+};
+
+// (a) A grid of nx * ny * nz cells over `box` (min <= max, finite; n* >= 1). With `eye`, a cell's
+// view region spans its x and z range and [bottom + eye.lo, bottom + eye.hi] in y; without, the
+// view region is the cell itself.
+ViewCells grid_cells(const Box3& box, uint32_t nx, uint32_t ny, uint32_t nz,
+                     const std::optional<EyeBand>& eye = std::nullopt);
+
+// (a) The same with cells of (at most) `cell_size` per side: n = max(1, ceil(extent / cell_size))
+// per axis. `cell_size` must be > 0.
+ViewCells grid_cells_by_size(const Box3& box, double cell_size,
+                             const std::optional<EyeBand>& eye = std::nullopt);
+
+struct WalkableOptions {
+  double cell_size = 2;            // side of a column in x and z (scene units), > 0
+  EyeBand eye;                     // band above the floor
+  double max_slope_degrees = 45;   // floor triangles: angle between the normal and +y below this
+  // Drop a floor level that has no headroom: at every one of a 4 x 4 grid of sample points in the
+  // column where the level's floor is, some other surface lies within eye.lo above it (the ground
+  // under a building, the floor inside a wall). Point-sampled: errs towards keeping cells.
+  bool require_headroom = true;
+  // Only place cells in this box (x and z range of the columns, y range of the floors), if set.
+  std::optional<Box3> clip;
+  size_t state = 0;                // key state whose geometry is used
+};
+
+// (b) Walkable cells. Columns start at the x/z minimum of `clip` (or of the scene bounds) and are
+// cell_size wide (the last ones clipped to the clip box). In each column the floor pieces (the
+// parts of floor triangles inside the column, clipped exactly, each of area above
+// kMinFloorAreaFraction * cell_size^2) are grouped into levels: sorted by height, a piece joins
+// the level below when its lowest point is within eye.hi of that level's highest point. A level
+// [lo, hi] gives the cell [column x] x [lo + eye.lo, hi + eye.hi] x [column z]. Cell order: columns
+// by z index, then x index, levels bottom to top. Deterministic (sequential, no threads).
+// Triangles facing up are those with (b - a) x (c - a) having a positive y component: the
+// winding matters (glTF's counter-clockwise front faces).
+ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options);
+
+// The segments a cell's visibility is computed on: the four sides of the view region's bottom
+// rectangle (y = min.y) then those of its top rectangle (y = max.y), each in the order of
+// perimeter_segments; only the four of the bottom when the region is flat in y.
+std::vector<Segment> cell_boundary_segments(const Box3& view_region);
+
+// Seed of cell `cell`'s runs for a bake seeded `seed`; the bottom rectangle's runs use
+// Rng::derive(cell_seed, 0), the top's Rng::derive(cell_seed, 1).
+uint64_t cell_seed(uint64_t seed, uint32_t cell);
+
+struct CellVisibility {
+  std::vector<uint32_t> triangles;  // visible triangle ids, sorted
+  std::vector<uint32_t> spheres;    // visible sphere indices, sorted
+  std::vector<Segment> segments;    // cell_boundary_segments(view region)
+  double seconds = 0;               // kernel seconds
+};
+
+// Visible triangles of cell `cell` of `layout`: region_visibility (options.runs orientations,
+// options.segment settings) on the bottom and the top rectangle of the view region, united.
+// Depends only on the scene, the view region, `options` and `cell` (not on the thread count).
+// Thread-safe; parallel inside (TBB).
+CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
+                               const RegionOptions& options);
+
+}  // namespace vislib

@@ -1,0 +1,149 @@
+// render.cpp: the Embree reference renderer (frames for the metrics of paper §4.3).
+#include "vislib/eval/render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace vislib {
+
+namespace {
+
+struct CameraBasis {
+  Vec3 f, r, u;
+  double sx_scale, sy_scale;
+};
+
+Vec3 normalized(Vec3 v) {
+  return v * (1.0 / length(v));
+}
+
+CameraBasis basis(const Camera& c) {
+  assert(is_finite(c.forward) && length(c.forward) > 0);
+  assert(c.vfov_degrees > 0 && c.vfov_degrees < 180);
+  assert(c.width >= 1 && c.height >= 1 && c.z_near > 0);
+  CameraBasis b;
+  b.f = normalized(c.forward);
+  Vec3 side = cross(b.f, c.up);
+  assert(length(side) > 0 && "up must not be parallel to forward");
+  b.r = normalized(side);
+  b.u = cross(b.r, b.f);
+  const double t = std::tan(c.vfov_degrees * (M_PI / 360.0));
+  b.sy_scale = t;
+  b.sx_scale = t * double(c.width) / double(c.height);
+  return b;
+}
+
+Vec3 ray(const CameraBasis& b, const Camera& c, int x, int y) {
+  const double sx = (double(2 * x + 1) / double(c.width) - 1.0) * b.sx_scale;
+  const double sy = (1.0 - double(2 * y + 1) / double(c.height)) * b.sy_scale;
+  return b.f + b.r * sx + b.u * sy;
+}
+
+uint64_t splitmix(uint64_t x) {
+  uint64_t z = x + 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+uint8_t to_byte(double v) {
+  double s = std::round(v * 255.0);
+  return uint8_t(s < 0 ? 0 : (s > 255 ? 255 : s));
+}
+
+}  // namespace
+
+Vec3 camera_ray(const Camera& camera, int x, int y) {
+  assert(x >= 0 && x < camera.width && y >= 0 && y < camera.height);
+  return ray(basis(camera), camera, x, y);
+}
+
+std::array<uint8_t, 3> object_colour(uint32_t object) {
+  const uint64_t h = splitmix(uint64_t(object));
+  const double hue = double(h & 0xFFFF) / 65536.0 * 6.0;  // sector in [0, 6)
+  const double sat = 0.45 + 0.35 * double((h >> 16) & 0xFF) / 255.0;
+  const double val = 0.65 + 0.35 * double((h >> 24) & 0xFF) / 255.0;
+  const int sector = int(hue);
+  const double frac = hue - sector;
+  const double p = val * (1 - sat), q = val * (1 - sat * frac), t = val * (1 - sat * (1 - frac));
+  double rgb[3];
+  switch (sector) {
+    case 0:
+      rgb[0] = val, rgb[1] = t, rgb[2] = p;
+      break;
+    case 1:
+      rgb[0] = q, rgb[1] = val, rgb[2] = p;
+      break;
+    case 2:
+      rgb[0] = p, rgb[1] = val, rgb[2] = t;
+      break;
+    case 3:
+      rgb[0] = p, rgb[1] = q, rgb[2] = val;
+      break;
+    case 4:
+      rgb[0] = t, rgb[1] = p, rgb[2] = val;
+      break;
+    default:
+      rgb[0] = val, rgb[1] = p, rgb[2] = q;
+      break;
+  }
+  return {to_byte(rgb[0]), to_byte(rgb[1]), to_byte(rgb[2])};
+}
+
+Frame render_frame(const Scene& scene, const EmbreeScene& rt, const Camera& camera,
+                   const uint8_t* allowed) {
+  assert(rt.triangle_count() == scene.triangle_count());
+  const CameraBasis b = basis(camera);
+  Frame frame;
+  frame.width = camera.width;
+  frame.height = camera.height;
+  const size_t w = size_t(camera.width), n = frame.pixel_count();
+  frame.rgb.assign(3 * n, 0);
+  frame.depth.assign(n, std::numeric_limits<float>::infinity());
+  frame.tri.assign(n, kNoHit);
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+        std::vector<Vec3> dirs(w);
+        std::vector<Hit> hits(w);
+        for (int y = rows.begin(); y != rows.end(); ++y) {
+          for (int x = 0; x < camera.width; ++x) dirs[size_t(x)] = ray(b, camera, x, y);
+          rt.first_hits_among(camera.eye, dirs.data(), w, camera.z_near, allowed, hits.data());
+          for (size_t x = 0; x < w; ++x) {
+            const size_t p = size_t(y) * w + x;
+            uint8_t* out = &frame.rgb[3 * p];
+            const Hit& h = hits[x];
+            if (h.tri == kNoHit) {
+              out[0] = kRenderBackground[0], out[1] = kRenderBackground[1],
+              out[2] = kRenderBackground[2];
+              continue;
+            }
+            const double len = length(dirs[x]);
+            frame.tri[p] = h.tri;
+            frame.depth[p] = float(h.lambda * len);
+            const auto c = scene.corners(h.tri, 0);
+            const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
+            const double nl = length(normal);
+            const double lambert = nl > 0 ? std::fabs(dot(normal, dirs[x])) / (nl * len) : 0.0;
+            const double shade = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
+            const auto albedo = object_colour(scene.triangle_object[h.tri]);
+            for (int k = 0; k < 3; ++k) out[k] = to_byte(double(albedo[size_t(k)]) / 255.0 * shade);
+          }
+        }
+      });
+  return frame;
+}
+
+std::vector<uint8_t> triangle_mask(size_t triangle_count, const std::vector<uint32_t>& ids) {
+  std::vector<uint8_t> mask(triangle_count, 0);
+  for (uint32_t id : ids) {
+    assert(id < triangle_count);
+    mask[id] = 1;
+  }
+  return mask;
+}
+
+}  // namespace vislib

@@ -1,0 +1,178 @@
+// footprint.cpp: math note §5.1 (clipped convex hull of the six eye-relative points).
+#include "vislib/kernel/footprint.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "vislib/base/tolerances.h"
+
+namespace vislib {
+namespace {
+
+double cross2(Vec2 o, Vec2 a, Vec2 b) {
+  return (a.u - o.u) * (b.w - o.w) - (a.w - o.w) * (b.u - o.u);
+}
+
+// Andrew's monotone chain over pts[0, n) (reordered in place); writes the CCW hull (collinear
+// points dropped) to `out` and returns its size.
+int convex_hull(Vec2* pts, int n, Vec2* out) {
+  std::sort(pts, pts + n, [](Vec2 a, Vec2 b) { return a.u < b.u || (a.u == b.u && a.w < b.w); });
+  n = int(std::unique(pts, pts + n, [](Vec2 a, Vec2 b) { return a.u == b.u && a.w == b.w; }) - pts);
+  if (n <= 2) {
+    std::copy(pts, pts + n, out);
+    return n;
+  }
+  Vec2 h[2 * kMaxFootprintPoints];
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    while (k >= 2 && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  for (int i = n - 1, lo = k + 1; i-- > 0;) {
+    while (k >= lo && cross2(h[k - 2], h[k - 1], pts[i]) <= 0) --k;
+    h[k++] = pts[i];
+  }
+  std::copy(h, h + k - 1, out);
+  return k - 1;
+}
+
+// Margin in face coordinates: absolute plus relative to the polygon's magnitude (points near the
+// near plane project far out; their rounding grows with them).
+double margin_of(const Footprint& fp) {
+  double m = 0;
+  for (int i = 0; i < fp.size; ++i)
+    m = std::max({m, std::fabs(fp.hull[i].u), std::fabs(fp.hull[i].w)});
+  return kFootprintMargin + kFootprintRelativeMargin * m;
+}
+
+}  // namespace
+
+namespace {
+
+// The projected, clipped points of §5.1 (before the hull): at most kMaxFootprintPoints. Returns
+// -1 when the quick frustum reject applies (the footprint is empty), else the point count; zmin
+// (if given) gets the smallest view depth F.rel[i].
+int projected_points(const Vec3* rel, int count, const FaceAxes& axes, double near, Vec2* pts,
+                     double* zmin) {
+  Vec3 q[12];
+  count = std::min(count, 12);
+  for (int i = 0; i < count; ++i)
+    q[i] = {dot(axes.S, rel[i]), dot(axes.T, rel[i]), dot(axes.F, rel[i])};
+  if (zmin) {
+    double z = INFINITY;
+    for (int i = 0; i < count; ++i) z = std::min(z, q[i].z);
+    *zmin = z;
+  }
+  // Quick reject: all points on the outer side of one plane of the face's frustum (near plane, or
+  // one of |u| <= 1, |w| <= 1 widened by kFrustumRejectWidening), so the clipped hull misses the
+  // face.
+  {
+    const double g = 1.0 + kFrustumRejectWidening;
+    bool behind = true, right = true, left = true, up = true, down = true;
+    for (int i = 0; i < count; ++i) {
+      const double z = std::fabs(q[i].z) * g;
+      behind = behind && q[i].z < near;
+      right = right && q[i].x > z;
+      left = left && q[i].x < -z;
+      up = up && q[i].y > z;
+      down = down && q[i].y < -z;
+    }
+    if (behind || right || left || up || down) return -1;
+  }
+  int n = 0;
+  for (int i = 0; i < count; ++i)
+    if (q[i].z >= near) pts[n++] = {q[i].x / q[i].z, q[i].y / q[i].z};
+  // Edges of the point set crossing the near plane: their crossing points (all pairs).
+  for (int i = 0; i < count; ++i)
+    for (int j = i + 1; j < count; ++j) {
+      double zi = q[i].z - near, zj = q[j].z - near;
+      if ((zi < 0 && zj > 0) || (zi > 0 && zj < 0)) {
+        double s = (near - q[i].z) / (q[j].z - q[i].z);
+        double x = q[i].x + s * (q[j].x - q[i].x), y = q[i].y + s * (q[j].y - q[i].y);
+        pts[n++] = {x / near, y / near};
+      }
+    }
+  return n;
+}
+
+// Pixel rectangle of the points pts[0, count) (non-empty) with margin m.
+bool bounds_of(const Vec2* pts, int count, double m, int n, int& x0, int& x1, int& y0, int& y1) {
+  double umin = INFINITY, umax = -INFINITY, wmin = INFINITY, wmax = -INFINITY;
+  for (int i = 0; i < count; ++i) {
+    Vec2 p = pts[i];
+    umin = std::min(umin, p.u);
+    umax = std::max(umax, p.u);
+    wmin = std::min(wmin, p.w);
+    wmax = std::max(wmax, p.w);
+  }
+  if (umax < -1 - m || umin > 1 + m || wmax < -1 - m || wmin > 1 + m) return false;
+  auto lo = [n](double c) {
+    return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n)))));
+  };
+  auto hi = [n](double c) {
+    return std::min(n - 1, int(std::floor(std::min(double(n) + 1, pixel_coord(c, n)))));
+  };
+  x0 = lo(umin - m);
+  x1 = hi(umax + m);
+  y0 = lo(wmin - m);
+  y1 = hi(wmax + m);
+  return x0 <= x1 && y0 <= y1;
+}
+
+}  // namespace
+
+Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near) {
+  Vec2 pts[kMaxFootprintPoints];
+  int n = projected_points(rel, count, axes, near, pts, nullptr);
+  Footprint fp;
+  if (n > 0) fp.size = convex_hull(pts, n, fp.hull.data());
+  return fp;
+}
+
+bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double near, int n, int& x0,
+                      int& x1, int& y0, int& y1, double& zmin) {
+  Vec2 pts[kMaxFootprintPoints];
+  int k = projected_points(rel, count, axes, near, pts, &zmin);
+  if (k <= 0) return false;
+  // The hull keeps every extreme point (its vertices are a subset of the points that includes
+  // the extremes in u and w), so the margin and the bounds equal those of the hull exactly.
+  double m = 0;
+  for (int i = 0; i < k; ++i) m = std::max({m, std::fabs(pts[i].u), std::fabs(pts[i].w)});
+  return bounds_of(pts, k, kFootprintMargin + kFootprintRelativeMargin * m, n, x0, x1, y0, y1);
+}
+
+bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y0, int& y1) {
+  if (fp.empty()) return false;
+  return bounds_of(fp.hull.data(), fp.size, margin_of(fp), n, x0, x1, y0, y1);
+}
+
+bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1) {
+  if (fp.empty()) return false;
+  double m = margin_of(fp);
+  double wc = pixel_center(y, n), wlo = wc - m, whi = wc + m;
+  double umin = INFINITY, umax = -INFINITY;
+  const int k = fp.size;
+  for (int i = 0; i < k; ++i) {
+    Vec2 a = fp.hull[i];
+    if (a.w >= wlo && a.w <= whi) {
+      umin = std::min(umin, a.u);
+      umax = std::max(umax, a.u);
+    }
+    if (k == 1) break;
+    Vec2 b = fp.hull[(i + 1) % k];
+    for (double wl : {wlo, whi}) {
+      if ((a.w < wl && b.w > wl) || (a.w > wl && b.w < wl)) {
+        double u = a.u + (wl - a.w) / (b.w - a.w) * (b.u - a.u);
+        umin = std::min(umin, u);
+        umax = std::max(umax, u);
+      }
+    }
+  }
+  if (!(umin <= umax)) return false;
+  if (umax < -1 - m || umin > 1 + m) return false;
+  x0 = std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(umin - m, n)))));
+  x1 = std::min(n - 1, int(std::floor(std::min(double(n) + 1, pixel_coord(umax + m, n)))));
+  return x0 <= x1;
+}
+
+}  // namespace vislib

@@ -1,0 +1,88 @@
+// kernel_support.h: pieces shared by the static and the dynamic from-segment kernels
+// (segment_visibility.cpp, dynamic_visibility.cpp): binning primitives into pixel tiles, and the
+// per-thread visibility marks and witnesses with their deterministic reduction.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vislib/kernel/witness.h"
+
+namespace vislib {
+
+// bbox holds 4 ints per primitive: x0, x1, y0, y1 (inclusive pixel bounds; x0 > x1 = empty).
+// Fills `start` (tile_count + 1 offsets) and `items` (make(p) for each primitive p in each tile
+// its box touches, in primitive order within a tile). tile = ty * tiles_x + tx, tiles of side ts.
+template <class Item, class Make>
+void bin_by_tile(const std::vector<int>& bbox, size_t count, int ts, int tiles_x,
+                 std::vector<uint32_t>& start, std::vector<Item>& items, Make make) {
+  const int tile_count = tiles_x * tiles_x;
+  start.assign(size_t(tile_count) + 1, 0);
+  auto for_tiles = [&](size_t p, auto f) {
+    const int* b = &bbox[p * 4];
+    if (b[0] > b[1]) return;
+    for (int ty = b[2] / ts; ty <= b[3] / ts; ++ty)
+      for (int tx = b[0] / ts; tx <= b[1] / ts; ++tx) f(ty * tiles_x + tx);
+  };
+  for (size_t p = 0; p < count; ++p) for_tiles(p, [&](int tile) { ++start[size_t(tile) + 1]; });
+  for (int i = 0; i < tile_count; ++i) start[size_t(i) + 1] += start[size_t(i)];
+  items.resize(start[size_t(tile_count)]);
+  std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+  for (size_t p = 0; p < count; ++p)
+    for_tiles(p, [&](int tile) { items[fill[size_t(tile)]++] = make(p); });
+}
+
+// Witness order: longer piece first, then lower face, row, column, t, tau. A missing witness has
+// length -1 and loses to any real one. A total order, so reductions do not depend on scheduling.
+inline bool better_witness(double len_a, const Witness& a, double len_b, const Witness& b) {
+  if (len_a != len_b) return len_a > len_b;
+  if (a.face != b.face) return a.face < b.face;
+  if (a.y != b.y) return a.y < b.y;
+  if (a.x != b.x) return a.x < b.x;
+  if (a.t != b.t) return a.t < b.t;
+  return a.tau < b.tau;
+}
+
+// What one thread found: a mark per visible primitive and, if wanted, its best witness so far.
+struct FoundMarks {
+  std::vector<uint8_t> seen;        // per primitive
+  std::vector<double> witness_len;  // per primitive: length of the witness piece (-1 = none)
+  std::vector<Witness> witness;     // per primitive
+
+  FoundMarks(size_t count, bool witnesses) : seen(count, 0) {
+    if (witnesses) {
+      witness_len.assign(count, -1.0);
+      witness.resize(count);
+    }
+  }
+  // Marks primitive p visible through a piece of length `len` (in t) with witness w.
+  void mark(uint32_t p, double len, const Witness& w) {
+    seen[p] = 1;
+    if (!witness_len.empty() && better_witness(len, w, witness_len[p], witness[p])) {
+      witness_len[p] = len;
+      witness[p] = w;
+    }
+  }
+};
+
+// Unites the marks of all threads (`found` iterates FoundMarks): seen[p] and the best witness of
+// every primitive (empty `best` when no witnesses were kept).
+template <class Range>
+void reduce_found(const Range& found, size_t count, bool witnesses, std::vector<uint8_t>& seen,
+                  std::vector<Witness>& best) {
+  seen.assign(count, 0);
+  std::vector<double> best_len(witnesses ? count : 0, -1.0);
+  best.assign(witnesses ? count : 0, Witness{});
+  for (const FoundMarks& f : found) {
+    for (size_t p = 0; p < count; ++p) seen[p] |= f.seen[p];
+    if (witnesses)
+      for (size_t p = 0; p < count; ++p)
+        if (f.witness_len[p] >= 0 &&
+            better_witness(f.witness_len[p], f.witness[p], best_len[p], best[p])) {
+          best_len[p] = f.witness_len[p];
+          best[p] = f.witness[p];
+        }
+  }
+}
+
+}  // namespace vislib

@@ -1,0 +1,93 @@
+// region_visibility.cpp: paper §4.1 (perimeter of the view rectangle) and §4.5 (random cube
+// orientations per run).
+#include "vislib/kernel/region_visibility.h"
+
+#include <algorithm>
+#include <functional>
+
+#include "vislib/base/random.h"
+
+namespace vislib {
+
+std::vector<Segment> perimeter_segments(const Box3& box) {
+  std::vector<int> flat, open;
+  for (int a = 0; a < 3; ++a) (box.max[a] > box.min[a] ? open : flat).push_back(a);
+  std::vector<Segment> out;
+  if (open.empty()) return {{box.min, box.min}};
+  // Every edge of the box along an open axis, at each low/high pattern of the other open axes
+  // (flat axes have a single value).
+  for (int axis : open) {
+    std::vector<int> others;
+    for (int a : open)
+      if (a != axis) others.push_back(a);
+    int patterns = 1 << others.size();
+    for (int p = 0; p < patterns; ++p) {
+      Vec3 a = box.min;
+      for (size_t k = 0; k < others.size(); ++k)
+        if (p & (1 << k)) a[others[k]] = box.max[others[k]];
+      Vec3 b = a;
+      b[axis] = box.max[axis];
+      out.push_back({a, b});
+    }
+  }
+  return out;
+}
+
+Mat3 run_orientation(uint64_t seed, size_t segment, int run) {
+  if (run == 0) return Mat3{};
+  return random_orientation(Rng::derive(Rng::derive(seed, segment), uint64_t(run)));
+}
+
+RegionResult region_visibility(const Scene& scene, const Box3& box, const RegionOptions& options,
+                               const std::function<void(size_t, size_t)>& progress) {
+  RegionResult result;
+  result.segments = perimeter_segments(box);
+  const size_t total = result.segments.size() * size_t(options.runs);
+  std::vector<uint8_t> in_union(scene.triangle_count(), 0),
+      sphere_in_union(scene.sphere_count(), 0);
+  size_t union_size = 0;
+  for (size_t s = 0; s < result.segments.size(); ++s) {
+    for (int k = 0; k < options.runs; ++k) {
+      SegmentOptions so = options.segment;
+      so.orientation = run_orientation(options.seed, s, k);
+      SegmentResult sr =
+          segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
+      for (uint32_t id : sr.visible)
+        if (!in_union[id]) {
+          in_union[id] = 1;
+          ++union_size;
+        }
+      for (uint32_t sphere : sr.visible_spheres) sphere_in_union[sphere] = 1;
+      result.seconds += sr.stats.seconds;
+      RunRecord rec;
+      rec.segment = s;
+      rec.run = k;
+      rec.orientation = so.orientation;
+      rec.visible = std::move(sr.visible);
+      rec.visible_spheres = std::move(sr.visible_spheres);
+      rec.stats = sr.stats;
+      rec.union_size_after = union_size;
+      rec.seconds_after = result.seconds;
+      result.runs.push_back(std::move(rec));
+      if (progress) progress(result.runs.size(), total);
+    }
+  }
+  for (uint32_t id = 0; id < in_union.size(); ++id)
+    if (in_union[id]) result.visible.push_back(id);
+  for (uint32_t s = 0; s < sphere_in_union.size(); ++s)
+    if (sphere_in_union[s]) result.visible_spheres.push_back(s);
+  return result;
+}
+
+std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles,
+                                 const std::vector<uint32_t>& spheres) {
+  std::vector<uint32_t> out;
+  out.reserve(triangles.size() + spheres.size());
+  for (uint32_t t : triangles) out.push_back(scene.triangle_object[t]);
+  for (uint32_t s : spheres) out.push_back(scene.sphere_object[s]);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+}  // namespace vislib

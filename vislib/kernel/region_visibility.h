@@ -1,0 +1,67 @@
+// region_visibility.h: from-region visibility as a union of from-segment runs (paper §4.1, §4.5).
+//
+// A view region is an axis-aligned box. Its perimeter segments are the paper's heuristic: the four
+// sides of a view rectangle (a box flat along one axis), the twelve edges of a full box, the
+// segment itself for a box flat along two axes, and a zero-length segment for a point. Each
+// segment is run with K cube orientations: run 0 is aligned with the world axes, runs 1..K-1 use
+// random rotations drawn from the seed (paper §4.5). The visible set is the union.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include "vislib/kernel/segment_visibility.h"
+
+namespace vislib {
+
+enum class Granularity { Triangle, Object };
+
+struct Segment {
+  Vec3 from, to;
+};
+
+// Perimeter segments of `box` (min <= max on every axis), in a fixed documented order: edges
+// sorted by (axis of the edge, then the fixed coordinates' low/high pattern).
+std::vector<Segment> perimeter_segments(const Box3& box);
+
+// Orientation of run `run` on segment `segment`: identity for run 0, else a rotation drawn from
+// (seed, segment, run). Same arguments, same rotation on every platform.
+Mat3 run_orientation(uint64_t seed, size_t segment, int run);
+
+struct RegionOptions {
+  SegmentOptions segment;  // resolution, near, eps_len, tile size... (orientation is ignored)
+  int runs = 1;            // K orientations per segment, >= 1
+  uint64_t seed = 1;
+};
+
+struct RunRecord {
+  size_t segment = 0;
+  int run = 0;
+  Mat3 orientation;
+  std::vector<uint32_t> visible;          // triangle ids of this run
+  std::vector<uint32_t> visible_spheres;  // sphere indices of this run
+  SegmentStats stats;
+  size_t union_size_after = 0;  // triangles in the union after this run
+  double seconds_after = 0;     // cumulative kernel seconds after this run
+};
+
+struct RegionResult {
+  std::vector<Segment> segments;
+  std::vector<RunRecord> runs;            // segment-major, run-minor
+  std::vector<uint32_t> visible;          // union of triangle ids, sorted
+  std::vector<uint32_t> visible_spheres;  // union of sphere indices, sorted
+  double seconds = 0;
+};
+
+// Runs every perimeter segment `runs` times. `progress(done, total)` is called after each run if
+// given (from the calling thread).
+RegionResult region_visibility(const Scene& scene, const Box3& box, const RegionOptions& options,
+                               const std::function<void(size_t, size_t)>& progress = {});
+
+// Object ids (sorted) of the objects owning at least one of `triangles` or `spheres`.
+std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles,
+                                 const std::vector<uint32_t>& spheres = {});
+
+}  // namespace vislib

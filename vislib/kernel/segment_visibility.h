@@ -1,0 +1,105 @@
+// segment_visibility.h: continuous from-segment visibility for static triangles.
+//
+// Implements §3.1 (Alg. 1) of "Complex VEs on All-In-One VR Headsets Through Continuous
+// From-Segment Visibility Computation" as specified in shared/design/visibility-math.md
+// (§1-2 coverage, §5.1 footprint, §6 numerics, §7 compositing): for every pixel centre of a
+// cubemap that translates (without rotating) along v(t) = v0 + t(v1 - v0), t in [0,1], the exact
+// list of pieces of t during which each triangle is the first hit (lambda > near), composited by
+// depth; a triangle is visible when it owns a final piece longer than eps_len.
+//
+// Arithmetic: coordinates are re-centred at v0 and everything is double; coverage uses 3D triple
+// products with canonically oriented edges (bit-identical on shared edges, so closed meshes do not
+// leak) and the symbolic-perturbation tie rule of §2.5. Deterministic: the result (ids, witnesses,
+// pieces) is identical for any thread count and any triangle input order (ids mapped back).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "vislib/base/cubemap.h"
+#include "vislib/base/tolerances.h"
+#include "vislib/kernel/general_depth.h"
+#include "vislib/kernel/interval_list.h"
+#include "vislib/kernel/witness.h"
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+// How animation time relates to the eye's motion in a dynamic scene (docs/visibility.md):
+//  Diagonal (the paper's mode): scene time tau and the segment parameter t advance together
+//    (tau = t), one space-time diagonal per state interval;
+//  Decoupled (what a VR user needs, any eye position at any time): the diagonal plus the boundary
+//    of the (t, tau) square: the eye fixed at each segment end while the scene animates, and the
+//    scene frozen at each key state while the eye moves. An approximation of the full square, as
+//    the perimeter is of a view rectangle.
+enum class DynamicMode { Diagonal, Decoupled };
+
+struct SegmentOptions {
+  int resolution = 512;             // N: each cube face is N x N pixels; must be >= 1
+  double near = kDefaultNear;       // z_near > 0, view depth in scene units
+  Mat3 orientation;                 // cube orientation R (world = R * local); a rotation
+  double eps_len = kDefaultEpsLen;  // final pieces must be longer (in t) to count
+  bool want_witnesses = false;      // one witness per visible triangle
+  bool want_pieces = false;         // keep every pixel's final list (memory: 6 N^2 lists)
+  int tile_size = 32;               // pixels per tile side (memory/parallelism grain)
+  bool depth_culling = true;  // skip hidden work (exact): triangles behind a tile's or a pixel's
+                              // covered depth, intervals behind the pixel's depth envelope over t
+  bool simd = true;           // vectorised coverage where the CPU has AVX2 (bit-identical results)
+  size_t state = 0;           // static scenes: which key state to use
+  DynamicMode mode = DynamicMode::Diagonal;  // dynamic scenes (moving vertices or spheres)
+};
+
+struct SegmentStats {
+  uint64_t pair_tests = 0;     // (triangle, pixel) coverage evaluations
+  uint64_t culled_pairs = 0;   // (triangle, pixel) pairs skipped by per-pixel depth culling
+  uint64_t covered_pairs = 0;  // of which gave a non-empty interval
+  uint64_t hidden_pairs = 0;   // of which lay behind the pixel's depth envelope (not inserted)
+  uint64_t final_pieces = 0;   // pieces in all final lists
+  uint64_t pixels_with_pieces = 0;
+  uint64_t max_pieces_per_pixel = 0;
+  uint64_t triangle_tiles = 0;         // (triangle, tile) pairs binned
+  uint64_t culled_triangle_tiles = 0;  // of which skipped by depth culling
+  double peak_tile_bytes = 0;          // largest memory held by one tile's pixel lists
+  double seconds = 0;                  // wall time of the call
+  // Adds another part's counts (maxima for the max fields).
+  void add(const SegmentStats& o) {
+    pair_tests += o.pair_tests;
+    culled_pairs += o.culled_pairs;
+    covered_pairs += o.covered_pairs;
+    hidden_pairs += o.hidden_pairs;
+    final_pieces += o.final_pieces;
+    pixels_with_pieces += o.pixels_with_pieces;
+    max_pieces_per_pixel = max_pieces_per_pixel > o.max_pieces_per_pixel ? max_pieces_per_pixel
+                                                                         : o.max_pieces_per_pixel;
+    triangle_tiles += o.triangle_tiles;
+    culled_triangle_tiles += o.culled_triangle_tiles;
+    peak_tile_bytes = peak_tile_bytes > o.peak_tile_bytes ? peak_tile_bytes : o.peak_tile_bytes;
+  }
+  double pieces_per_pixel() const {
+    return pixels_with_pieces ? double(final_pieces) / double(pixels_with_pieces) : 0.0;
+  }
+};
+
+struct SegmentResult {
+  std::vector<uint32_t> visible;          // sorted triangle ids
+  std::vector<uint32_t> visible_spheres;  // sorted sphere indices (dynamic kernel)
+  std::vector<Witness> witnesses;         // if requested: one per visible id, in id order
+  // If requested: final list of pixel (face, x, y) at index (face * N + y) * N + x.
+  std::vector<PieceList> pieces;
+  // If requested, for dynamic scenes in Diagonal mode (instead of `pieces`): same indexing; ids
+  // are triangle ids, and triangle_count + s for sphere s. t0, t1 are on the whole segment; each
+  // depth function stays in the local parameter of its state interval [t_k, t_k+1] (evaluate it
+  // at (t - t_k) / (t_k+1 - t_k), with t_k = k / (states - 1)).
+  std::vector<std::vector<GeneralPiece>> general_pieces;
+  SegmentStats stats;
+};
+
+// Visibility of the scene's triangles and spheres from the segment v0 -> v1. A static scene
+// without spheres takes the linear path (key state `options.state`); a scene with moving vertices
+// or spheres takes the dynamic kernel (dynamic_visibility.cpp; quadratic events only for what
+// moves; dynamic_visibility.h) in `options.mode`. Thread-safe (reads the scene only); parallel with
+// TBB.
+SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
+                                 const SegmentOptions& options);
+
+}  // namespace vislib

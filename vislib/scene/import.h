@@ -1,0 +1,29 @@
+// import.h: loading scenes from files. The I/O boundary: bad files throw vislib::InputError with
+// the path and what is wrong (accessor index, line number, byte offset); nothing else is thrown
+// for bad data, and no input makes it crash.
+//
+// Formats, chosen by extension (case-insensitive):
+//   .gltf .glb        glTF 2.0 (import_gltf.cpp)
+//   .obj .ply .off .stl  through OpenMesh (import_mesh.cpp)
+//   .spheres          the sphere text format of docs/sphere-format.md (import_spheres.cpp)
+#pragma once
+
+#include <string>
+
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+struct LoadOptions {
+  // Key states to sample node animations into (glTF). 1 = the rest pose only. Must be >= 1.
+  int states = 1;
+  // glTF: index of the animation to sample (-1 = all animations together, on a common clock).
+  int animation = -1;
+};
+
+// Loads any supported format. Throws InputError on a missing, unreadable, malformed or
+// unsupported file. Warnings (skipped primitives etc.) are appended to `warnings` if given.
+Scene load_scene(const std::string& path, const LoadOptions& options = {},
+                 std::vector<std::string>* warnings = nullptr);
+
+}  // namespace vislib

@@ -1,0 +1,21 @@
+// import_formats.h: the per-format loaders behind load_scene (import.h). Internal to vislib.
+// Each one takes the path (for messages and relative resources) and throws InputError(path, ...)
+// on bad data; warnings are appended to `warnings` (never null here).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "vislib/scene/import.h"
+
+namespace vislib {
+
+// glTF 2.0, .gltf or .glb (import_gltf.cpp).
+Scene load_gltf(const std::string& path, const LoadOptions& options,
+                std::vector<std::string>& warnings);
+// OBJ by our own reader (groups become objects); PLY, OFF, STL through OpenMesh (import_mesh.cpp).
+Scene load_mesh(const std::string& path, std::vector<std::string>& warnings);
+// The sphere text format of docs/sphere-format.md (import_spheres.cpp).
+Scene load_spheres(const std::string& path, std::vector<std::string>& warnings);
+
+}  // namespace vislib

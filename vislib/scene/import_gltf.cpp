@@ -1,0 +1,876 @@
+// import_gltf.cpp: glTF 2.0 (.gltf, .glb) through tinygltf (Debian's shared library).
+//
+// What is imported: the default scene (scene 0 if none is set; all root nodes if the file has no
+// scenes), nodes depth-first with children in order, TRS or matrix transforms composed in double;
+// every node with a mesh becomes one Object (node name, else mesh name, else "node<i>") with its
+// own copy of the vertices (instancing flattened). TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN
+// primitives in order (points and lines are skipped with a warning); indexed or not.
+//
+// Robustness: tinygltf parses the JSON and loads buffers, but every bufferView and accessor range
+// is checked here before a byte is read, so a bad file gives InputError, never a crash. Images
+// are never decoded (a no-op image loader). tinygltf 2.7 ignores extensionsRequired; we check it:
+// extensions that only concern appearance (materials, textures, lights) are ignored, geometry
+// extensions other than EXT_meshopt_compression and KHR_mesh_quantization are rejected.
+//
+// EXT_meshopt_compression: tinygltf does not decode it, and it rejects the GLB "fallback" buffer
+// (no uri, larger than the BIN chunk). We rewrite such fallback buffers in the JSON into 1-byte
+// data URIs before tinygltf sees the file, and decode compressed bufferViews with meshoptimizer
+// into our own byte buffers (filters NONE/OCTAHEDRAL/QUATERNION/EXPONENTIAL).
+//
+// Animation (LoadOptions::states K > 1): translation/rotation/scale and morph "weights" channels
+// (LINEAR, with slerp for rotations; STEP; CUBICSPLINE as cubic Hermite splines through the value
+// element of each in-tangent/value/out-tangent triple, the tangents giving the slopes) are sampled
+// at K evenly spaced times over [0, latest key time] of the selected animations. Channels of
+// other paths (e.g. KHR_animation_pointer) are skipped with a warning.
+//
+// Morph targets (glTF 2.0 §3.7.2.2): the POSITION displacements of the targets (sparse accessors
+// included) are applied first, p = base + sum_i w_i * target_i in double, then skinning, then the
+// node transform. Weights: the mesh's `weights`, overridden by the node's `weights` (zeros if
+// neither is given), overridden in each state by a sampled "weights" channel. K = 1 is the rest
+// pose: default weights, the animation is not sampled. NORMAL/TANGENT targets do not move
+// geometry and are not read.
+//
+// Skinned meshes are deformed by linear-blend skinning (JOINTS_0/WEIGHTS_0, inverse bind
+// matrices) with the sampled joint transforms, also for K = 1 (the rest pose of the joints).
+#include <tiny_gltf.h>
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "vislib/base/error.h"
+#include "vislib/base/file_util.h"
+#include "vislib/scene/import_formats.h"
+
+namespace vislib {
+
+namespace {
+
+using json = nlohmann::json;
+
+// Column-major 4x4 matrix, as in glTF.
+struct Mat4 {
+  double m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+};
+
+Mat4 operator*(const Mat4& a, const Mat4& b) {
+  Mat4 r;
+  for (int c = 0; c < 4; ++c)
+    for (int i = 0; i < 4; ++i) {
+      double s = 0;
+      for (int k = 0; k < 4; ++k) s += a.m[k * 4 + i] * b.m[c * 4 + k];
+      r.m[c * 4 + i] = s;
+    }
+  return r;
+}
+
+Vec3 transform(const Mat4& a, Vec3 p) {
+  return {a.m[0] * p.x + a.m[4] * p.y + a.m[8] * p.z + a.m[12],
+          a.m[1] * p.x + a.m[5] * p.y + a.m[9] * p.z + a.m[13],
+          a.m[2] * p.x + a.m[6] * p.y + a.m[10] * p.z + a.m[14]};
+}
+
+struct Trs {
+  double t[3] = {0, 0, 0};
+  double r[4] = {0, 0, 0, 1};  // quaternion x, y, z, w
+  double s[3] = {1, 1, 1};
+  bool has_matrix = false;
+  Mat4 matrix;
+};
+
+Mat4 to_matrix(const Trs& x) {
+  if (x.has_matrix) return x.matrix;
+  double qx = x.r[0], qy = x.r[1], qz = x.r[2], qw = x.r[3];
+  double n = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
+  if (n > 0) qx /= n, qy /= n, qz /= n, qw /= n;
+  double R[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+                    {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+                    {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+  Mat4 m;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r) m.m[c * 4 + r] = R[r][c] * x.s[c];
+  for (int r = 0; r < 3; ++r) m.m[12 + r] = x.t[r];
+  return m;
+}
+
+struct Bytes {
+  const unsigned char* data = nullptr;
+  size_t size = 0;
+};
+
+struct Channel {
+  int node = -1;
+  int path = 0;  // 0 translation, 1 rotation, 2 scale, 3 morph weights
+  int interp = 0;  // 0 LINEAR, 1 STEP, 2 CUBICSPLINE
+  size_t ncomp = 3;  // values per key element: 3, 4 (rotation) or the morph target count (weights)
+  std::vector<double> times;
+  std::vector<double> values;  // per key: ncomp values (CUBICSPLINE: in-tangent, value, out-tangent)
+};
+
+// One primitive of a mesh, decoded once and shared by all instances of the mesh.
+struct Prim {
+  std::vector<Vec3> local;
+  std::vector<std::array<uint32_t, 3>> tris;
+  std::vector<std::array<uint32_t, 4>> joints;  // empty unless skinned
+  std::vector<std::array<double, 4>> weights;
+  // POSITION displacement of each vertex per morph target; a target without POSITION is empty.
+  std::vector<std::vector<Vec3>> targets;
+};
+
+struct Ctx {
+  std::string path;
+  tinygltf::Model model;
+  json doc;
+  std::vector<std::vector<unsigned char>> decoded;  // meshopt-decoded bufferViews
+  std::vector<char> is_decoded;
+  std::vector<std::string>* warnings;
+
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(path, what); }
+};
+
+bool image_loader_noop(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                       const unsigned char*, int, void*) {
+  return true;
+}
+
+uint32_t rd32(const std::string& b, size_t at) {
+  uint32_t v;
+  std::memcpy(&v, b.data() + at, 4);
+  return v;
+}
+
+// Decodes an EXT_meshopt_compression bufferView into ctx.decoded[view].
+void decode_meshopt(Ctx& ctx, int view, const json& ext) {
+  std::string who = "bufferView " + std::to_string(view) + " (EXT_meshopt_compression): ";
+  auto num = [&](const char* key, bool required) -> uint64_t {
+    if (!ext.contains(key)) {
+      if (required) ctx.fail(who + "missing '" + key + "'");
+      return 0;
+    }
+    const json& v = ext[key];
+    if (!v.is_number_unsigned()) ctx.fail(who + "'" + key + "' must be a non-negative integer");
+    return v.get<uint64_t>();
+  };
+  uint64_t buffer = num("buffer", true), offset = num("byteOffset", false),
+           length = num("byteLength", true), stride = num("byteStride", true),
+           count = num("count", true);
+  std::string mode = ext.value("mode", std::string());
+  std::string filter = ext.value("filter", std::string("NONE"));
+  if (buffer >= ctx.model.buffers.size())
+    ctx.fail(who + "buffer " + std::to_string(buffer) + " does not exist");
+  const auto& data = ctx.model.buffers[buffer].data;
+  if (offset > data.size() || length > data.size() - offset)
+    ctx.fail(who + "source bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
+             ") exceed buffer " + std::to_string(buffer) + " of " + std::to_string(data.size()) + " bytes");
+  if (stride == 0 || stride > 256 || count > (uint64_t(1) << 31) / stride)
+    ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " + std::to_string(count));
+  auto& out = ctx.decoded[view];
+  out.assign(size_t(count * stride), 0);
+  const unsigned char* src = data.data() + offset;
+  int rc;
+  if (mode == "ATTRIBUTES") {
+    if (stride % 4) ctx.fail(who + "ATTRIBUTES need a byteStride multiple of 4");
+    rc = meshopt_decodeVertexBuffer(out.data(), count, stride, src, length);
+  } else if (mode == "TRIANGLES" || mode == "INDICES") {
+    if (stride != 2 && stride != 4) ctx.fail(who + "indices need byteStride 2 or 4");
+    if (mode == "TRIANGLES" && count % 3) ctx.fail(who + "TRIANGLES count is not a multiple of 3");
+    rc = mode == "TRIANGLES" ? meshopt_decodeIndexBuffer(out.data(), count, stride, src, length)
+                             : meshopt_decodeIndexSequence(out.data(), count, stride, src, length);
+  } else {
+    ctx.fail(who + "unknown mode '" + mode + "'");
+  }
+  if (rc != 0) ctx.fail(who + "meshoptimizer could not decode the data (error " + std::to_string(rc) + ")");
+  if (filter == "NONE") {
+  } else if (mode != "ATTRIBUTES") {
+    ctx.fail(who + "filter " + filter + " is only allowed with ATTRIBUTES");
+  } else if (filter == "OCTAHEDRAL" && (stride == 4 || stride == 8)) {
+    meshopt_decodeFilterOct(out.data(), count, stride);
+  } else if (filter == "QUATERNION" && stride == 8) {
+    meshopt_decodeFilterQuat(out.data(), count, stride);
+  } else if (filter == "EXPONENTIAL") {
+    meshopt_decodeFilterExp(out.data(), count, stride);
+  } else {
+    ctx.fail(who + "filter '" + filter + "' is unknown or does not fit byteStride " + std::to_string(stride));
+  }
+}
+
+// The bytes of a bufferView, range-checked (meshopt-compressed views are decoded first).
+Bytes view_bytes(Ctx& ctx, int view, const std::string& who) {
+  const auto& views = ctx.model.bufferViews;
+  if (view < 0 || size_t(view) >= views.size())
+    ctx.fail(who + ": bufferView " + std::to_string(view) + " does not exist (the file has " +
+             std::to_string(views.size()) + ")");
+  const json* ext = nullptr;
+  const json& jv = ctx.doc["bufferViews"][size_t(view)];
+  if (jv.contains("extensions") && jv["extensions"].contains("EXT_meshopt_compression"))
+    ext = &jv["extensions"]["EXT_meshopt_compression"];
+  if (ext) {
+    if (!ctx.is_decoded[view]) {
+      decode_meshopt(ctx, view, *ext);
+      ctx.is_decoded[view] = 1;
+    }
+    return {ctx.decoded[view].data(), ctx.decoded[view].size()};
+  }
+  const auto& bv = views[view];
+  if (bv.buffer < 0 || size_t(bv.buffer) >= ctx.model.buffers.size())
+    ctx.fail("bufferView " + std::to_string(view) + ": buffer " + std::to_string(bv.buffer) +
+             " does not exist");
+  const auto& data = ctx.model.buffers[bv.buffer].data;
+  if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
+    ctx.fail("bufferView " + std::to_string(view) + ": bytes [" + std::to_string(bv.byteOffset) +
+             ", " + std::to_string(bv.byteOffset + bv.byteLength) + ") are out of range of buffer " +
+             std::to_string(bv.buffer) + " (" + std::to_string(data.size()) + " bytes)");
+  return {data.data() + bv.byteOffset, bv.byteLength};
+}
+
+double read_component(const unsigned char* p, int type, bool normalized) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v; std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v; std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v; std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v; std::memcpy(&v, p, 4);
+      return v;
+    }
+    default: {
+      float v; std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
+int component_size(int type) {
+  switch (type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+  }
+}
+
+// Reads `count` elements of `ncomp` components each from a (view, offset, stride) region after
+// checking the range.
+void read_elements(Ctx& ctx, const std::string& who, int view, size_t offset, size_t stride,
+                   size_t count, int ncomp, int ctype, bool normalized, double* out,
+                   const std::vector<size_t>* targets = nullptr) {
+  Bytes b = view_bytes(ctx, view, who);
+  size_t csize = size_t(component_size(ctype)), esize = csize * size_t(ncomp);
+  if (stride == 0) stride = esize;
+  if (stride < esize)
+    ctx.fail(who + ": byteStride " + std::to_string(stride) + " is smaller than the element (" +
+             std::to_string(esize) + " bytes)");
+  if (count == 0) return;
+  if (offset > b.size || esize > b.size - offset || (count - 1) > (b.size - offset - esize) / stride)
+    ctx.fail(who + ": " + std::to_string(count) + " elements of " + std::to_string(esize) +
+             " bytes (stride " + std::to_string(stride) + ") from byte " + std::to_string(offset) +
+             " do not fit in bufferView " + std::to_string(view) + " (" + std::to_string(b.size) +
+             " bytes)");
+  for (size_t i = 0; i < count; ++i) {
+    const unsigned char* p = b.data + offset + i * stride;
+    double* dst = out + (targets ? (*targets)[i] : i) * size_t(ncomp);
+    for (int c = 0; c < ncomp; ++c) dst[c] = read_component(p + size_t(c) * csize, ctype, normalized);
+  }
+}
+
+// All values of an accessor as doubles (count * ncomp), every range checked. `who` says what the
+// accessor is for; `want` lists the allowed component counts (empty = any).
+std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, int& ncomp,
+                                  std::initializer_list<int> want = {}) {
+  const auto& accs = ctx.model.accessors;
+  std::string who = "accessor " + std::to_string(index) + " (" + what + ")";
+  if (index < 0 || size_t(index) >= accs.size())
+    ctx.fail(who + " does not exist (the file has " + std::to_string(accs.size()) + " accessors)");
+  const auto& a = accs[index];
+  if (!component_size(a.componentType))
+    ctx.fail(who + ": bad componentType " + std::to_string(a.componentType));
+  ncomp = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+  if (ncomp <= 0) ctx.fail(who + ": bad type " + std::to_string(a.type));
+  if (want.size() && std::find(want.begin(), want.end(), ncomp) == want.end())
+    ctx.fail(who + ": unexpected type with " + std::to_string(ncomp) + " components");
+  if (a.count > (size_t(1) << 28))
+    ctx.fail(who + ": count " + std::to_string(a.count) + " is too large");
+  std::vector<double> out(a.count * size_t(ncomp), 0.0);
+  if (a.bufferView >= 0) {
+    size_t stride = ctx.model.bufferViews.size() > size_t(a.bufferView)
+                        ? ctx.model.bufferViews[a.bufferView].byteStride : 0;
+    read_elements(ctx, who, a.bufferView, a.byteOffset, stride, a.count, ncomp, a.componentType,
+                  a.normalized, out.data());
+  }
+  if (a.sparse.isSparse) {
+    size_t n = size_t(std::max(a.sparse.count, 0));
+    if (n > a.count) ctx.fail(who + ": sparse count exceeds the accessor count");
+    int itype = a.sparse.indices.componentType;
+    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      ctx.fail(who + ": bad sparse index componentType");
+    std::vector<double> idx(n);
+    read_elements(ctx, who + " sparse indices", a.sparse.indices.bufferView,
+                  size_t(std::max(a.sparse.indices.byteOffset, 0)), 0, n, 1, itype, false, idx.data());
+    std::vector<size_t> targets(n);
+    for (size_t i = 0; i < n; ++i) {
+      if (idx[i] >= double(a.count)) ctx.fail(who + ": sparse index out of range");
+      targets[i] = size_t(idx[i]);
+    }
+    read_elements(ctx, who + " sparse values", a.sparse.values.bufferView,
+                  size_t(std::max(a.sparse.values.byteOffset, 0)), 0, n, ncomp, a.componentType,
+                  a.normalized, out.data(), &targets);
+  }
+  return out;
+}
+
+std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
+  const auto& mesh = ctx.model.meshes[mesh_index];
+  std::vector<Prim> prims;
+  for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
+    const auto& prim = mesh.primitives[pi];
+    std::string where = "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(pi);
+    int mode = prim.mode < 0 ? TINYGLTF_MODE_TRIANGLES : prim.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+        mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+      ctx.warnings->push_back(ctx.path + ": " + where + ": mode " + std::to_string(mode) +
+                              " (points/lines) skipped");
+      continue;
+    }
+    auto pos_it = prim.attributes.find("POSITION");
+    if (pos_it == prim.attributes.end()) {
+      ctx.warnings->push_back(ctx.path + ": " + where + ": no POSITION, skipped");
+      continue;
+    }
+    Prim out;
+    int nc;
+    auto pos = read_accessor(ctx, pos_it->second, "POSITION of " + where, nc, {3});
+    size_t nv = pos.size() / 3;
+    out.local.resize(nv);
+    for (size_t v = 0; v < nv; ++v) {
+      out.local[v] = {pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]};
+      if (!is_finite(out.local[v]))
+        ctx.fail("accessor " + std::to_string(pos_it->second) + " (POSITION of " + where +
+                 "): vertex " + std::to_string(v) + " is not finite (NaN or inf)");
+    }
+    std::vector<uint32_t> idx;
+    if (prim.indices >= 0) {
+      const auto& accs = ctx.model.accessors;
+      if (size_t(prim.indices) < accs.size()) {
+        int ct = accs[prim.indices].componentType;
+        if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+          ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where +
+                   "): componentType " + std::to_string(ct) + " is not an unsigned integer type");
+      }
+      auto raw = read_accessor(ctx, prim.indices, "indices of " + where, nc, {1});
+      size_t bad = 0;
+      double worst = 0;
+      idx.resize(raw.size());
+      for (size_t i = 0; i < raw.size(); ++i) {
+        if (raw[i] >= double(nv)) ++bad, worst = std::max(worst, raw[i]);
+        idx[i] = uint32_t(raw[i]);
+      }
+      if (bad)
+        ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where + "): " +
+                 std::to_string(bad) + " indices out of range (largest " +
+                 std::to_string(uint64_t(worst)) + ", POSITION has " + std::to_string(nv) + " vertices)");
+    } else {
+      idx.resize(nv);
+      for (size_t i = 0; i < nv; ++i) idx[i] = uint32_t(i);
+    }
+    size_t n = idx.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      for (size_t i = 0; i + 2 < n; i += 3) out.tris.push_back({idx[i], idx[i + 1], idx[i + 2]});
+      if (n % 3)
+        ctx.warnings->push_back(ctx.path + ": " + where + ": " + std::to_string(n % 3) +
+                                " trailing indices ignored");
+    } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // p_i = {v_i, v_{i+1+i%2}, v_{i+2-i%2}}
+      for (size_t i = 0; i + 2 < n; ++i)
+        out.tris.push_back({idx[i], idx[i + 1 + i % 2], idx[i + 2 - i % 2]});
+    } else {  // fan: p_i = {v_{i+1}, v_{i+2}, v_0}
+      for (size_t i = 0; i + 2 < n; ++i) out.tris.push_back({idx[i + 1], idx[i + 2], idx[0]});
+    }
+    auto j_it = prim.attributes.find("JOINTS_0"), w_it = prim.attributes.find("WEIGHTS_0");
+    if (skinned && j_it != prim.attributes.end() && w_it != prim.attributes.end()) {
+      auto j = read_accessor(ctx, j_it->second, "JOINTS_0 of " + where, nc, {4});
+      auto w = read_accessor(ctx, w_it->second, "WEIGHTS_0 of " + where, nc, {4});
+      if (j.size() != 4 * nv || w.size() != 4 * nv)
+        ctx.fail(where + ": JOINTS_0/WEIGHTS_0 counts differ from POSITION");
+      out.joints.resize(nv);
+      out.weights.resize(nv);
+      for (size_t v = 0; v < nv; ++v)
+        for (int c = 0; c < 4; ++c) {
+          out.joints[v][c] = uint32_t(j[4 * v + c]);
+          out.weights[v][c] = w[4 * v + c];
+        }
+    }
+    for (size_t ti = 0; ti < prim.targets.size(); ++ti) {
+      auto t_it = prim.targets[ti].find("POSITION");
+      if (t_it == prim.targets[ti].end()) {
+        out.targets.emplace_back();
+        continue;
+      }
+      std::string what = "POSITION of morph target " + std::to_string(ti) + " of " + where;
+      auto d = read_accessor(ctx, t_it->second, what, nc, {3});
+      if (d.size() != 3 * nv)
+        ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what + "): " +
+                 std::to_string(d.size() / 3) + " elements, but POSITION has " + std::to_string(nv));
+      std::vector<Vec3> disp(nv);
+      for (size_t v = 0; v < nv; ++v) {
+        disp[v] = {d[3 * v], d[3 * v + 1], d[3 * v + 2]};
+        if (!is_finite(disp[v]))
+          ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what + "): vertex " +
+                   std::to_string(v) + " is not finite (NaN or inf)");
+      }
+      out.targets.push_back(std::move(disp));
+    }
+    prims.push_back(std::move(out));
+  }
+  return prims;
+}
+
+// Reads the animation channels of the selected animations. `node_targets[n]` is the morph target
+// count of node n's mesh (0 without a mesh), the number of weights a "weights" channel animates.
+std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t>& node_targets) {
+  std::vector<Channel> out;
+  const auto& anims = ctx.model.animations;
+  if (which >= int(anims.size()))
+    ctx.fail("animation " + std::to_string(which) + " does not exist (the file has " +
+             std::to_string(anims.size()) + ")");
+  for (size_t ai = 0; ai < anims.size(); ++ai) {
+    if (which >= 0 && size_t(which) != ai) continue;
+    const auto& an = anims[ai];
+    for (size_t ci = 0; ci < an.channels.size(); ++ci) {
+      const auto& ch = an.channels[ci];
+      std::string where = "animation " + std::to_string(ai) + " channel " + std::to_string(ci);
+      Channel c;
+      if (ch.target_path == "translation") c.path = 0;
+      else if (ch.target_path == "rotation") c.path = 1;
+      else if (ch.target_path == "scale") c.path = 2;
+      else if (ch.target_path == "weights") c.path = 3;
+      else {
+        ctx.warnings->push_back(ctx.path + ": " + where + ": target path '" + ch.target_path +
+                                "' is not supported; channel ignored");
+        continue;
+      }
+      if (ch.target_node < 0 || size_t(ch.target_node) >= ctx.model.nodes.size())
+        ctx.fail(where + ": target node " + std::to_string(ch.target_node) + " does not exist");
+      if (c.path == 3) {
+        c.ncomp = node_targets[size_t(ch.target_node)];
+        if (c.ncomp == 0)
+          ctx.fail(where + ": animates the morph weights of node " + std::to_string(ch.target_node) +
+                   ", which has no mesh with morph targets");
+      } else {
+        c.ncomp = c.path == 1 ? 4 : 3;
+      }
+      if (ch.sampler < 0 || size_t(ch.sampler) >= an.samplers.size())
+        ctx.fail(where + ": sampler " + std::to_string(ch.sampler) + " does not exist");
+      const auto& s = an.samplers[ch.sampler];
+      c.node = ch.target_node;
+      c.interp = s.interpolation == "STEP" ? 1 : s.interpolation == "CUBICSPLINE" ? 2 : 0;
+      int nc;
+      c.times = read_accessor(ctx, s.input, "input of " + where, nc, {1});
+      c.values = read_accessor(ctx, s.output, "output of " + where, nc,
+                               {c.path == 3 ? 1 : int(c.ncomp)});
+      size_t per_key = c.ncomp * (c.interp == 2 ? 3 : 1);
+      if (c.times.empty() || c.values.size() != c.times.size() * per_key)
+        ctx.fail("accessor " + std::to_string(s.output) + " (output of " + where + "): " +
+                 std::to_string(c.values.size()) + " values, but " + std::to_string(c.times.size()) +
+                 " keys (accessor " + std::to_string(s.input) + ") need " +
+                 std::to_string(c.times.size() * per_key) +
+                 (c.path == 3 ? " (" + std::to_string(c.ncomp) + " morph weights per key" +
+                                    (c.interp == 2 ? ", times 3 for CUBICSPLINE)" : ")")
+                              : std::string()));
+      for (double t : c.times)
+        if (!std::isfinite(t)) ctx.fail(where + ": non-finite key time");
+      c.node = ch.target_node;
+      out.push_back(std::move(c));
+    }
+  }
+  return out;
+}
+
+// Value of channel `c` at time t (c.ncomp components).
+void sample(const Channel& c, double t, double* v) {
+  const size_t n = c.ncomp;
+  size_t keys = c.times.size();
+  size_t stride = n * (c.interp == 2 ? 3 : 1), voff = c.interp == 2 ? n : 0;
+  auto val = [&](size_t k, size_t i) { return c.values[k * stride + voff + i]; };
+  size_t k = size_t(std::upper_bound(c.times.begin(), c.times.end(), t) - c.times.begin());
+  if (k == 0 || k == keys) {
+    size_t at = k == 0 ? 0 : keys - 1;
+    for (size_t i = 0; i < n; ++i) v[i] = val(at, i);
+    return;
+  }
+  size_t k0 = k - 1;
+  double t0 = c.times[k0], t1 = c.times[k], dt = t1 - t0;
+  double s = dt > 0 ? (t - t0) / dt : 0;
+  if (c.interp == 1) {
+    for (size_t i = 0; i < n; ++i) v[i] = val(k0, i);
+  } else if (c.interp == 2) {
+    double s2 = s * s, s3 = s2 * s;
+    for (size_t i = 0; i < n; ++i) {
+      double p0 = val(k0, i), p1 = val(k, i);
+      double m0 = dt * c.values[k0 * stride + 2 * n + i];  // out-tangent of k0
+      double m1 = dt * c.values[k * stride + i];          // in-tangent of k
+      v[i] = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 +
+             (s3 - s2) * m1;
+    }
+  } else if (c.path == 1) {  // slerp
+    double a[4], b[4], d = 0;
+    for (size_t i = 0; i < 4; ++i) a[i] = val(k0, i), b[i] = val(k, i), d += a[i] * b[i];
+    if (d < 0) {
+      d = -d;
+      for (double& x : b) x = -x;
+    }
+    double wa = 1 - s, wb = s;
+    if (d < 0.9995) {
+      double th = std::acos(std::min(d, 1.0)), sn = std::sin(th);
+      wa = std::sin((1 - s) * th) / sn;
+      wb = std::sin(s * th) / sn;
+    }
+    for (size_t i = 0; i < 4; ++i) v[i] = wa * a[i] + wb * b[i];
+  } else {
+    for (size_t i = 0; i < n; ++i) v[i] = val(k0, i) + (val(k, i) - val(k0, i)) * s;
+  }
+}
+
+// Checks the required extensions (see the top of this file).
+void check_extensions(const Ctx& ctx) {
+  for (const auto& e : ctx.model.extensionsRequired) {
+    bool appearance = e.rfind("KHR_materials_", 0) == 0 || e.rfind("KHR_texture_", 0) == 0 ||
+                      e.rfind("EXT_texture_", 0) == 0 || e == "KHR_lights_punctual" ||
+                      e.rfind("MSFT_texture_", 0) == 0;
+    if (appearance) {
+      ctx.warnings->push_back(ctx.path + ": required extension " + e +
+                              " concerns appearance only; ignored");
+    } else if (e != "EXT_meshopt_compression" && e != "KHR_mesh_quantization") {
+      ctx.fail("requires extension " + e + ", which vislib does not support");
+    }
+  }
+  for (const auto& e : ctx.model.extensionsUsed)
+    if (e == "EXT_mesh_gpu_instancing" || e == "KHR_draco_mesh_compression")
+      ctx.warnings->push_back(ctx.path + ": extension " + e + " is used but not supported; "
+                              "geometry that relies on it is missing");
+}
+
+// Parses the container, rewrites meshopt fallback buffers and hands the file to tinygltf.
+void parse_file(Ctx& ctx) {
+  const std::string bytes = read_file(ctx.path);
+  bool glb = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
+  std::string json_text, bin;
+  bool has_bin = false;
+  if (glb) {
+    if (bytes.size() < 20)
+      ctx.fail("truncated .glb: " + std::to_string(bytes.size()) + " bytes, less than a GLB header");
+    uint32_t version = rd32(bytes, 4), length = rd32(bytes, 8);
+    if (version != 2) ctx.fail("unsupported GLB version " + std::to_string(version));
+    if (length > bytes.size())
+      ctx.fail("truncated .glb: the header declares " + std::to_string(length) +
+               " bytes but the file has " + std::to_string(bytes.size()));
+    size_t at = 12;
+    for (int chunk = 0; at + 8 <= length; ++chunk) {
+      uint32_t clen = rd32(bytes, at), ctype = rd32(bytes, at + 4);
+      if (clen > length - at - 8)
+        ctx.fail("truncated .glb: chunk " + std::to_string(chunk) + " at byte " + std::to_string(at) +
+                 " declares " + std::to_string(clen) + " bytes, past the end of the file");
+      if (chunk == 0 && ctype != 0x4E4F534Au) ctx.fail("malformed .glb: the first chunk is not JSON");
+      if (chunk == 0) json_text = bytes.substr(at + 8, clen);
+      if (chunk == 1 && ctype == 0x004E4942u) bin = bytes.substr(at + 8, clen), has_bin = true;
+      at += 8 + size_t(clen);
+      at = (at + 3) & ~size_t(3);
+    }
+    if (at == 12) ctx.fail("malformed .glb: no JSON chunk");
+  } else {
+    json_text = bytes;
+  }
+  try {
+    ctx.doc = json::parse(json_text);
+  } catch (const json::exception& e) {
+    ctx.fail(std::string("invalid JSON: ") + e.what());
+  }
+  if (!ctx.doc.is_object()) ctx.fail("invalid glTF: the JSON is not an object");
+  // EXT_meshopt_compression fallback buffers: replace by a 1-byte data URI (see top of file).
+  if (ctx.doc.contains("buffers") && ctx.doc["buffers"].is_array())
+    for (auto& b : ctx.doc["buffers"])
+      if (b.is_object() && b.contains("extensions") && b["extensions"].is_object() &&
+          b["extensions"].contains("EXT_meshopt_compression") &&
+          b["extensions"]["EXT_meshopt_compression"].value("fallback", false)) {
+        b["uri"] = "data:application/octet-stream;base64,AA==";
+        b["byteLength"] = 1;
+      }
+  if (!ctx.doc.contains("bufferViews") || !ctx.doc["bufferViews"].is_array())
+    ctx.doc["bufferViews"] = json::array();
+  for (const auto& v : ctx.doc["bufferViews"])
+    if (!v.is_object()) ctx.fail("invalid glTF: a bufferView is not an object");
+
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(image_loader_noop, nullptr);
+  std::string err, warn, text = ctx.doc.dump();
+  std::string base = std::filesystem::path(ctx.path).parent_path().string();
+  bool ok;
+  try {
+    if (glb) {
+      std::string out(12, '\0');
+      auto put = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+      while (text.size() % 4) text += ' ';
+      put(uint32_t(text.size()));
+      put(0x4E4F534Au);
+      out += text;
+      if (has_bin) {
+        while (bin.size() % 4) bin += '\0';
+        put(uint32_t(bin.size()));
+        put(0x004E4942u);
+        out += bin;
+      }
+      uint32_t head[3] = {0x46546C67u, 2u, uint32_t(out.size())};
+      std::memcpy(&out[0], head, 12);
+      ok = loader.LoadBinaryFromMemory(&ctx.model, &err, &warn,
+                                       reinterpret_cast<const unsigned char*>(out.data()),
+                                       unsigned(out.size()), base);
+    } else {
+      ok = loader.LoadASCIIFromString(&ctx.model, &err, &warn, text.c_str(), unsigned(text.size()), base);
+    }
+  } catch (const std::exception& e) {
+    ok = false;
+    err += e.what();
+  }
+  if (!ok) {
+    while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
+    ctx.fail("invalid glTF (tinygltf: " + err + ")");
+  }
+  if (ctx.model.bufferViews.size() != ctx.doc["bufferViews"].size())
+    ctx.fail("invalid glTF: bufferViews could not be parsed");
+  ctx.decoded.resize(ctx.model.bufferViews.size());
+  ctx.is_decoded.assign(ctx.model.bufferViews.size(), 0);
+}
+
+}  // namespace
+
+Scene load_gltf(const std::string& path, const LoadOptions& options,
+                std::vector<std::string>& warnings) {
+  Ctx ctx;
+  ctx.path = path;
+  ctx.warnings = &warnings;
+  parse_file(ctx);
+  check_extensions(ctx);
+  const auto& model = ctx.model;
+  const size_t N = model.nodes.size();
+
+  // Rest-pose TRS of every node, and the hierarchy (validated: indices, single parent, no cycle).
+  std::vector<Trs> rest(N);
+  std::vector<int> parent(N, -1);
+  for (size_t n = 0; n < N; ++n) {
+    const auto& nd = model.nodes[n];
+    std::string who = "node " + std::to_string(n);
+    if (nd.matrix.size() == 16) {
+      rest[n].has_matrix = true;
+      std::copy(nd.matrix.begin(), nd.matrix.end(), rest[n].matrix.m);
+    } else if (!nd.matrix.empty()) {
+      ctx.fail(who + ": matrix must have 16 numbers");
+    }
+    if (!nd.translation.empty() && nd.translation.size() != 3) ctx.fail(who + ": bad translation");
+    if (!nd.rotation.empty() && nd.rotation.size() != 4) ctx.fail(who + ": bad rotation");
+    if (!nd.scale.empty() && nd.scale.size() != 3) ctx.fail(who + ": bad scale");
+    std::copy(nd.translation.begin(), nd.translation.end(), rest[n].t);
+    std::copy(nd.rotation.begin(), nd.rotation.end(), rest[n].r);
+    std::copy(nd.scale.begin(), nd.scale.end(), rest[n].s);
+    if (nd.mesh >= int(model.meshes.size())) ctx.fail(who + ": mesh " + std::to_string(nd.mesh) + " does not exist");
+    if (nd.skin >= int(model.skins.size())) ctx.fail(who + ": skin " + std::to_string(nd.skin) + " does not exist");
+    for (int c : nd.children) {
+      if (c < 0 || size_t(c) >= N) ctx.fail(who + ": child " + std::to_string(c) + " does not exist");
+      if (parent[c] != -1 || size_t(c) == n)
+        ctx.fail("node " + std::to_string(c) + " has more than one parent (or is its own child)");
+      parent[c] = int(n);
+    }
+  }
+  // Morph target count of each mesh (every primitive must have the same, glTF 2.0 §3.7.2.2) and
+  // the default weights of each node: node `weights`, else mesh `weights`, else zeros.
+  std::vector<size_t> mesh_targets(model.meshes.size(), 0);
+  for (size_t m = 0; m < model.meshes.size(); ++m) {
+    const auto& mesh = model.meshes[m];
+    if (!mesh.primitives.empty()) mesh_targets[m] = mesh.primitives[0].targets.size();
+    for (size_t pi = 1; pi < mesh.primitives.size(); ++pi)
+      if (mesh.primitives[pi].targets.size() != mesh_targets[m])
+        ctx.fail("mesh " + std::to_string(m) + ": primitive " + std::to_string(pi) + " has " +
+                 std::to_string(mesh.primitives[pi].targets.size()) + " morph targets, primitive 0 has " +
+                 std::to_string(mesh_targets[m]));
+    if (!mesh.weights.empty() && mesh.weights.size() != mesh_targets[m])
+      ctx.fail("mesh " + std::to_string(m) + ": weights has " + std::to_string(mesh.weights.size()) +
+               " numbers, but the mesh has " + std::to_string(mesh_targets[m]) + " morph targets");
+  }
+  std::vector<size_t> node_targets(N, 0);
+  std::vector<std::vector<double>> rest_weights(N);
+  for (size_t n = 0; n < N; ++n) {
+    const auto& nd = model.nodes[n];
+    if (nd.mesh >= 0) node_targets[n] = mesh_targets[size_t(nd.mesh)];
+    if (!nd.weights.empty() && nd.weights.size() != node_targets[n])
+      ctx.fail("node " + std::to_string(n) + ": weights has " + std::to_string(nd.weights.size()) +
+               " numbers, but its mesh has " + std::to_string(node_targets[n]) + " morph targets");
+    if (!nd.weights.empty())
+      rest_weights[n] = nd.weights;
+    else if (nd.mesh >= 0 && !model.meshes[size_t(nd.mesh)].weights.empty())
+      rest_weights[n] = model.meshes[size_t(nd.mesh)].weights;
+    else
+      rest_weights[n].assign(node_targets[n], 0.0);
+    for (double w : rest_weights[n])
+      if (!std::isfinite(w)) ctx.fail("node " + std::to_string(n) + ": non-finite morph weight");
+  }
+  for (size_t n = 0; n < N; ++n) {  // cycle check: walking up must end within N steps
+    size_t steps = 0;
+    for (int p = parent[n]; p != -1; p = parent[p])
+      if (++steps > N) ctx.fail("node hierarchy has a cycle through node " + std::to_string(n));
+  }
+  std::vector<int> roots;
+  if (!model.scenes.empty()) {
+    int si = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (size_t(si) >= model.scenes.size()) ctx.fail("default scene " + std::to_string(si) + " does not exist");
+    for (int r : model.scenes[si].nodes) {
+      if (r < 0 || size_t(r) >= N) ctx.fail("scene " + std::to_string(si) + ": node " + std::to_string(r) + " does not exist");
+      roots.push_back(r);
+    }
+  } else {
+    for (size_t n = 0; n < N; ++n)
+      if (parent[n] == -1) roots.push_back(int(n));
+  }
+  // Mesh instances in depth-first order.
+  std::vector<int> instances;
+  {
+    std::vector<int> stack(roots.rbegin(), roots.rend());
+    while (!stack.empty()) {
+      int n = stack.back();
+      stack.pop_back();
+      if (model.nodes[n].mesh >= 0) instances.push_back(n);
+      const auto& ch = model.nodes[n].children;
+      for (auto it = ch.rbegin(); it != ch.rend(); ++it) stack.push_back(*it);
+    }
+  }
+
+  // Animation channels and sample times.
+  std::vector<Channel> channels;
+  if (options.states > 1 || options.animation >= 0) channels = read_channels(ctx, options.animation, node_targets);
+  double t_end = 0;
+  for (const auto& c : channels) t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
+  size_t K = options.states > 1 && !channels.empty() ? size_t(options.states) : 1;
+
+  // World matrices and morph weights of all nodes in each state.
+  std::vector<std::vector<Mat4>> world(K, std::vector<Mat4>(N));
+  std::vector<std::vector<std::vector<double>>> morph_weights(K, rest_weights);
+  for (size_t k = 0; k < K; ++k) {
+    std::vector<Trs> local = rest;
+    if (K > 1) {
+      double t = t_end * double(k) / double(K - 1);
+      for (const auto& c : channels) {
+        if (c.path == 3) {
+          sample(c, t, morph_weights[k][size_t(c.node)].data());
+          continue;
+        }
+        if (local[c.node].has_matrix) continue;  // animated nodes must use TRS (glTF 2.0 §5.25)
+        sample(c, t, c.path == 0 ? local[c.node].t : c.path == 1 ? local[c.node].r : local[c.node].s);
+      }
+    }
+    std::vector<char> done(N, 0);
+    for (size_t n = 0; n < N; ++n) {
+      std::vector<int> chain;
+      for (int p = int(n); p != -1 && !done[p]; p = parent[p]) chain.push_back(p);
+      for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+        int p = parent[*it];
+        world[k][*it] = p == -1 ? to_matrix(local[*it]) : world[k][p] * to_matrix(local[*it]);
+        done[*it] = 1;
+      }
+    }
+  }
+
+  Scene scene;
+  scene.positions.resize(K);
+  std::vector<std::vector<Prim>> mesh_cache(model.meshes.size());
+  std::vector<char> mesh_cached(model.meshes.size(), 0);
+  for (int n : instances) {
+    const auto& nd = model.nodes[n];
+    bool skinned = nd.skin >= 0;
+    if (!mesh_cached[nd.mesh]) {
+      mesh_cache[nd.mesh] = decode_mesh(ctx, nd.mesh, skinned);
+      mesh_cached[nd.mesh] = 1;
+    }
+    std::string name = !nd.name.empty() ? nd.name
+                       : !model.meshes[nd.mesh].name.empty() ? model.meshes[nd.mesh].name
+                                                             : "node" + std::to_string(n);
+    uint32_t obj = uint32_t(scene.objects.size());
+    scene.objects.push_back({name});
+    // Joint matrices per state (skinned nodes): world(joint) * inverseBind.
+    std::vector<std::vector<Mat4>> joint_m;
+    if (skinned) {
+      const auto& skin = model.skins[nd.skin];
+      std::vector<double> ibm;
+      int nc;
+      if (skin.inverseBindMatrices >= 0)
+        ibm = read_accessor(ctx, skin.inverseBindMatrices, "inverseBindMatrices of skin " +
+                            std::to_string(nd.skin), nc, {16});
+      if (!ibm.empty() && ibm.size() < 16 * skin.joints.size())
+        ctx.fail("skin " + std::to_string(nd.skin) + ": fewer inverse bind matrices than joints");
+      joint_m.assign(K, std::vector<Mat4>(skin.joints.size()));
+      for (size_t j = 0; j < skin.joints.size(); ++j) {
+        int jn = skin.joints[j];
+        if (jn < 0 || size_t(jn) >= N) ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) + " does not exist");
+        Mat4 inv;
+        if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inv.m);
+        for (size_t k = 0; k < K; ++k) joint_m[k][j] = world[k][jn] * inv;
+      }
+    }
+    std::vector<Vec3> morphed;
+    for (const Prim& p : mesh_cache[nd.mesh]) {
+      size_t base = scene.positions[0].size();
+      if (base + p.local.size() >= UINT32_MAX) ctx.fail("too many vertices for 32-bit indices");
+      for (size_t k = 0; k < K; ++k) {
+        auto& out = scene.positions[k];
+        // Morph first (base + sum_i w_i * target_i), then skin, then the node transform.
+        const std::vector<Vec3>* local = &p.local;
+        if (!p.targets.empty()) {
+          const auto& w = morph_weights[k][size_t(n)];
+          morphed = p.local;
+          for (size_t ti = 0; ti < p.targets.size(); ++ti) {
+            if (w[ti] == 0 || p.targets[ti].empty()) continue;
+            for (size_t v = 0; v < morphed.size(); ++v) morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
+          }
+          local = &morphed;
+        }
+        for (size_t v = 0; v < p.local.size(); ++v) {
+          const Vec3 lv = (*local)[v];
+          if (!skinned || p.joints.empty()) {
+            out.push_back(transform(world[k][n], lv));
+            continue;
+          }
+          Vec3 acc{0, 0, 0};
+          double wsum = 0;
+          for (int c = 0; c < 4; ++c) {
+            double w = p.weights[v][c];
+            if (w == 0) continue;
+            uint32_t j = p.joints[v][c];
+            if (j >= joint_m[k].size())
+              ctx.fail("mesh " + std::to_string(nd.mesh) + ": joint index " + std::to_string(j) +
+                       " out of range of skin " + std::to_string(nd.skin));
+            acc = acc + transform(joint_m[k][j], lv) * w;
+            wsum += w;
+          }
+          out.push_back(wsum > 0 ? acc * (1.0 / wsum) : transform(world[k][n], lv));
+        }
+      }
+      for (auto t : p.tris) {
+        scene.triangles.push_back({uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
+        scene.triangle_object.push_back(obj);
+      }
+    }
+  }
+  return scene;
+}
+
+}  // namespace vislib

@@ -1,0 +1,97 @@
+#include "vislib/scene/scene_info.h"
+
+#include <array>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <unordered_set>
+
+namespace vislib {
+
+namespace {
+
+struct BitsHash {
+  size_t operator()(const std::array<uint64_t, 3>& k) const {
+    uint64_t h = 1469598103934665603ull;
+    for (uint64_t x : k) h = (h ^ x) * 1099511628211ull + (h >> 29);
+    return size_t(h);
+  }
+};
+
+std::array<uint64_t, 3> bits_of(Vec3 p) {
+  std::array<uint64_t, 3> k;
+  for (int i = 0; i < 3; ++i) {
+    double d = p[i];
+    std::memcpy(&k[i], &d, 8);
+  }
+  return k;
+}
+
+}  // namespace
+
+SceneInfo scene_info(const Scene& s) {
+  SceneInfo info;
+  info.triangles = s.triangle_count();
+  info.vertices = s.vertex_count();
+  info.objects = s.objects.size();
+  info.states = s.state_count();
+  info.spheres = s.sphere_count();
+  info.dynamic = s.is_dynamic();
+  info.bbox = s.bounds();
+  if (!info.bbox.empty()) info.diagonal = length(info.bbox.max - info.bbox.min);
+  double d = info.diagonal;
+  info.units_guess = (d >= 0.1 && d <= 3000)     ? "meters (likely)"
+                     : (d > 3000 && d <= 300000) ? "centimeters (likely)"
+                                                 : "unknown";
+  size_t n = s.vertex_count();
+  for (size_t v = 0; v < n; ++v)
+    for (const auto& state : s.positions)
+      if (v < state.size() && !is_finite(state[v])) {
+        ++info.nonfinite_vertices;
+        break;
+      }
+  if (n) {
+    std::unordered_set<std::array<uint64_t, 3>, BitsHash> seen;
+    seen.reserve(n);
+    for (const Vec3& p : s.positions[0])
+      if (!seen.insert(bits_of(p)).second) ++info.duplicate_vertices;
+  }
+  for (const auto& t : s.triangles) {
+    bool bad = false;
+    for (uint32_t i : t)
+      if (i >= n) ++info.out_of_range_indices, bad = true;
+    if (bad) continue;
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
+      ++info.degenerate_triangles;
+      continue;
+    }
+    const auto& p = s.positions[0];
+    Vec3 c = cross(p[t[1]] - p[t[0]], p[t[2]] - p[t[0]]);
+    if (c.x == 0 && c.y == 0 && c.z == 0) ++info.degenerate_triangles;
+  }
+  return info;
+}
+
+std::string to_json(const SceneInfo& info, int indent) {
+  nlohmann::json j;
+  j["triangles"] = info.triangles;
+  j["vertices"] = info.vertices;
+  j["objects"] = info.objects;
+  j["states"] = info.states;
+  j["spheres"] = info.spheres;
+  j["dynamic"] = info.dynamic;
+  if (info.bbox.empty()) {
+    j["bbox"] = nullptr;
+  } else {
+    j["bbox"] = {{"min", {info.bbox.min.x, info.bbox.min.y, info.bbox.min.z}},
+                 {"max", {info.bbox.max.x, info.bbox.max.y, info.bbox.max.z}}};
+  }
+  j["diagonal"] = info.diagonal;
+  j["units_guess"] = info.units_guess;
+  j["degenerate_triangles"] = info.degenerate_triangles;
+  j["nonfinite_vertices"] = info.nonfinite_vertices;
+  j["duplicate_vertices"] = info.duplicate_vertices;
+  j["out_of_range_indices"] = info.out_of_range_indices;
+  return j.dump(indent);
+}
+
+}  // namespace vislib
