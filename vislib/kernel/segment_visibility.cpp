@@ -97,7 +97,7 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
 namespace {
 
 // Per-pixel depth envelope over kEnvBins equal t-bins (issue 13, item 4): env[b] is an upper
-// bound (float, rounded up) of the list's depth over bin b = [b/kEnvBins, (b+1)/kEnvBins] when the
+// bound (double) of the list's depth over bin b = [b/kEnvBins, (b+1)/kEnvBins] when the
 // list covers the bin without gap, else +inf. LinearDepth::at is monotone in t in floating point
 // (each rounded operation is monotone), so the list's largest evaluated depth on a piece clipped to
 // a bin is at a clipped end, and a new piece's smallest is at one of its ends. An interval whose
@@ -105,12 +105,6 @@ namespace {
 // insert_piece makes (front() at any midpoint inside it), so inserting it would leave the list as
 // it is: skipping it is exact.
 constexpr int kEnvBins = 16;
-
-inline float round_up(double x) {
-  float f = float(x);
-  if (double(f) < x) f = std::nextafter(f, INFINITY);
-  return f;
-}
 
 // Bins overlapped by [lo, hi), 0 <= lo < hi <= 1 (scaling by a power of two is exact).
 inline void bins_of(double lo, double hi, int& b0, int& b1) {
@@ -133,11 +127,11 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
   return v > 0 ? v * (1 - 0x1p-50) : v * (1 + 0x1p-50);
 }
 
-inline bool envelope_hides(const float* env, double lo, double hi, const LinearDepth& depth,
+inline bool envelope_hides(const double* env, double lo, double hi, const LinearDepth& depth,
                            double inv) {
   int b0, b1;
   bins_of(lo, hi, b0, b1);
-  float m = env[b0];
+  double m = env[b0];
   for (int b = b0 + 1; b <= b1; ++b) m = std::max(m, env[b]);
   if (!(m < INFINITY)) return false;
   return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > double(m);
@@ -146,7 +140,7 @@ inline bool envelope_hides(const float* env, double lo, double hi, const LinearD
 // Recomputes the bins of `env` that [lo, hi) overlaps after an insertion there (the rest of the
 // list is unchanged, merged pieces keep their depth functions); returns the largest bin (inf when
 // some bin is not covered), the pixel's bound for culling whole triangles.
-inline double update_envelope(const PieceList& l, float* env, double lo, double hi) {
+inline double update_envelope(const PieceList& l, double* env, double lo, double hi) {
   int b0, b1;
   bins_of(lo, hi, b0, b1);
   for (int b = b0; b <= b1; ++b) env[b] = -INFINITY;
@@ -172,14 +166,14 @@ inline double update_envelope(const PieceList& l, float* env, double lo, double 
     for (int b = q0; b <= q1; ++b) {
       const double be = std::min(e, double(b + 1) / kEnvBins);
       const double right = depth_upper(p.depth, inv, be);
-      const float m = round_up(std::max(left, right));
+      const double m = std::max(left, right);
       if (env[b] < m) env[b] = m;
       left = right;
     }
     cur = p.t1;
   }
   if (cur < bhi1) gap(cur, bhi1);
-  float far = env[0];
+  double far = env[0];
   for (int b = 1; b < kEnvBins; ++b) far = std::max(far, env[b]);
   return double(far);
 }
@@ -317,12 +311,12 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   // pixel whether its list covers [0,1] and its farthest depth (for depth culling).
   struct TileScratch {
     std::vector<PieceList> lists;
-    std::vector<float> env;   // kEnvBins per pixel: DepthEnvelope
+    std::vector<double> env;  // kEnvBins per pixel: the depth envelope
     std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
   };
   tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
     return TileScratch{std::vector<PieceList>(size_t(TS) * TS),
-                       std::vector<float>(size_t(TS) * TS * kEnvBins),
+                       std::vector<double>(size_t(TS) * TS * kEnvBins),
                        std::vector<double>(size_t(TS) * TS)};
   });
   tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
@@ -449,14 +443,21 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                     ++stats.covered_pairs;
                     const double lo = cov.lo[i], hi = cov.hi[i];
                     const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
-                    float* env = &sc.env[k * kEnvBins];
+                    double* env = &sc.env[k * kEnvBins];
                     if (opt.depth_culling && envelope_hides(env, lo, hi, depth, cov.inv[i])) {
                       ++stats.hidden_pairs;
                       continue;
                     }
                     PieceList& l = lists[k];
-                    if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling)
-                      sc.far[k] = update_envelope(l, env, lo, hi);
+                    // The envelope is kept only once the list covers [0, 1] (a covered list
+                    // stays covered; until then every bin stays infinite): recomputed whole when
+                    // the list first covers, then over the bins each insertion touches.
+                    if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling) {
+                      if (sc.far[k] < INFINITY)
+                        sc.far[k] = update_envelope(l, env, lo, hi);
+                      else if (covers_segment(l))
+                        sc.far[k] = update_envelope(l, env, 0.0, 1.0);
+                    }
                   }
                 }
               }
