@@ -374,7 +374,8 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
             const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
             const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
             for (auto& l : lists) l.clear();
-            std::fill(sc.env.begin(), sc.env.end(), INFINITY);
+            // sc.env is not reset: a pixel's bins are read only while far < inf, and are all
+            // written when its list first covers [0, 1].
             std::fill(sc.far.begin(), sc.far.end(), INFINITY);
             FaceTriangle* tb = bins.data() + bin_start[tile];
             FaceTriangle* te = bins.data() + bin_start[tile + 1];
@@ -444,7 +445,8 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                     const double lo = cov.lo[i], hi = cov.hi[i];
                     const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
                     double* env = &sc.env[k * kEnvBins];
-                    if (opt.depth_culling && envelope_hides(env, lo, hi, depth, cov.inv[i])) {
+                    if (opt.depth_culling && sc.far[k] < INFINITY &&
+                        envelope_hides(env, lo, hi, depth, cov.inv[i])) {
                       ++stats.hidden_pairs;
                       continue;
                     }
