@@ -1,6 +1,9 @@
 #include "cli/load_scene.h"
 
+#include <cstdio>
+
 #include "cli/commands.h"
+#include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
 
@@ -12,6 +15,19 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states) {
   std::vector<std::string> warnings;
   vislib::Scene scene = vislib::load_scene(path, options, &warnings);
   for (const auto& w : warnings) warn(w);
+  vislib::Box3 b = scene.bounds();
+  if (vislib::far_from_origin(b)) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "%s: the scene lies far from the origin (centre %g away, %g times its size): "
+                  "vislib works in "
+                  "double and is not affected, but float32 consumers (the Embree baseline, "
+                  "renderers, engines) "
+                  "lose precision there; consider re-centring it",
+                  path.c_str(), length((b.min + b.max) * 0.5),
+                  length((b.min + b.max) * 0.5) / length(b.max - b.min));
+    warn(buf);
+  }
   return scene;
 }
 

@@ -127,14 +127,16 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
   return v > 0 ? v * (1 - 0x1p-50) : v * (1 + 0x1p-50);
 }
 
+// `scale` (>= 1) widens the envelope so that an interval within the tie tolerance of the list
+// (CoplanarRule::Both records such ties) is never skipped.
 inline bool envelope_hides(const double* env, double lo, double hi, const LinearDepth& depth,
-                           double inv) {
+                           double inv, double scale) {
   int b0, b1;
   bins_of(lo, hi, b0, b1);
   double m = env[b0];
   for (int b = b0 + 1; b <= b1; ++b) m = std::max(m, env[b]);
   if (!(m < INFINITY)) return false;
-  return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > double(m);
+  return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
 }
 
 // Recomputes the bins of `env` that [lo, hi) overlaps after an insertion there (the rest of the
@@ -313,12 +315,17 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     std::vector<PieceList> lists;
     std::vector<double> env;  // kEnvBins per pixel: the depth envelope
     std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
+    std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
   tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
-    return TileScratch{std::vector<PieceList>(size_t(TS) * TS),
-                       std::vector<double>(size_t(TS) * TS * kEnvBins),
-                       std::vector<double>(size_t(TS) * TS)};
+    return TileScratch{
+        std::vector<PieceList>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS * kEnvBins),
+        std::vector<double>(size_t(TS) * TS), std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
   });
+  const bool keep_ties = opt.coplanar == CoplanarRule::Both;
+  // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of it,
+  // so only triangles beyond far * (1 + eps_z) are skipped (2 eps_z covers the rounding).
+  const double far_scale = keep_ties ? 1 + 2 * opt.eps_z : 1.0;
   tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
       [&] { return FoundMarks(ntri, opt.want_witnesses); });
 
@@ -374,6 +381,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
             const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
             const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
             for (auto& l : lists) l.clear();
+            for (auto& l : sc.ties) l.clear();
             // sc.env is not reset: a pixel's bins are read only while far < inf, and are all
             // written when its list first covers [0, 1].
             std::fill(sc.far.begin(), sc.far.end(), INFINITY);
@@ -446,7 +454,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                     const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
                     double* env = &sc.env[k * kEnvBins];
                     if (opt.depth_culling && sc.far[k] < INFINITY &&
-                        envelope_hides(env, lo, hi, depth, cov.inv[i])) {
+                        envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale)) {
                       ++stats.hidden_pairs;
                       continue;
                     }
@@ -454,11 +462,12 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                     // The envelope is kept only once the list covers [0, 1] (a covered list
                     // stays covered; until then every bin stays infinite): recomputed whole when
                     // the list first covers, then over the bins each insertion touches.
-                    if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling) {
+                    TieRule rule{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
+                    if (insert_piece(l, Piece{lo, hi, ft->id, depth}, rule) && opt.depth_culling) {
                       if (sc.far[k] < INFINITY)
-                        sc.far[k] = update_envelope(l, env, lo, hi);
+                        sc.far[k] = update_envelope(l, env, lo, hi) * far_scale;
                       else if (covers_segment(l))
-                        sc.far[k] = update_envelope(l, env, 0.0, 1.0);
+                        sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale;
                     }
                   }
                 }
@@ -475,17 +484,18 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                 stats.final_pieces += l.size();
                 stats.max_pieces_per_pixel =
                     std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-                for (const Piece& p : l) {
-                  double len = p.t1 - p.t0;
-                  if (!(len > opt.eps_len)) continue;
+                const auto& ties = sc.ties[size_t(y - ty0) * TS + (x - tx0)];
+                for_each_visible(l, ties, [&](uint32_t id, double t0, double t1) {
+                  double len = t1 - t0;
+                  if (!(len > opt.eps_len)) return;
                   Witness w;
-                  w.tri = p.id;
+                  w.tri = id;
                   w.face = face;
                   w.x = x;
                   w.y = y;
-                  w.t = 0.5 * (p.t0 + p.t1);
-                  found.mark(p.id, len, w);
-                }
+                  w.t = 0.5 * (t0 + t1);
+                  found.mark(id, len, w);
+                });
                 if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
               }
             stats.peak_tile_bytes = double(bytes);
