@@ -97,6 +97,7 @@ json counts_json(const vislib::SegmentStats& s) {
   return {{"triangle_pixel_pairs", s.pair_tests},
           {"culled_pixel_pairs", s.culled_pairs},
           {"covered_pairs", s.covered_pairs},
+          {"hidden_pairs", s.hidden_pairs},
           {"final_pieces", s.final_pieces},
           {"pixels_with_pieces", s.pixels_with_pieces},
           {"pieces_per_pixel", s.pieces_per_pixel()},

@@ -47,11 +47,22 @@ double margin_of(const Footprint& fp) {
 
 }  // namespace
 
-Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near) {
+namespace {
+
+// The projected, clipped points of §5.1 (before the hull): at most kMaxFootprintPoints. Returns
+// -1 when the quick frustum reject applies (the footprint is empty), else the point count; zmin
+// (if given) gets the smallest view depth F.rel[i].
+int projected_points(const Vec3* rel, int count, const FaceAxes& axes, double near, Vec2* pts,
+                     double* zmin) {
   Vec3 q[12];
   count = std::min(count, 12);
   for (int i = 0; i < count; ++i)
     q[i] = {dot(axes.S, rel[i]), dot(axes.T, rel[i]), dot(axes.F, rel[i])};
+  if (zmin) {
+    double z = INFINITY;
+    for (int i = 0; i < count; ++i) z = std::min(z, q[i].z);
+    *zmin = z;
+  }
   // Quick reject: all points on the outer side of one plane of the face's frustum (near plane, or
   // one of |u| <= 1, |w| <= 1 widened by kFrustumRejectWidening), so the clipped hull misses the
   // face.
@@ -66,9 +77,8 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
       up = up && q[i].y > z;
       down = down && q[i].y < -z;
     }
-    if (behind || right || left || up || down) return Footprint{};
+    if (behind || right || left || up || down) return -1;
   }
-  Vec2 pts[kMaxFootprintPoints];
   int n = 0;
   for (int i = 0; i < count; ++i)
     if (q[i].z >= near) pts[n++] = {q[i].x / q[i].z, q[i].y / q[i].z};
@@ -82,17 +92,14 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
         pts[n++] = {x / near, y / near};
       }
     }
-  Footprint fp;
-  if (n > 0) fp.size = convex_hull(pts, n, fp.hull.data());
-  return fp;
+  return n;
 }
 
-bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y0, int& y1) {
-  if (fp.empty()) return false;
-  double m = margin_of(fp);
+// Pixel rectangle of the points pts[0, count) (non-empty) with margin m.
+bool bounds_of(const Vec2* pts, int count, double m, int n, int& x0, int& x1, int& y0, int& y1) {
   double umin = INFINITY, umax = -INFINITY, wmin = INFINITY, wmax = -INFINITY;
-  for (int i = 0; i < fp.size; ++i) {
-    Vec2 p = fp.hull[i];
+  for (int i = 0; i < count; ++i) {
+    Vec2 p = pts[i];
     umin = std::min(umin, p.u);
     umax = std::max(umax, p.u);
     wmin = std::min(wmin, p.w);
@@ -110,6 +117,33 @@ bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y
   y0 = lo(wmin - m);
   y1 = hi(wmax + m);
   return x0 <= x1 && y0 <= y1;
+}
+
+}  // namespace
+
+Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near) {
+  Vec2 pts[kMaxFootprintPoints];
+  int n = projected_points(rel, count, axes, near, pts, nullptr);
+  Footprint fp;
+  if (n > 0) fp.size = convex_hull(pts, n, fp.hull.data());
+  return fp;
+}
+
+bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double near, int n, int& x0,
+                      int& x1, int& y0, int& y1, double& zmin) {
+  Vec2 pts[kMaxFootprintPoints];
+  int k = projected_points(rel, count, axes, near, pts, &zmin);
+  if (k <= 0) return false;
+  // The hull keeps every extreme point (its vertices are a subset of the points that includes
+  // the extremes in u and w), so the margin and the bounds equal those of the hull exactly.
+  double m = 0;
+  for (int i = 0; i < k; ++i) m = std::max({m, std::fabs(pts[i].u), std::fabs(pts[i].w)});
+  return bounds_of(pts, k, kFootprintMargin + kFootprintRelativeMargin * m, n, x0, x1, y0, y1);
+}
+
+bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y0, int& y1) {
+  if (fp.empty()) return false;
+  return bounds_of(fp.hull.data(), fp.size, margin_of(fp), n, x0, x1, y0, y1);
 }
 
 bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1) {

@@ -39,6 +39,12 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
 // of the footprint (with kFootprintMargin); false when none.
 bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y0, int& y1);
 
+// The pixel rectangle of footprint_pixel_bounds(compute_footprint(rel, count, axes, near), ...)
+// without building the hull: the hull's extreme coordinates are those of its input points, so the
+// result is bit-identical at a fraction of the cost. `zmin` gets min F.rel[i] over the points.
+bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double near, int n, int& x0,
+                      int& x1, int& y0, int& y1, double& zmin);
+
 // Columns [x0, x1] of row `y` whose centres may lie in the footprint; false when none.
 bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1);
 

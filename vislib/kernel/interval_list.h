@@ -131,10 +131,17 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
                   const TieRule& ties = TieRule{}) {
   assert(p.t0 < p.t1);
   const double s = p.t0, f = p.t1;
-  // First piece ending after s (t1 increases along the list).
-  size_t first = size_t(std::upper_bound(list.begin(), list.end(), s,
-                                         [](double v, const PieceT<D>& q) { return v < q.t1; }) -
-                        list.begin());
+  // First piece ending after s (t1 increases along the list): a linear scan on short lists (the
+  // common case, a few cache lines), a binary search on long ones; the same index either way.
+  size_t first;
+  if (list.size() <= 16) {
+    first = 0;
+    while (first < list.size() && !(s < list[first].t1)) ++first;
+  } else {
+    first = size_t(std::upper_bound(list.begin(), list.end(), s,
+                                    [](double v, const PieceT<D>& q) { return v < q.t1; }) -
+                   list.begin());
+  }
   double cuts[kMaxCrossings + 2];
   // Read-only pass first: most insertions (front-to-back order) are hidden everywhere and must
   // leave the list untouched; find that out without rebuilding anything.

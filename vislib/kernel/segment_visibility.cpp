@@ -19,6 +19,11 @@
 #include <chrono>
 #include <cmath>
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#define VISLIB_HAVE_AVX2_PATH 1
+#endif
+
 #include "vislib/kernel/dynamic_visibility.h"
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
@@ -91,6 +96,197 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
 
 namespace {
 
+// Per-pixel depth envelope over kEnvBins equal t-bins (issue 13, item 4): env[b] is an upper
+// bound (double) of the list's depth over bin b = [b/kEnvBins, (b+1)/kEnvBins] when the
+// list covers the bin without gap, else +inf. LinearDepth::at is monotone in t in floating point
+// (each rounded operation is monotone), so the list's largest evaluated depth on a piece clipped to
+// a bin is at a clipped end, and a new piece's smallest is at one of its ends. An interval whose
+// smallest depth exceeds the envelope over every bin it overlaps loses every comparison that
+// insert_piece makes (front() at any midpoint inside it), so inserting it would leave the list as
+// it is: skipping it is exact.
+constexpr int kEnvBins = 16;
+
+// Bins overlapped by [lo, hi), 0 <= lo < hi <= 1 (scaling by a power of two is exact).
+inline void bins_of(double lo, double hi, int& b0, int& b1) {
+  b0 = std::min(kEnvBins - 1, int(lo * kEnvBins));
+  b1 = std::max(b0, std::min(kEnvBins - 1, int(std::ceil(hi * kEnvBins)) - 1));
+}
+
+// Bounds of LinearDepth::at(t) = (n0 - n1 t) / dn without its division: the same numerator times
+// inv = 1/dn is within 3 units in the last place of the quotient (one rounding for inv, one for the
+// product, one of the quotient), so widening it by 2^-50 relative (8 units) bounds at(t) from
+// above or below. Non-finite products (dn near 0) fall back to the division.
+inline double depth_upper(const LinearDepth& z, double inv, double t) {
+  const double num = z.n0 - z.n1 * t, v = num * inv;
+  if (!std::isfinite(v)) return z.at(t);
+  return v > 0 ? v * (1 + 0x1p-50) : v * (1 - 0x1p-50);
+}
+inline double depth_lower(const LinearDepth& z, double inv, double t) {
+  const double num = z.n0 - z.n1 * t, v = num * inv;
+  if (!std::isfinite(v)) return z.at(t);
+  return v > 0 ? v * (1 - 0x1p-50) : v * (1 + 0x1p-50);
+}
+
+// `scale` (>= 1) widens the envelope so that an interval within the tie tolerance of the list
+// (CoplanarRule::Both records such ties) is never skipped.
+inline bool envelope_hides(const double* env, double lo, double hi, const LinearDepth& depth,
+                           double inv, double scale) {
+  int b0, b1;
+  bins_of(lo, hi, b0, b1);
+  double m = env[b0];
+  for (int b = b0 + 1; b <= b1; ++b) m = std::max(m, env[b]);
+  if (!(m < INFINITY)) return false;
+  return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
+}
+
+// Recomputes the bins of `env` that [lo, hi) overlaps after an insertion there (the rest of the
+// list is unchanged, merged pieces keep their depth functions); returns the largest bin (inf when
+// some bin is not covered), the pixel's bound for culling whole triangles.
+inline double update_envelope(const PieceList& l, double* env, double lo, double hi) {
+  int b0, b1;
+  bins_of(lo, hi, b0, b1);
+  for (int b = b0; b <= b1; ++b) env[b] = -INFINITY;
+  const double blo0 = double(b0) / kEnvBins, bhi1 = double(b1 + 1) / kEnvBins;
+  size_t i = 0;
+  while (i < l.size() && l[i].t1 <= blo0) ++i;
+  // Walk the pieces over [blo0, bhi1]: each adds its depth at its ends clipped to every bin it
+  // overlaps; a gap (or an uncovered end) makes the bins it touches infinite.
+  double cur = blo0;
+  auto gap = [&](double a, double b) {  // [a, b) uncovered
+    int g0, g1;
+    bins_of(std::max(a, blo0), std::min(b, bhi1), g0, g1);
+    for (int g = std::max(g0, b0); g <= std::min(g1, b1); ++g) env[g] = INFINITY;
+  };
+  for (; i < l.size() && l[i].t0 < bhi1; ++i) {
+    const Piece& p = l[i];
+    if (p.t0 > cur) gap(cur, p.t0);
+    const double inv = 1.0 / p.depth.dn;
+    const double a = std::max(p.t0, blo0), e = std::min(p.t1, bhi1);
+    int q0, q1;
+    bins_of(a, e, q0, q1);
+    double left = depth_upper(p.depth, inv, a);
+    for (int b = q0; b <= q1; ++b) {
+      const double be = std::min(e, double(b + 1) / kEnvBins);
+      const double right = depth_upper(p.depth, inv, be);
+      const double m = std::max(left, right);
+      if (env[b] < m) env[b] = m;
+      left = right;
+    }
+    cur = p.t1;
+  }
+  if (cur < bhi1) gap(cur, bhi1);
+  double far = env[0];
+  for (int b = 1; b < kEnvBins; ++b) far = std::max(far, env[b]);
+  return double(far);
+}
+
+// True when the triangle's plane lies behind `far` along the pixel ray for every t in [0, 1]: its
+// depth there is at(t) of LinearDepth{N0, N1, Dn} (as static_coverage would give), monotone in t,
+// so at(0) and at(1) bound it. Exact culling of a pair whose pixel list covers [0, 1] below `far`.
+inline bool plane_behind(const StaticTriangle& st, double Dn, double inv, double far) {
+  if (Dn == 0) return true;  // never covers (static_coverage returns false)
+  const LinearDepth z{st.N0, st.N1, Dn};
+  return std::min(depth_lower(z, inv, 0.0), depth_lower(z, inv, 1.0)) > far;
+}
+
+// ---- Coverage of one triangle at 4 consecutive pixels of a row (issue 13, item 3) ----------
+// The same operations as static_coverage, lane by lane and in the same order (no FMA, IEEE
+// division, max/min with the operand order of std::max/std::min), so every lane's interval and
+// depth are bit-identical to the scalar function's; lanes that hit the tie rule of §2.5 (A = B = 0
+// on an edge) are redone by the scalar function. AVX2 is chosen at run time; other CPUs and
+// SegmentOptions::simd = false take the scalar loop.
+struct Coverage4 {
+  double lo[4], hi[4], dn[4], inv[4];  // inv = 1 / dn (bounds only)
+  bool ok[4];
+};
+
+void coverage4_scalar(const StaticTriangle& st, const FaceAxes& ax, const double* sc, double tc,
+                      int lanes, double near, Coverage4& out) {
+  for (int i = 0; i < lanes; ++i) {
+    Vec3 d = ax.F + ax.S * sc[i] + ax.T * tc;
+    LinearDepth z;
+    out.ok[i] = static_coverage(st, d, ax.S, ax.T, near, out.lo[i], out.hi[i], z);
+    out.dn[i] = dot(d, st.n);
+    out.inv[i] = 1.0 / out.dn[i];
+  }
+}
+
+#ifdef VISLIB_HAVE_AVX2_PATH
+#define VISLIB_AVX2 __attribute__((target("avx2")))
+// (F + S sc) + (T tc), one component, as Vec3 arithmetic does it.
+VISLIB_AVX2 inline __m256d dir_comp(double f, double sx, double tx_tc, __m256d s) {
+  return _mm256_add_pd(_mm256_add_pd(_mm256_set1_pd(f), _mm256_mul_pd(_mm256_set1_pd(sx), s)),
+                       _mm256_set1_pd(tx_tc));
+}
+// (d.x v.x + d.y v.y) + d.z v.z, as dot() does it.
+VISLIB_AVX2 inline __m256d dot4(__m256d dx, __m256d dy, __m256d dz, Vec3 v) {
+  return _mm256_add_pd(
+      _mm256_add_pd(_mm256_mul_pd(dx, _mm256_set1_pd(v.x)), _mm256_mul_pd(dy, _mm256_set1_pd(v.y))),
+      _mm256_mul_pd(dz, _mm256_set1_pd(v.z)));
+}
+// halfline() of every lane: keeps t with A t + B > 0 in [lo, hi]; `fail` gets the lanes with A = 0
+// and B <= 0.
+VISLIB_AVX2 inline void halfline4(__m256d A, __m256d B, __m256d& lo, __m256d& hi, __m256d& fail) {
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d pos = _mm256_cmp_pd(A, zero, _CMP_GT_OQ), neg = _mm256_cmp_pd(A, zero, _CMP_LT_OQ);
+  const __m256d q = _mm256_div_pd(_mm256_sub_pd(zero, B), A);  // -B / A (the negation is exact)
+  lo = _mm256_blendv_pd(lo, _mm256_max_pd(q, lo), pos);        // std::max(lo, q): q if q > lo
+  hi = _mm256_blendv_pd(hi, _mm256_min_pd(q, hi), neg);        // std::min(hi, q): q if q < hi
+  const __m256d flat =
+      _mm256_andnot_pd(_mm256_or_pd(pos, neg), _mm256_cmp_pd(B, zero, _CMP_NGT_UQ));
+  fail = _mm256_or_pd(fail, flat);
+}
+
+VISLIB_AVX2 void coverage4_avx2(const StaticTriangle& st, const FaceAxes& ax, const double* sc,
+                                double tc, int lanes, double near, Coverage4& out) {
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), mone = _mm256_set1_pd(-1.0);
+  const __m256d s = _mm256_loadu_pd(sc);
+  const __m256d dx = dir_comp(ax.F.x, ax.S.x, ax.T.x * tc, s),
+                dy = dir_comp(ax.F.y, ax.S.y, ax.T.y * tc, s),
+                dz = dir_comp(ax.F.z, ax.S.z, ax.T.z * tc, s);
+  const __m256d Dn = dot4(dx, dy, dz, st.n);
+  __m256d fail = _mm256_cmp_pd(Dn, zero, _CMP_EQ_OQ);
+  const __m256d sigma = _mm256_blendv_pd(mone, one, _mm256_cmp_pd(Dn, zero, _CMP_GT_OQ));
+  __m256d lo = zero, hi = one, tie = zero;
+  for (int e = 0; e < 3; ++e) {
+    const __m256d A = dot4(dx, dy, dz, st.KA[e]), B = dot4(dx, dy, dz, st.KB[e]);
+    tie = _mm256_or_pd(
+        tie, _mm256_and_pd(_mm256_cmp_pd(A, zero, _CMP_EQ_OQ), _mm256_cmp_pd(B, zero, _CMP_EQ_OQ)));
+    const __m256d f = _mm256_mul_pd(sigma, _mm256_set1_pd(st.rho[e]));
+    halfline4(_mm256_mul_pd(f, A), _mm256_mul_pd(f, B), lo, hi, fail);
+  }
+  const __m256d nsig = _mm256_sub_pd(zero, sigma);
+  halfline4(_mm256_mul_pd(nsig, _mm256_set1_pd(st.N1)),
+            _mm256_mul_pd(sigma, _mm256_sub_pd(_mm256_set1_pd(st.N0),
+                                               _mm256_mul_pd(_mm256_set1_pd(near), Dn))),
+            lo, hi, fail);
+  const __m256d good = _mm256_andnot_pd(fail, _mm256_cmp_pd(lo, hi, _CMP_LT_OQ));
+  _mm256_storeu_pd(out.lo, lo);
+  _mm256_storeu_pd(out.hi, hi);
+  _mm256_storeu_pd(out.dn, Dn);
+  _mm256_storeu_pd(out.inv, _mm256_div_pd(one, Dn));
+  const int gm = _mm256_movemask_pd(good), tm = _mm256_movemask_pd(tie);
+  for (int i = 0; i < lanes; ++i) {
+    if (tm >> i & 1) {  // persistent on-edge tie in this lane: the scalar rule decides
+      Vec3 d = ax.F + ax.S * sc[i] + ax.T * tc;
+      LinearDepth z;
+      out.ok[i] = static_coverage(st, d, ax.S, ax.T, near, out.lo[i], out.hi[i], z);
+    } else {
+      out.ok[i] = gm >> i & 1;
+    }
+  }
+}
+#endif
+
+bool cpu_has_avx2() {
+#ifdef VISLIB_HAVE_AVX2_PATH
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
+#else
+  return false;
+#endif
+}
+
 struct FaceTriangle {
   uint32_t id;
   float zmin;  // nearest possible view depth over the segment (rounded down)
@@ -117,14 +313,14 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   // pixel whether its list covers [0,1] and its farthest depth (for depth culling).
   struct TileScratch {
     std::vector<PieceList> lists;
-    std::vector<uint8_t> full;
-    std::vector<double> far;
+    std::vector<double> env;  // kEnvBins per pixel: the depth envelope
+    std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
   tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
-    return TileScratch{std::vector<PieceList>(size_t(TS) * TS),
-                       std::vector<uint8_t>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS),
-                       std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
+    return TileScratch{
+        std::vector<PieceList>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS * kEnvBins),
+        std::vector<double>(size_t(TS) * TS), std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
   });
   const bool keep_ties = opt.coplanar == CoplanarRule::Both;
   // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of it,
@@ -133,6 +329,15 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
       [&] { return FoundMarks(ntri, opt.want_witnesses); });
 
+  // Pixel-centre coordinates (pixel_center), padded so that 4 lanes can always be loaded.
+  std::vector<double> pixel_centers(size_t(N) + 4, 0.0);
+  for (int i = 0; i < N; ++i) pixel_centers[size_t(i)] = pixel_center(i, N);
+#ifdef VISLIB_HAVE_AVX2_PATH
+  const auto coverage4 = opt.simd && cpu_has_avx2() ? coverage4_avx2 : coverage4_scalar;
+#else
+  const auto coverage4 = coverage4_scalar;
+#endif
+
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
   std::vector<uint32_t> bin_start(tile_count + 1);
@@ -140,21 +345,20 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
 
   for (int face = 0; face < 6; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
-    // (1) footprint bounds and nearest depth of every triangle on this face.
+    // (1) footprint bounds and nearest depth of every triangle on this face (the bounds alone,
+    // without the hull: footprint_bounds gives the rectangle of the hull bit for bit).
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
           for (size_t t = r.begin(); t != r.end(); ++t) {
             auto c = scene.corners(uint32_t(t), opt.state);
             Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
             int* b = &bbox[t * 4];
-            Footprint fp = compute_footprint(rel, 6, axes, opt.near);
-            if (!footprint_pixel_bounds(fp, N, b[0], b[1], b[2], b[3])) {
+            double z;
+            if (!footprint_bounds(rel, 6, axes, opt.near, N, b[0], b[1], b[2], b[3], z)) {
               b[0] = 1;
               b[1] = 0;  // empty
               continue;
             }
-            double z = INFINITY;
-            for (const Vec3& q : rel) z = std::min(z, dot(axes.F, q));
             float zf = float(z);
             if (double(zf) > z) zf = std::nextafter(zf, -INFINITY);
             zmin[t] = zf;
@@ -178,7 +382,8 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
             const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
             for (auto& l : lists) l.clear();
             for (auto& l : sc.ties) l.clear();
-            std::fill(sc.full.begin(), sc.full.end(), 0);
+            // sc.env is not reset: a pixel's bins are read only while far < inf, and are all
+            // written when its list first covers [0, 1].
             std::fill(sc.far.begin(), sc.far.end(), INFINITY);
             FaceTriangle* tb = bins.data() + bin_start[tile];
             FaceTriangle* te = bins.data() + bin_start[tile + 1];
@@ -221,23 +426,50 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                 if (!footprint_row_span(fp, N, y, x0, x1)) continue;
                 x0 = std::max(x0, tx0);
                 x1 = std::min(x1, tx1);
-                for (int x = x0; x <= x1; ++x) {
-                  const size_t k = size_t(y - ty0) * TS + (x - tx0);
-                  if (opt.depth_culling && tz > sc.far[k]) {
-                    ++stats.culled_pairs;
+                const double tc = pixel_centers[size_t(y)];
+                for (int xb = x0; xb <= x1; xb += 4) {
+                  const int lanes = std::min(4, x1 - xb + 1);
+                  const size_t kb = size_t(y - ty0) * TS + (xb - tx0);
+                  bool any = false;
+                  for (int i = 0; i < lanes; ++i)
+                    any |= !(opt.depth_culling && tz > sc.far[kb + i]);
+                  if (!any) {
+                    stats.culled_pairs += uint64_t(lanes);
                     continue;
                   }
-                  ++stats.pair_tests;
-                  Vec3 d = pixel_direction(axes, x, y, N);
-                  double lo, hi;
-                  LinearDepth depth;
-                  if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
-                  ++stats.covered_pairs;
-                  PieceList& l = lists[k];
-                  TieRule rule{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
-                  if (insert_piece(l, Piece{lo, hi, ft->id, depth}, rule) && opt.depth_culling &&
-                      covers_segment(l))
-                    sc.far[k] = farthest_depth(l) * far_scale;
+                  Coverage4 cov;
+                  coverage4(st, axes, &pixel_centers[size_t(xb)], tc, lanes, opt.near, cov);
+                  for (int i = 0; i < lanes; ++i) {
+                    const size_t k = kb + size_t(i);
+                    if (opt.depth_culling &&
+                        (tz > sc.far[k] || (sc.far[k] < INFINITY &&
+                                            plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
+                      ++stats.culled_pairs;
+                      continue;
+                    }
+                    ++stats.pair_tests;
+                    if (!cov.ok[i]) continue;
+                    ++stats.covered_pairs;
+                    const double lo = cov.lo[i], hi = cov.hi[i];
+                    const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
+                    double* env = &sc.env[k * kEnvBins];
+                    if (opt.depth_culling && sc.far[k] < INFINITY &&
+                        envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale)) {
+                      ++stats.hidden_pairs;
+                      continue;
+                    }
+                    PieceList& l = lists[k];
+                    // The envelope is kept only once the list covers [0, 1] (a covered list
+                    // stays covered; until then every bin stays infinite): recomputed whole when
+                    // the list first covers, then over the bins each insertion touches.
+                    TieRule rule{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
+                    if (insert_piece(l, Piece{lo, hi, ft->id, depth}, rule) && opt.depth_culling) {
+                      if (sc.far[k] < INFINITY)
+                        sc.far[k] = update_envelope(l, env, lo, hi) * far_scale;
+                      else if (covers_segment(l))
+                        sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale;
+                    }
+                  }
                 }
               }
             }

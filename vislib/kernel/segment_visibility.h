@@ -42,15 +42,17 @@ enum class DynamicMode { Diagonal, Decoupled };
 enum class CoplanarRule { Both, First };
 
 struct SegmentOptions {
-  int resolution = 512;                      // N: each cube face is N x N pixels; must be >= 1
-  double near = kDefaultNear;                // z_near > 0, view depth in scene units
-  Mat3 orientation;                          // cube orientation R (world = R * local); a rotation
-  double eps_len = kDefaultEpsLen;           // final pieces must be longer (in t) to count
-  bool want_witnesses = false;               // one witness per visible triangle
-  bool want_pieces = false;                  // keep every pixel's final list (memory: 6 N^2 lists)
-  int tile_size = 32;                        // pixels per tile side (memory/parallelism grain)
-  bool depth_culling = true;                 // skip triangles behind a tile's fully covered pixels
-  size_t state = 0;                          // static scenes: which key state to use
+  int resolution = 512;             // N: each cube face is N x N pixels; must be >= 1
+  double near = kDefaultNear;       // z_near > 0, view depth in scene units
+  Mat3 orientation;                 // cube orientation R (world = R * local); a rotation
+  double eps_len = kDefaultEpsLen;  // final pieces must be longer (in t) to count
+  bool want_witnesses = false;      // one witness per visible triangle
+  bool want_pieces = false;         // keep every pixel's final list (memory: 6 N^2 lists)
+  int tile_size = 32;               // pixels per tile side (memory/parallelism grain)
+  bool depth_culling = true;  // skip hidden work (exact): triangles behind a tile's or a pixel's
+                              // covered depth, intervals behind the pixel's depth envelope over t
+  bool simd = true;           // vectorised coverage where the CPU has AVX2 (bit-identical results)
+  size_t state = 0;           // static scenes: which key state to use
   DynamicMode mode = DynamicMode::Diagonal;  // dynamic scenes (moving vertices or spheres)
   CoplanarRule coplanar = CoplanarRule::Both;  // depth ties: both visible, or the first (lower id)
   double eps_z = kDefaultEpsZ;                 // tie tolerance, relative to the front depth; >= 0
@@ -60,6 +62,7 @@ struct SegmentStats {
   uint64_t pair_tests = 0;     // (triangle, pixel) coverage evaluations
   uint64_t culled_pairs = 0;   // (triangle, pixel) pairs skipped by per-pixel depth culling
   uint64_t covered_pairs = 0;  // of which gave a non-empty interval
+  uint64_t hidden_pairs = 0;   // of which lay behind the pixel's depth envelope (not inserted)
   uint64_t final_pieces = 0;   // pieces in all final lists
   uint64_t pixels_with_pieces = 0;
   uint64_t max_pieces_per_pixel = 0;
@@ -72,6 +75,7 @@ struct SegmentStats {
     pair_tests += o.pair_tests;
     culled_pairs += o.culled_pairs;
     covered_pairs += o.covered_pairs;
+    hidden_pairs += o.hidden_pairs;
     final_pieces += o.final_pieces;
     pixels_with_pieces += o.pixels_with_pieces;
     max_pieces_per_pixel = max_pieces_per_pixel > o.max_pieces_per_pixel ? max_pieces_per_pixel

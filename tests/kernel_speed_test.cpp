@@ -1,0 +1,121 @@
+// The speed work of issue 13 must not change any result: footprint bounds without the hull, the
+// per-pixel depth envelope, and the vectorised coverage are checked against the plain paths.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "tests/scene_builders.h"
+#include "vislib/base/random.h"
+#include "vislib/kernel/footprint.h"
+#include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/generate.h"
+
+using namespace vislib;
+using vislib_test::random_soup;
+
+namespace {
+
+// Every byte of every piece (t0, t1, id, depth) equal: bit-identical, -0.0 != +0.0.
+bool identical_lists(const std::vector<PieceList>& a, const std::vector<PieceList>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t k = 0; k < a.size(); ++k) {
+    if (a[k].size() != b[k].size()) return false;
+    for (size_t i = 0; i < a[k].size(); ++i) {
+      const Piece &p = a[k][i], &q = b[k][i];
+      if (std::memcmp(&p.t0, &q.t0, 8) || std::memcmp(&p.t1, &q.t1, 8) || p.id != q.id ||
+          std::memcmp(&p.depth, &q.depth, sizeof(LinearDepth)))
+        return false;
+    }
+  }
+  return true;
+}
+
+bool same_witnesses(const std::vector<Witness>& a, const std::vector<Witness>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].tri != b[i].tri || a[i].face != b[i].face || a[i].x != b[i].x || a[i].y != b[i].y ||
+        a[i].t != b[i].t)
+      return false;
+  return true;
+}
+
+// A small city street (many layers of facades, axis-aligned edges that pixel centres hit
+// exactly, so the tie rule runs) plus a random soup in front of it.
+Scene street_scene() {
+  CityOptions o;
+  o.blocks_x = o.blocks_z = 2;
+  o.panel_size = 4;
+  o.seed = 3;
+  Scene s = generate_city(o);
+  return s;
+}
+
+}  // namespace
+
+TEST(KernelSpeed, FootprintBoundsWithoutTheHullEqualTheHullsBounds) {
+  Rng rng(17);
+  const int n = 64;
+  int nonempty = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    Vec3 rel[6];
+    for (Vec3& q : rel) q = {rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)};
+    if (trial % 3 == 0)  // small, far triangles (the common case)
+      for (int i = 1; i < 6; ++i) rel[i] = rel[0] + (rel[i] - rel[0]) * 0.01;
+    for (int face = 0; face < 6; ++face) {
+      FaceAxes ax = face_axes(face, Mat3{});
+      int a[4] = {1, 0, 1, 0}, b[4] = {1, 0, 1, 0};
+      double z;
+      bool ra =
+          footprint_pixel_bounds(compute_footprint(rel, 6, ax, 0.05), n, a[0], a[1], a[2], a[3]);
+      bool rb = footprint_bounds(rel, 6, ax, 0.05, n, b[0], b[1], b[2], b[3], z);
+      ASSERT_EQ(ra, rb) << trial << " " << face;
+      if (!ra) continue;
+      ++nonempty;
+      for (int k = 0; k < 4; ++k) ASSERT_EQ(a[k], b[k]) << trial << " " << face;
+      double zmin = INFINITY;
+      for (const Vec3& q : rel) zmin = std::min(zmin, dot(ax.F, q));
+      EXPECT_EQ(z, zmin);
+    }
+  }
+  EXPECT_GT(nonempty, 1000);
+}
+
+TEST(KernelSpeed, VectorisedCoverageGivesBitIdenticalPiecesAndWitnesses) {
+  for (int scene_kind = 0; scene_kind < 2; ++scene_kind) {
+    Scene s = scene_kind == 0 ? random_soup(400, 5) : street_scene();
+    for (int orient = 0; orient < 2; ++orient) {
+      SegmentOptions o;
+      o.resolution = 48;
+      o.want_pieces = true;
+      o.want_witnesses = true;
+      if (orient) o.orientation = random_orientation(11);
+      Vec3 v0 = scene_kind == 0 ? Vec3{-2, 0, 0} : Vec3{0, 1.7, -8},
+           v1 = scene_kind == 0 ? Vec3{2, 0.5, 0} : Vec3{0, 1.7, 8};
+      auto vec = segment_visibility(s, v0, v1, o);
+      o.simd = false;
+      auto sca = segment_visibility(s, v0, v1, o);
+      EXPECT_EQ(vec.visible, sca.visible);
+      EXPECT_TRUE(identical_lists(vec.pieces, sca.pieces)) << scene_kind << " " << orient;
+      EXPECT_TRUE(same_witnesses(vec.witnesses, sca.witnesses));
+      EXPECT_EQ(vec.stats.pair_tests, sca.stats.pair_tests);
+      EXPECT_GT(vec.stats.final_pieces, 0u);
+    }
+  }
+}
+
+TEST(KernelSpeed, DepthEnvelopeSkipsHiddenIntervalsAndChangesNoPiece) {
+  Scene s = street_scene();
+  SegmentOptions o;
+  o.resolution = 48;
+  o.want_pieces = true;
+  o.want_witnesses = true;
+  auto with = segment_visibility(s, {0, 1.7, -8}, {0, 1.7, 8}, o);
+  o.depth_culling = false;
+  auto without = segment_visibility(s, {0, 1.7, -8}, {0, 1.7, 8}, o);
+  EXPECT_EQ(with.visible, without.visible);
+  EXPECT_TRUE(identical_lists(with.pieces, without.pieces));
+  EXPECT_TRUE(same_witnesses(with.witnesses, without.witnesses));
+  EXPECT_GT(with.stats.hidden_pairs, 0u);
+  EXPECT_EQ(without.stats.hidden_pairs, 0u);
+  EXPECT_LT(with.stats.pair_tests, without.stats.pair_tests);
+}
