@@ -53,7 +53,7 @@ struct SegmentOptions {
                               // covered depth, intervals behind the pixel's depth envelope over t
   bool simd = true;           // vectorised coverage where the CPU has AVX2 (bit-identical results)
   size_t state = 0;           // static scenes: which key state to use
-  DynamicMode mode = DynamicMode::Diagonal;  // dynamic scenes (moving vertices or spheres)
+  DynamicMode mode = DynamicMode::Diagonal;    // dynamic scenes (moving vertices or spheres)
   CoplanarRule coplanar = CoplanarRule::Both;  // depth ties: both visible, or the first (lower id)
   double eps_z = kDefaultEpsZ;                 // tie tolerance, relative to the front depth; >= 0
 };
