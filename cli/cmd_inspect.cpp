@@ -243,10 +243,12 @@ void add_inspect(CLI::App& app) {
   cmd->add_option("--states", a->states, "With --scene: key states to sample animations into (as for the bake)")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--export-gltf", a->gltf, "With --scene and a cell: write the scene reduced to the cell's set (.glb)");
-  cmd->add_option("--render", a->render_dir,
-                  "With --scene and a cell: render from the --at point (else the centre of the cell's view "
-                  "region), in 4 horizontal directions, the full-scene frame, the PVS frame and the error heat map into this folder, "
-                  "with epsilon/PSNR/SSIM");
+  cmd->add_option(
+      "--render", a->render_dir,
+      "With --scene and a cell: render from the --at point (else the centre of the cell's view "
+      "region, or when that is enclosed by the scene the free sample nearest it), in 4 horizontal "
+      "directions, the full-scene frame, the PVS frame and the error heat map into this folder, "
+      "with epsilon/PSNR/SSIM");
   cmd->add_option("--frame", a->frame, "Frame size WxH for --render")->capture_default_str();
   cmd->add_option("--max-ids", a->max_ids, "Text output: print at most this many ids of a cell")->capture_default_str();
   cmd->callback([a] {
@@ -292,10 +294,29 @@ void add_inspect(CLI::App& app) {
       if (!cell) {
         json j = summary(r);
         j["file"] = a->file;
-        if (a->json_out)
+        std::vector<uint32_t> enclosed;
+        if (!a->scene.empty()) {
+          // Cells whose view-region centre is enclosed by the scene (issue 17 item 6).
+          for (uint32_t k = 0; k < r.cell_count(); ++k) {
+            pvs::Box b = info.layout.view_region(k);
+            vislib::Vec3 p{(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2,
+                           (b.min[2] + b.max[2]) / 2};
+            if (vislib::point_enclosed(scene, p)) enclosed.push_back(k);
+          }
+          j["enclosed_centre_cells"] = enclosed;
+        }
+        if (a->json_out) {
           std::printf("%s\n", j.dump(1).c_str());
-        else
+        } else {
           print_summary(a->file, j);
+          if (!a->scene.empty()) {
+            std::printf("  cells whose view-region centre is enclosed by the scene: %zu",
+                        enclosed.size());
+            for (size_t i = 0; i < enclosed.size() && int(i) < a->max_ids; ++i)
+              std::printf(" %u", enclosed[i]);
+            std::printf("\n");
+          }
+        }
         return;
       }
       // One cell.
@@ -315,7 +336,15 @@ void add_inspect(CLI::App& app) {
       j["visible_count"] = ids.size();
       j["share"] = info.universe ? double(ids.size()) / info.universe : 0.0;
       vislib::Granularity g = info.granularity == pvs::Granularity::Object ? vislib::Granularity::Object : vislib::Granularity::Triangle;
+      vislib::CellFreeSpace free_space;
       if (!a->scene.empty()) {
+        free_space = vislib::cell_free_space(scene, vislib::to_box3(info.layout.view_region(c)));
+        j["free_space"] = {{"samples", free_space.samples},
+                           {"enclosed", free_space.enclosed},
+                           {"centre_enclosed", free_space.centre_enclosed}};
+        if (free_space.free_point)
+          j["free_space"]["free_point"] = {free_space.free_point->x, free_space.free_point->y,
+                                           free_space.free_point->z};
         vislib::Scene sub = vislib::scene_subset(scene, ids, g);
         j["visible_triangles"] = sub.triangle_count();
         j["triangle_share"] = scene.triangle_count() ? double(sub.triangle_count()) / scene.triangle_count() : 0.0;
@@ -328,7 +357,16 @@ void add_inspect(CLI::App& app) {
           pvs::Box region = info.layout.view_region(c);
           vislib::Vec3 eye{(region.min[0] + region.max[0]) / 2, (region.min[1] + region.max[1]) / 2,
                            (region.min[2] + region.max[2]) / 2};
-          if (!a->at.empty()) eye = parse_vec3(a->at, "--at");
+          if (!a->at.empty()) {
+            eye = parse_vec3(a->at, "--at");
+          } else if (free_space.centre_enclosed) {
+            // Never an enclosed point as the default eye (issue 17 item 6).
+            if (!free_space.free_point)
+              throw vislib::InputError(a->file,
+                                       "every sample of cell " + std::to_string(c) +
+                                           "'s view region is enclosed by the scene: give --at");
+            eye = *free_space.free_point;
+          }
           j["render"] = render_cell(scene, ids, g, eye, a->render_dir, fw, fh);
         }
       }
@@ -349,6 +387,15 @@ void add_inspect(CLI::App& app) {
       }
       std::printf("  visible: %zu of %u %ss (%.2f%%)\n", ids.size(), info.universe, j["granularity"].get<std::string>().c_str(),
                   100 * j["share"].get<double>());
+      if (j.contains("free_space")) {
+        std::printf(
+            "  free space: %d of %d samples of the view region enclosed by the scene%s\n",
+            free_space.enclosed, free_space.samples,
+            free_space.centre_enclosed ? " (the centre is: the cell straddles a solid)" : "");
+        if (free_space.enclosed > 0)
+          warn("cell " + std::to_string(c) +
+               " holds points enclosed by the scene: its boundary segments run through solids");
+      }
       if (j.contains("visible_triangles"))
         std::printf("  visible triangles: %zu of %zu (%.2f%%)\n", j["visible_triangles"].get<size_t>(), scene.triangle_count(),
                     100 * j["triangle_share"].get<double>());

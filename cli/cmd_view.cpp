@@ -13,13 +13,14 @@
 #include "cli/load_scene.h"
 #include "pvs_format/pvs_format.h"
 #include "runtime/near_far.h"
-#include "vislib/eval/embree_scene.h"
+#include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/eval/embree_scene.h"
 #include "vislib/eval/image_io.h"
 #include "vislib/eval/metrics.h"
-#include "vislib/render/near_far_render.h"
 #include "vislib/eval/render.h"
+#include "vislib/render/near_far_render.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 namespace pvs_cli {
@@ -65,8 +66,10 @@ void add_view(CLI::App& app) {
   cmd->add_option("--look", a->look, "Point x,y,z the user looks at")->required();
   cmd->add_option("--near-far", a->near_far, "Radii r1,r2 of the cylinders about the centre (scene units)")
       ->capture_default_str();
-  cmd->add_option("--centre", a->centre, "Centre O x,y,z of the cylinders and environment map (default: the "
-                                         "centre of the cell's view region)");
+  cmd->add_option("--centre", a->centre,
+                  "Centre O x,y,z of the cylinders and environment map (default: the "
+                  "centre of the cell's view region, or when that is enclosed by the scene "
+                  "the free sample of the region nearest it)");
   cmd->add_flag("--grow", a->grow, "Also render the progressive near region (CloVR rings up to r2) and report "
                                    "the minimum SSIM between consecutive frames");
   cmd->add_option("--rings", a->rings, "--grow: equal-area rings up to r2")->check(CLI::Range(1, 1000))->capture_default_str();
@@ -136,6 +139,21 @@ void add_view(CLI::App& app) {
       pvs::Box region = info.layout.view_region(cell);
       centre = {(region.min[0] + region.max[0]) / 2, (region.min[1] + region.max[1]) / 2,
                 (region.min[2] + region.max[2]) / 2};
+      if (a->centre.empty()) {
+        // Never a point inside a building as the default centre (issue 17 item 6).
+        vislib::CellFreeSpace fs = vislib::cell_free_space(full_scene, vislib::to_box3(region));
+        if (fs.centre_enclosed) {
+          if (!fs.free_point)
+            throw vislib::InputError(a->file,
+                                     "every sample of cell " + std::to_string(cell) +
+                                         "'s view region is enclosed by the scene: give --centre");
+          centre = *fs.free_point;
+          warn("the centre of cell " + std::to_string(cell) +
+               "'s view region is enclosed by the scene; using " + "the free point " +
+               std::to_string(centre.x) + "," + std::to_string(centre.y) + "," +
+               std::to_string(centre.z) + " as the centre");
+        }
+      }
     } catch (const pvs::FormatError& e) {
       throw vislib::InputError(a->file, e.what());
     }
