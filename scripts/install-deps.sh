@@ -7,7 +7,7 @@ PACKAGES=(
   libembree-dev libtbb-dev libcgal-dev libopenmesh-dev libtinygltf-dev libmeshoptimizer-dev
   libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libstb-dev
-  python3 python3-matplotlib python3-numpy
+  python3 python3-matplotlib python3-numpy help2man
   clang libclang-rt-14-dev
 )
 missing=()
