@@ -242,7 +242,10 @@ void add_inspect(CLI::App& app) {
   cmd->add_option("--scene", a->scene, "The scene the PVS was baked for (checked by its fingerprint)");
   cmd->add_option("--states", a->states, "With --scene: key states to sample animations into (as for the bake)")
       ->check(CLI::Range(1, 100000));
-  cmd->add_option("--export-gltf", a->gltf, "With --scene and a cell: write the scene reduced to the cell's set (.glb)");
+  cmd->add_option(
+      "--export-gltf", a->gltf,
+      "With --scene and a cell: write the scene reduced to the cell's set (.glb), with the "
+      "source's normals, UVs, materials, textures and copyright");
   cmd->add_option(
       "--render", a->render_dir,
       "With --scene and a cell: render from the --at point (else the centre of the cell's view "
@@ -349,7 +352,14 @@ void add_inspect(CLI::App& app) {
         j["visible_triangles"] = sub.triangle_count();
         j["triangle_share"] = scene.triangle_count() ? double(sub.triangle_count()) / scene.triangle_count() : 0.0;
         if (!a->gltf.empty()) {
-          vislib::write_file_atomic(a->gltf, vislib::scene_to_glb(sub));
+          // What a viewer needs besides the triangles: normals, UVs, materials, copyright.
+          vislib::LoadOptions lo;
+          lo.states = a->states;
+          std::vector<std::string> warnings;
+          vislib::SceneAppearance app = vislib::load_appearance(a->scene, lo, &warnings);
+          for (const auto& w : warnings) warn(w);
+          vislib::SceneAppearance sub_app = vislib::appearance_subset(scene, app, ids, g);
+          vislib::write_file_atomic(a->gltf, vislib::scene_to_glb(sub, &sub_app));
           j["export_gltf"] = a->gltf;
         }
         if (!a->render_dir.empty()) {

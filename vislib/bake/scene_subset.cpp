@@ -5,7 +5,10 @@
 
 namespace vislib {
 
-Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granularity granularity) {
+namespace {
+
+std::vector<uint8_t> kept(const Scene& scene, const std::vector<uint32_t>& ids,
+                          Granularity granularity) {
   std::vector<uint8_t> keep(scene.triangle_count(), 0);
   if (granularity == Granularity::Triangle) {
     for (uint32_t t : ids) {
@@ -20,6 +23,24 @@ Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granula
     }
     for (size_t t = 0; t < scene.triangle_count(); ++t) keep[t] = object[scene.triangle_object[t]];
   }
+  return keep;
+}
+
+}  // namespace
+
+SceneAppearance appearance_subset(const Scene& scene, const SceneAppearance& appearance,
+                                  const std::vector<uint32_t>& ids, Granularity granularity) {
+  SceneAppearance out = appearance;
+  if (appearance.triangle_material.size() != scene.triangle_count()) return out;
+  std::vector<uint8_t> keep = kept(scene, ids, granularity);
+  out.triangle_material.clear();
+  for (size_t t = 0; t < scene.triangle_count(); ++t)
+    if (keep[t]) out.triangle_material.push_back(appearance.triangle_material[t]);
+  return out;
+}
+
+Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granularity granularity) {
+  std::vector<uint8_t> keep = kept(scene, ids, granularity);
   std::vector<uint32_t> used(scene.objects.size(), 0);
   for (size_t t = 0; t < scene.triangle_count(); ++t)
     if (keep[t]) used[scene.triangle_object[t]] = 1;
