@@ -56,8 +56,9 @@ uint64_t bake_key(const pvs::FileInfo& info, Shard shard) {
 }
 
 std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                                const BakeSettings& settings, double* seconds) {
-  CellVisibility v = cell_visibility(scene, layout, cell, settings.region);
+                                const BakeSettings& settings, double* seconds,
+                                const std::function<void(double)>& progress) {
+  CellVisibility v = cell_visibility(scene, layout, cell, settings.region, progress);
   if (seconds) *seconds = v.seconds;
   if (settings.granularity == Granularity::Object) return objects_of(scene, v.triangles, v.spheres);
   std::vector<uint32_t> ids = std::move(v.triangles);
@@ -102,23 +103,45 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   std::mutex progress_mutex;
   uint32_t done = report.resumed;
-  if (progress) progress({done, report.shard_cells, report.resumed, 0.0});
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, pending.size(), 1),
-      [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-          uint32_t c = pending[i];
-          double seconds = 0;
-          std::vector<uint32_t> ids = bake_cell(scene, info.layout, c, settings, &seconds);
-          if (checkpoint) checkpoint->append(c, ids);
-          sets[c] = std::move(ids);
-          report.cell_seconds[c] = seconds;
-          std::lock_guard<std::mutex> lock(progress_mutex);
-          ++done;
-          if (progress) progress({done, report.shard_cells, report.resumed, elapsed()});
-        }
-      },
-      tbb::simple_partitioner());
+  std::vector<double> partial(n, 0.0);  // fraction of each running cell's runs done
+  double running = 0;                   // their sum
+  if (progress) progress({done, report.shard_cells, report.resumed, 0.0, 0.0});
+  try {
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, pending.size(), 1),
+        [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t i = r.begin(); i != r.end(); ++i) {
+            uint32_t c = pending[i];
+            double seconds = 0;
+            std::function<void(double)> in_cell;
+            if (progress)
+              in_cell = [&, c](double fraction) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                running += fraction - partial[c];
+                partial[c] = fraction;
+                progress(
+                    {done, report.shard_cells, report.resumed, elapsed(), std::max(0.0, running)});
+              };
+            std::vector<uint32_t> ids =
+                bake_cell(scene, info.layout, c, settings, &seconds, in_cell);
+            if (checkpoint) checkpoint->append(c, ids);
+            sets[c] = std::move(ids);
+            report.cell_seconds[c] = seconds;
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            ++done;
+            running -= partial[c];
+            partial[c] = 0;
+            if (progress)
+              progress(
+                  {done, report.shard_cells, report.resumed, elapsed(), std::max(0.0, running)});
+          }
+        },
+        tbb::simple_partitioner());
+  } catch (...) {
+    // A bake that recorded nothing leaves no checkpoint behind (issue 17 item 1).
+    if (checkpoint && done == 0) checkpoint->remove();
+    throw;
+  }
   report.baked = uint32_t(pending.size());
   report.seconds = elapsed();
 

@@ -265,7 +265,8 @@ std::vector<Segment> cell_boundary_segments(const Box3& view_region) {
 uint64_t cell_seed(uint64_t seed, uint32_t cell) { return Rng::derive(seed, cell); }
 
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                               const RegionOptions& options) {
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress) {
   Box3 region = to_box3(layout.view_region(cell));
   CellVisibility out;
   out.segments = cell_boundary_segments(region);
@@ -277,7 +278,12 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
   for (int r = 0; r < rects; ++r) {
     RegionOptions o = options;
     o.seed = Rng::derive(seed, uint64_t(r));
-    RegionResult rr = region_visibility(scene, rect[r], o);
+    std::function<void(size_t, size_t)> run_done;
+    if (progress)
+      run_done = [&](size_t done, size_t total) {
+        progress((double(r) + double(done) / double(std::max<size_t>(1, total))) / double(rects));
+      };
+    RegionResult rr = region_visibility(scene, rect[r], o, run_done);
     std::vector<uint32_t> merged;
     merged.reserve(out.triangles.size() + rr.visible.size());
     std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(), rr.visible.end(),

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -97,9 +98,12 @@ struct CellVisibility {
 // Visible triangles of cell `cell` of `layout`: region_visibility (options.runs orientations,
 // options.segment settings) on the bottom and the top rectangle of the view region, united.
 // Depends only on the scene, the view region, `options` and `cell` (not on the thread count).
-// Thread-safe; parallel inside (TBB).
+// Thread-safe; parallel inside (TBB). `progress(fraction)`, if given, is called after each
+// from-segment run with the fraction in (0, 1] of the cell's runs done (from the calling thread
+// or a worker; never two calls at once).
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                               const RegionOptions& options);
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress = {});
 
 // --- Free space (issue 17 item 6) ---------------------------------------------------------------
 // Walkable cells are columns over floor: a column that straddles a building holds points inside
