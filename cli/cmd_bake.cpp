@@ -1,4 +1,4 @@
-// pvs bake / pvs merge: bake a scene's view cells into a PVS file (docs/bake.md), and join the
+// pvs bake: bake a scene's view cells into a PVS file (docs/bake.md); cmd_merge.cpp joins the
 // shard files of a sharded bake.
 #include <sys/stat.h>
 #include <tbb/global_control.h>
@@ -11,12 +11,13 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
+#include "cli/bake_progress.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "vislib/bake/bake.h"
+#include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
-#include "vislib/bake/view_cells.h"
 
 namespace pvs_cli {
 namespace {
@@ -35,52 +36,6 @@ struct BakeArgs {
   std::string mode = "diagonal";
   int states = 1;
 };
-
-std::string format_duration(double s) {
-  if (!std::isfinite(s) || s < 0) return "?";
-  long t = long(s + 0.5);
-  char buf[32];
-  if (t >= 3600)
-    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
-  else
-    std::snprintf(buf, sizeof buf, "%ld:%02ld", t / 60, t % 60);
-  return buf;
-}
-
-// A bar with cells done / total and the ETA on a terminal (redrawn in place); plain lines
-// otherwise, every 5% of the cells or every 10 s, whichever comes first.
-vislib::BakeProgressFn progress_printer() {
-  struct State {
-    bool tty = isatty(fileno(stderr));
-    double last_line = -1;
-    uint32_t last_done = 0;
-  };
-  auto st = std::make_shared<State>();
-  return [st](const vislib::BakeProgress& p) {
-    uint32_t baked = p.done - p.resumed;
-    double eta = baked > 0 ? p.elapsed / baked * double(p.total - p.done) : NAN;
-    if (st->tty) {
-      const int width = 30;
-      int fill = p.total ? int(double(width) * p.done / p.total) : width;
-      std::string bar(size_t(fill), '#');
-      bar.resize(width, '.');
-      std::fprintf(stderr, "\rpvs bake: [%s] %u/%u cells", bar.c_str(), p.done, p.total);
-      if (p.resumed) std::fprintf(stderr, " (%u resumed)", p.resumed);
-      std::fprintf(stderr, "  %s elapsed  ETA %s   ", format_duration(p.elapsed).c_str(),
-                   p.done == p.total ? "0:00" : format_duration(eta).c_str());
-      if (p.done == p.total) std::fprintf(stderr, "\n");
-      std::fflush(stderr);
-      return;
-    }
-    bool first = st->last_line < 0, last = p.done == p.total;
-    bool step = p.done >= st->last_done + std::max<uint32_t>(1, p.total / 20);
-    if (!first && !last && !step && p.elapsed - st->last_line < 10) return;
-    st->last_line = p.elapsed;
-    st->last_done = p.done;
-    std::fprintf(stderr, "pvs bake: %u/%u cells (%u resumed), %s elapsed, ETA %s\n", p.done, p.total,
-                 p.resumed, format_duration(p.elapsed).c_str(), last ? "0:00" : format_duration(eta).c_str());
-  };
-}
 
 vislib::Shard parse_shard(const std::string& text) {
   unsigned i = 0, n = 0;
@@ -117,21 +72,27 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     vislib::Box3 r = box ? *box : scene.bounds();
     auto columns = [&](double extent) { return std::max(1.0, std::ceil(extent / w.cell_size)); };
     if (!r.empty() && columns(r.max.x - r.min.x) * columns(r.max.z - r.min.z) > 1e7)
-      throw CLI::ValidationError("--cell-size", "more than 10^7 columns: use a larger cell size or a --box");
+      throw CLI::ValidationError("--cell-size",
+                                 "more than 10^7 columns: use a larger cell size or a --box");
     return vislib::walkable_cells(scene, w);
   }
-  if (!box) throw CLI::ValidationError("--box", "give --box with --grid or --cell-size, or --walkable");
-  if (!a.grid.empty() && a.cell_size > 0) throw CLI::ValidationError("--grid", "give --grid or --cell-size, not both");
+  if (!box)
+    throw CLI::ValidationError("--box", "give --box with --grid or --cell-size, or --walkable");
+  if (!a.grid.empty() && a.cell_size > 0)
+    throw CLI::ValidationError("--grid", "give --grid or --cell-size, not both");
   if (!a.grid.empty()) {
     auto g = parse_doubles(a.grid, "--grid", 3);
     for (double v : g)
-      if (!(v >= 1 && v == std::floor(v) && v <= 1e6)) throw CLI::ValidationError("--grid", "expected three integers >= 1");
+      if (!(v >= 1 && v == std::floor(v) && v <= 1e6))
+        throw CLI::ValidationError("--grid", "expected three integers >= 1");
     if (g[0] * g[1] * g[2] > 1e7) throw CLI::ValidationError("--grid", "more than 10^7 cells");
     return vislib::grid_cells(*box, uint32_t(g[0]), uint32_t(g[1]), uint32_t(g[2]), eye);
   }
-  if (!(a.cell_size > 0)) throw CLI::ValidationError("--grid", "give --grid nx,ny,nz or --cell-size S with --box");
+  if (!(a.cell_size > 0))
+    throw CLI::ValidationError("--grid", "give --grid nx,ny,nz or --cell-size S with --box");
   double count = 1;
-  for (int k = 0; k < 3; ++k) count *= std::max(1.0, std::ceil((box->max[k] - box->min[k]) / a.cell_size));
+  for (int k = 0; k < 3; ++k)
+    count *= std::max(1.0, std::ceil((box->max[k] - box->min[k]) / a.cell_size));
   if (count > 1e7) throw CLI::ValidationError("--cell-size", "more than 10^7 cells");
   return vislib::grid_cells_by_size(*box, a.cell_size, eye);
 }
@@ -149,52 +110,67 @@ void add_bake(CLI::App& app) {
       "on the perimeter of the bottom and top rectangles of each cell's eye band. Cells: a grid "
       "over --box, or --walkable cells over the floors of the scene.");
   cmd->add_option("SCENE", a->scene, "Scene file (.glb .gltf .obj .ply .off .stl)")->required();
-  cmd->add_option("-o,--output", a->output, "Output PVS file (a shard file with --shard)")->required();
-  cmd->add_option("--box", a->box, "Grid box x0,y0,z0,x1,y1,z1 (with --walkable: only place cells in it)");
+  cmd->add_option("-o,--output", a->output, "Output PVS file (a shard file with --shard)")
+      ->required();
+  cmd->add_option("--box", a->box,
+                  "Grid box x0,y0,z0,x1,y1,z1 (with --walkable: only place cells in it)");
   cmd->add_option("--grid", a->grid, "Grid cells nx,ny,nz over --box");
   cmd->add_flag("--walkable", a->walkable, "Place cells automatically over upward-facing floors");
-  cmd->add_option("--cell-size", a->cell_size, "Cell side: walkable columns (default 2) or grid cells over --box")
+  cmd->add_option("--cell-size", a->cell_size,
+                  "Cell side: walkable columns (default 2) or grid cells over --box")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--eye-height", a->eye, "Eye band h0,h1 above the floor / the cell bottom (walkable default 1.5,1.8)");
+  cmd->add_option("--eye-height", a->eye,
+                  "Eye band h0,h1 above the floor / the cell bottom (walkable default 1.5,1.8)");
   cmd->add_option("--max-slope", a->max_slope, "Walkable: steepest floor, degrees from horizontal")
       ->check(CLI::Range(0.0, 90.0))
       ->capture_default_str();
-  cmd->add_flag("--no-headroom", a->no_headroom, "Walkable: keep floors covered by other geometry (under buildings)");
+  cmd->add_flag("--no-headroom", a->no_headroom,
+                "Walkable: keep floors covered by other geometry (under buildings)");
   cmd->add_option("--res", a->resolution, "Cube face resolution N of the from-segment runs")
       ->check(CLI::Range(1, 16384))
       ->capture_default_str();
   cmd->add_option("--runs", a->runs, "Cube orientations K per boundary segment")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();
-  cmd->add_option("--seed", a->seed, "Seed of the orientations (derived per cell)")->capture_default_str();
+  cmd->add_option("--seed", a->seed, "Seed of the orientations (derived per cell)")
+      ->capture_default_str();
   cmd->add_option("--near", a->near, "Near plane (view depth, scene units)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--eps-len", a->eps_len, "Final pieces must be longer than this (in t) to count")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--tile", a->tile, "Kernel tile side in pixels")->check(CLI::Range(1, 4096))->capture_default_str();
-  cmd->add_option("--states", a->states, "Key states to sample glTF animations into (dynamic scenes)")
+  cmd->add_option("--tile", a->tile, "Kernel tile side in pixels")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  cmd->add_option("--states", a->states,
+                  "Key states to sample glTF animations into (dynamic scenes)")
       ->check(CLI::Range(1, 100000));
-  cmd->add_option("--mode", a->mode, "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
+  cmd->add_option("--mode", a->mode,
+                  "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))
       ->capture_default_str();
-  cmd->add_option("--granularity", a->granularity, "Store triangle ids (spheres after them) or object ids")
+  cmd->add_option("--granularity", a->granularity,
+                  "Store triangle ids (spheres after them) or object ids")
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
-  cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores); never changes the output")
+  cmd->add_option("--threads", a->threads,
+                  "Worker threads (0 = all cores); never changes the output")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--shard", a->shard, "Bake only cells c with c % N == i, into a shard file for pvs merge")
+  cmd->add_option("--shard", a->shard,
+                  "Bake only cells c with c % N == i, into a shard file for pvs merge")
       ->capture_default_str();
   cmd->add_flag("--resume", a->resume, "Continue an interrupted bake from its checkpoint");
   cmd->add_option("--checkpoint", a->checkpoint, "Checkpoint file (default OUTPUT.ckpt)");
   cmd->add_flag("--dry-run", a->dry_run, "Place the cells, print their count and stop");
-  cmd->add_option("--json", a->json_out, "Write a bake report (timings per cell, sizes) as JSON ('-' = stdout)");
+  cmd->add_option("--json", a->json_out,
+                  "Write a bake report (timings per cell, sizes) as JSON ('-' = stdout)");
   cmd->callback([a] {
     vislib::Shard shard = parse_shard(a->shard);
     std::unique_ptr<tbb::global_control> limit;
     if (a->threads > 0)
-      limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, a->threads);
+      limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    a->threads);
     std::string checkpoint = a->checkpoint.empty() ? a->output + ".ckpt" : a->checkpoint;
     if (!a->resume && file_exists(checkpoint)) {
       std::fprintf(stderr,
@@ -205,27 +181,33 @@ void add_bake(CLI::App& app) {
     }
     auto t0 = std::chrono::steady_clock::now();
     vislib::Scene scene = load_scene_for_cli(a->scene, a->states);
-    if (scene.sphere_count() > 0) warn(a->scene + ": spheres are not handled by the static kernel; ignored");
-    if (scene.triangle_count() >= 0xFFFFFFFFull) throw vislib::InputError(a->scene, "more than 2^32-1 triangles");
+    if (scene.sphere_count() > 0)
+      warn(a->scene + ": spheres are not handled by the static kernel; ignored");
+    if (scene.triangle_count() >= 0xFFFFFFFFull)
+      throw vislib::InputError(a->scene, "more than 2^32-1 triangles");
     vislib::ViewCells cells = make_cells(*a, scene);
     double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     uint32_t n = cells.layout.cell_count();
     if (n == 0) {
-      std::fprintf(stderr, "pvs: error: no view cells (no walkable floor in the scene%s)\n", a->box.empty() ? "" : " within --box");
+      std::fprintf(stderr, "pvs: error: no view cells (no walkable floor in the scene%s)\n",
+                   a->box.empty() ? "" : " within --box");
       throw Exit{2};
     }
     if (a->dry_run) {
-      std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell\n", n,
-                  cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
-                  (n + shard.count - 1 - shard.index) / shard.count, shard.index, shard.count,
-                  vislib::cell_boundary_segments(vislib::to_box3(cells.layout.view_region(0))).size(), a->runs);
+      std::printf(
+          "%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell\n", n,
+          cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
+          (n + shard.count - 1 - shard.index) / shard.count, shard.index, shard.count,
+          vislib::cell_boundary_segments(vislib::to_box3(cells.layout.view_region(0))).size(),
+          a->runs);
       return;
     }
     if (a->resume && !file_exists(checkpoint))
-      std::fprintf(stderr, "pvs bake: no checkpoint %s: starting from the beginning\n", checkpoint.c_str());
+      std::fprintf(stderr, "pvs bake: no checkpoint %s: starting from the beginning\n",
+                   checkpoint.c_str());
     std::fprintf(stderr, "pvs bake: %u cells (%s), %zu triangles, shard %u/%u\n", n,
-                 cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable", scene.triangle_count(),
-                 shard.index, shard.count);
+                 cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
+                 scene.triangle_count(), shard.index, shard.count);
 
     vislib::BakeSettings s;
     s.region.segment.resolution = a->resolution;
@@ -234,31 +216,40 @@ void add_bake(CLI::App& app) {
     s.region.segment.tile_size = a->tile;
     s.region.runs = a->runs;
     s.region.seed = a->seed;
-    s.granularity = a->granularity == "object" ? vislib::Granularity::Object : vislib::Granularity::Triangle;
-    s.region.segment.mode = a->mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
+    s.granularity =
+        a->granularity == "object" ? vislib::Granularity::Object : vislib::Granularity::Triangle;
+    s.region.segment.mode =
+        a->mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
     vislib::BakeFiles files{a->output, checkpoint, a->resume};
     vislib::BakeReport r = vislib::bake(scene, cells, s, shard, files, progress_printer());
 
     double kernel = 0;
     for (double x : r.cell_seconds) kernel += x;
-    std::fprintf(stderr,
-                 "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
-                 "%llu bytes (%.1f per cell) written to %s\n",
-                 r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
-                 static_cast<unsigned long long>(r.stats.file_bytes),
-                 r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a->output.c_str());
+    std::fprintf(
+        stderr,
+        "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
+        "%llu bytes (%.1f per cell) written to %s\n",
+        r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
+        static_cast<unsigned long long>(r.stats.file_bytes),
+        r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a->output.c_str());
     if (!a->json_out.empty()) {
-      json j = {{"scene", a->scene},
-                {"output", a->output},
-                {"cells", r.cells},
-                {"shard", {shard.index, shard.count}},
-                {"shard_cells", r.shard_cells},
-                {"baked", r.baked},
-                {"resumed", r.resumed},
-                {"timings", {{"setup_seconds", setup_s}, {"bake_seconds", r.seconds}, {"kernel_seconds", kernel}}},
-                {"cell_seconds", r.cell_seconds},
-                {"bytes", {{"file", r.stats.file_bytes}, {"header", r.stats.header_bytes}, {"layout", r.stats.layout_bytes},
-                           {"index", r.stats.index_bytes}, {"blocks", r.stats.block_bytes}}}};
+      json j = {
+          {"scene", a->scene},
+          {"output", a->output},
+          {"cells", r.cells},
+          {"shard", {shard.index, shard.count}},
+          {"shard_cells", r.shard_cells},
+          {"baked", r.baked},
+          {"resumed", r.resumed},
+          {"timings",
+           {{"setup_seconds", setup_s}, {"bake_seconds", r.seconds}, {"kernel_seconds", kernel}}},
+          {"cell_seconds", r.cell_seconds},
+          {"bytes",
+           {{"file", r.stats.file_bytes},
+            {"header", r.stats.header_bytes},
+            {"layout", r.stats.layout_bytes},
+            {"index", r.stats.index_bytes},
+            {"blocks", r.stats.block_bytes}}}};
       std::string text = j.dump(1) + "\n";
       if (a->json_out == "-")
         std::fwrite(text.data(), 1, text.size(), stdout);
@@ -268,37 +259,7 @@ void add_bake(CLI::App& app) {
   });
 }
 
-void add_merge(CLI::App& app) {
-  auto shards = std::make_shared<std::vector<std::string>>();
-  auto out = std::make_shared<std::string>();
-  CLI::App* cmd = app.add_subcommand(
-      "merge", "Join the shard files of a sharded bake (pvs bake --shard i/N) into one PVS file, "
-               "byte-identical to an unsharded bake");
-  cmd->add_option("SHARD", *shards, "Shard files, any order")->required();
-  cmd->add_option("-o,--output", *out, "Output PVS file")->required();
-  cmd->callback([shards, out] {
-    std::vector<pvs::Reader> readers;
-    for (const auto& path : *shards) {
-      try {
-        readers.push_back(pvs::Reader::from_file(path));
-      } catch (const pvs::FormatError& e) {
-        throw vislib::InputError(path, e.what());
-      }
-    }
-    std::string bytes;
-    try {
-      bytes = pvs::merge_pvs(readers);
-    } catch (const pvs::FormatError& e) {
-      throw vislib::InputError("pvs merge", e.what());
-    }
-    vislib::write_file_atomic(*out, bytes);
-    std::fprintf(stderr, "pvs merge: %zu shards, %u cells, %zu bytes written to %s\n", readers.size(),
-                 readers[0].cell_count(), bytes.size(), out->c_str());
-  });
-}
-
 Registration bake_registration("bake", add_bake);
-Registration merge_registration("merge", add_merge);
 
 }  // namespace
 }  // namespace pvs_cli

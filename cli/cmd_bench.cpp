@@ -15,10 +15,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli/bench_output.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
-#include "vislib/eval/benchmark_compare.h"
 #include "vislib/base/file_util.h"
+#include "vislib/eval/bench_report.h"
+#include "vislib/eval/benchmark_compare.h"
 #include "vislib/eval/image_io.h"
 
 namespace pvs_cli {
@@ -27,120 +29,13 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-struct BenchArgs {
-  std::string scene, box, frame = "640x480", out, path = "walk", python = "/usr/bin/python3";
-  std::string plot_script;
-  vislib::BenchOptions o;
-  int threads = 0;
-  bool no_frames = false, no_plots = false;
-};
-
-// Finite numbers as numbers, +-inf and NaN as null (JSON has no infinities).
-json num(double v) {
-  return std::isfinite(v) ? json(v) : json(nullptr);
-}
-// CSV cells: "inf" / "nan" for non-finite values (Python's float() reads both).
-std::string cell(double v) {
-  if (std::isnan(v)) return "nan";
-  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
-}
-json vec_json(vislib::Vec3 v) {
-  return json::array({v.x, v.y, v.z});
-}
-
-json quality_json(const vislib::QualitySummary& q) {
-  return {{"epsilon", num(q.epsilon_mean)},
-          {"epsilon_max", num(q.epsilon_max)},
-          {"psnr", num(q.psnr)},
-          {"psnr_min", num(q.psnr_min)},
-          {"ssim", num(q.ssim_mean)},
-          {"ssim_min", num(q.ssim_min)},
-          {"missed_pixels", q.missed_pixels}};
-}
-
-json set_json(const vislib::SetComparison& c) {
-  return {{"size", c.size},
-          {"reference_size", c.reference_size},
-          {"common", c.common},
-          {"missed", c.missed},
-          {"extra", c.extra}};
-}
-
-json method_json(const vislib::Checkpoint& c, const vislib::SetComparison& vs_reference) {
-  json j = quality_json(c.quality);
-  j["runs"] = c.runs;
-  j["seconds"] = num(c.seconds);
-  j["found"] = c.set_size;
-  j["vs_frame_triangles"] = set_json(c.vs_frames);
-  j["vs_reference"] = set_json(vs_reference);
-  return j;
-}
-
-std::string csv_growth(const vislib::MethodRun& m, size_t segments, bool segment_method) {
-  std::ostringstream s;
-  s << (segment_method ? "runs,pass,segment,seconds,found\n" : "runs,seconds,found\n");
-  for (const auto& g : m.growth) {
-    s << g.runs << ',';
-    if (segment_method)
-      s << (g.runs - 1) / int(segments) << ',' << (g.runs - 1) % int(segments) << ',';
-    s << cell(g.seconds) << ',' << g.found << '\n';
-  }
-  return s.str();
-}
-
-void csv_checkpoints(std::ostringstream& s, std::ostringstream& v, const char* method,
-                     const vislib::MethodRun& m) {
-  for (const auto& c : m.checkpoints) {
-    const auto& q = c.quality;
-    s << method << ',' << c.runs << ',' << cell(c.seconds) << ',' << c.set_size << ','
-      << cell(q.epsilon_mean) << ',' << cell(q.epsilon_max) << ',' << cell(q.psnr) << ','
-      << cell(q.psnr_min) << ',' << cell(q.ssim_mean) << ',' << cell(q.ssim_min) << ','
-      << q.missed_pixels << ',' << c.vs_frames.missed << '\n';
-    for (size_t i = 0; i < c.views.size(); ++i) {
-      const auto& f = c.views[i];
-      v << method << ',' << c.runs << ',' << cell(c.seconds) << ',' << i << ',' << cell(f.epsilon)
-        << ',' << cell(f.mse) << ',' << cell(f.psnr) << ',' << cell(f.ssim) << ','
-        << f.missed_pixels << '\n';
-    }
-  }
-}
-
-std::string shell_quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// bench/plot_bench.py: --plot-script, else beside the source tree of this build (the build
-// folder's CMakeCache.txt names it), else <exe>/../../bench, else <exe>/../share/vislib.
-std::string find_plot_script(const std::string& given) {
-  if (!given.empty()) return given;
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return "";
-  const fs::path dir = exe.parent_path();
-  std::ifstream cache(dir.parent_path() / "CMakeCache.txt");
-  std::string line;
-  while (std::getline(cache, line)) {
-    const std::string key = "vislib_SOURCE_DIR:STATIC=";
-    if (line.rfind(key, 0) == 0) {
-      fs::path p = fs::path(line.substr(key.size())) / "bench" / "plot_bench.py";
-      if (fs::exists(p, ec)) return p.string();
-    }
-  }
-  for (fs::path p : {dir / ".." / ".." / "bench" / "plot_bench.py",
-                     dir / ".." / "share" / "vislib" / "plot_bench.py"})
-    if (fs::exists(p, ec)) return p.lexically_normal().string();
-  return "";
-}
-
 // Runs the plotting script; returns the PNG names written, or warns and returns nothing.
 std::vector<std::string> make_plots(const BenchArgs& a) {
-  const std::string script = find_plot_script(a.plot_script);
-  const std::string manual = "python3-with-matplotlib bench/plot_bench.py " + shell_quote(a.out);
+  std::error_code ec;
+  const std::string script =
+      vislib::find_plot_script(a.plot_script, fs::read_symlink("/proc/self/exe", ec).string());
+  const std::string manual =
+      "python3-with-matplotlib bench/plot_bench.py " + vislib::shell_quote(a.out);
   if (script.empty()) {
     warn(
         "plots skipped: bench/plot_bench.py not found (give --plot-script); the CSV files are "
@@ -151,11 +46,11 @@ std::vector<std::string> make_plots(const BenchArgs& a) {
   if (::access(a.python.c_str(), X_OK) != 0) {
     warn("plots skipped: " + a.python +
          " is not an executable Python (give --python); later run: " + a.python + " " +
-         shell_quote(script) + " " + shell_quote(a.out));
+         vislib::shell_quote(script) + " " + vislib::shell_quote(a.out));
     return {};
   }
-  const std::string cmd =
-      shell_quote(a.python) + " " + shell_quote(script) + " " + shell_quote(a.out);
+  const std::string cmd = vislib::shell_quote(a.python) + " " + vislib::shell_quote(script) + " " +
+                          vislib::shell_quote(a.out);
   std::fflush(stderr);
   const int status = std::system(cmd.c_str());
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -228,166 +123,18 @@ void run(BenchArgs& a) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // CSV.
-  vislib::write_file_atomic((fs::path(a.out) / "growth_segment.csv").string(),
-                            csv_growth(r.segment, r.segments.size(), true));
-  {
-    std::ostringstream s;
-    s << "runs,seconds,found,x,y,z\n";
-    for (size_t i = 0; i < r.point.growth.size(); ++i) {
-      const auto& g = r.point.growth[i];
-      const auto& p = r.point_viewpoints[i];
-      s << g.runs << ',' << cell(g.seconds) << ',' << g.found << ',' << cell(p.x) << ','
-        << cell(p.y) << ',' << cell(p.z) << '\n';
-    }
-    vislib::write_file_atomic((fs::path(a.out) / "growth_point.csv").string(), s.str());
-  }
-  {
-    std::ostringstream s, v;
-    s << "method,runs,seconds,found,epsilon,epsilon_max,psnr,psnr_min,ssim,ssim_min,missed_pixels,"
-         "frame_triangles_missed\n";
-    v << "method,runs,seconds,view,epsilon,mse,psnr,ssim,missed_pixels\n";
-    csv_checkpoints(s, v, "segment", r.segment);
-    csv_checkpoints(s, v, "point", r.point);
-    vislib::write_file_atomic((fs::path(a.out) / "quality.csv").string(), s.str());
-    vislib::write_file_atomic((fs::path(a.out) / "quality_views.csv").string(), v.str());
-  }
-  {
-    std::ostringstream s;
-    s << "view,eye_x,eye_y,eye_z,forward_x,forward_y,forward_z\n";
-    for (size_t i = 0; i < r.views.size(); ++i) {
-      const auto& c = r.views[i];
-      s << i << ',' << cell(c.eye.x) << ',' << cell(c.eye.y) << ',' << cell(c.eye.z) << ','
-        << cell(c.forward.x) << ',' << cell(c.forward.y) << ',' << cell(c.forward.z) << '\n';
-    }
-    vislib::write_file_atomic((fs::path(a.out) / "views.csv").string(), s.str());
-  }
+  vislib::write_bench_csv(r, a.out);
 
   // Frames at equal time.
   json frames = json::array();
-  if (!a.no_frames) {
-    const fs::path dir = fs::path(a.out) / "frames";
-    fs::create_directories(dir);
-    for (size_t i = 0; i < r.truth_frames.size(); ++i) {
-      const std::string v = "view" + std::to_string(i);
-      const auto& t = r.truth_frames[i];
-      auto file = [&](const std::string& name) { return (dir / (v + name)).string(); };
-      vislib::write_rgb8_image(file("_truth.png"), t.width, t.height, t.rgb);
-      vislib::write_float_image(file("_truth_depth.exr"), t.width, t.height, t.depth);
-      vislib::write_rgb8_image(file("_segment.png"), t.width, t.height, r.segment_frames[i].rgb);
-      vislib::write_rgb8_image(file("_point.png"), t.width, t.height, r.point_frames[i].rgb);
-      vislib::write_rgb8_image(file("_segment_heat.png"), t.width, t.height,
-                               vislib::error_heat_map(t, r.segment_missed[i]));
-      vislib::write_rgb8_image(file("_point_heat.png"), t.width, t.height,
-                               vislib::error_heat_map(t, r.point_missed[i]));
-      frames.push_back("frames/" + v +
-                       "_{truth,truth_depth,segment,point,segment_heat,point_heat}");
-    }
-  }
+  if (!a.no_frames) frames = vislib::write_bench_frames(r, a.out);
 
   std::vector<std::string> plots;
   if (!a.no_plots) plots = make_plots(a);
 
-  // JSON.
-  const auto& et = r.equal_time;
-  const auto& eq = r.equal_quality;
-  json j;
-  j["scene"] = a.scene;
-  j["scene_triangles"] = scene.triangle_count();
-  j["box"] = {{"min", vec_json(a.o.box.min)}, {"max", vec_json(a.o.box.max)}};
-  j["settings"] = {{"resolution", a.o.resolution},
-                   {"near", a.o.near},
-                   {"segment_runs", a.o.segment_runs},
-                   {"perimeter_segments", r.segments.size()},
-                   {"point_runs", r.options.point_runs},
-                   {"point_runs_automatic", a.o.point_runs == 0},
-                   {"point_time_factor", a.o.point_time_factor},
-                   {"views", a.o.views},
-                   {"view_path", a.path},
-                   {"frame", {a.o.width, a.o.height}},
-                   {"vfov_degrees", a.o.vfov_degrees},
-                   {"seed", a.o.seed},
-                   {"threads", a.threads}};
-  j["equal_time_share"] = num(et.share);
-  j["equal_quality_time_ratio"] = num(eq.time_ratio);
-  j["equal_quality_extrapolated"] = eq.extrapolated;
-  j["segment"] = method_json(et.segment, r.segment_vs_reference);
-  j["point"] = method_json(et.point, r.point_equal_time_vs_reference);
-  j["point_final"] = method_json(r.point.checkpoints.back(), r.point_vs_reference);
-  j["equal_time"] = {{"seconds", num(et.seconds)},
-                     {"point_runs", et.point_runs},
-                     {"point_seconds", num(et.point_seconds)},
-                     {"segment_found", et.segment_found},
-                     {"point_found", et.point_found},
-                     {"point_found_of_segment", et.point_found_of_segment},
-                     {"share", num(et.share)},
-                     {"overlap_share", num(et.overlap_share)},
-                     {"within_measured", et.within_measured}};
-  j["equal_quality"] = {{"target_found", eq.target},
-                        {"segment_seconds", num(eq.segment_seconds)},
-                        {"reached", eq.reached},
-                        {"extrapolated", eq.extrapolated},
-                        {"finite", eq.finite},
-                        {"point_runs", num(eq.point_runs)},
-                        {"point_seconds", num(eq.point_seconds)},
-                        {"time_ratio", num(eq.time_ratio)},
-                        {"time_ratio_lower_bound", num(eq.time_ratio_lower_bound)},
-                        {"time_ratio_range", {num(eq.time_ratio_low), num(eq.time_ratio_high)}},
-                        {"rate_coefficient", num(eq.rate_coefficient)},
-                        {"rate_exponent", num(eq.rate_exponent)},
-                        {"fit_points", eq.fit_points},
-                        {"note", eq.note}};
-  j["frame_triangles"] = r.frame_triangles.size();
-  j["reference_triangles"] = r.reference.size();
-  j["timings"] = {{"load_seconds", load_s},
-                  {"bvh_build_seconds", r.bvh_build_seconds},
-                  {"truth_frames_seconds", r.truth_seconds},
-                  {"segment_seconds", num(et.seconds)},
-                  {"point_seconds", num(r.point.growth.back().seconds)},
-                  {"point_seconds_per_run", num(r.point_seconds_per_run)},
-                  {"point_calibration_seconds_per_run", num(r.calibration_seconds_per_run)},
-                  {"quality_seconds", r.quality_seconds},
-                  {"total_seconds", total_s}};
-  j["files"] = {
-      {"csv",
-       {"growth_segment.csv", "growth_point.csv", "quality.csv", "quality_views.csv", "views.csv"}},
-      {"frames", frames},
-      {"plots", plots}};
-  vislib::write_file_atomic((fs::path(a.out) / "bench.json").string(), j.dump(1) + "\n");
-
-  if (!et.within_measured)
-    warn("from-point stopped (" + std::to_string(r.options.point_runs) + " runs, " +
-         cell(r.point.growth.back().seconds) + " s) before the from-segment time " +
-         cell(et.seconds) + " s: equal_time_share is a lower bound; raise --point-runs");
-  auto pct = [](double v) { return 100.0 * v; };
-  std::fprintf(stderr,
-               "pvs bench: from-segment %zu triangles in %.2f s (%zu segments x %d runs); "
-               "from-point %zu in the same time (%d runs): equal-time share %.1f%%\n",
-               et.segment_found, et.seconds, r.segments.size(), a.o.segment_runs, et.point_found,
-               et.point_runs, pct(et.share));
-  if (eq.reached)
-    std::fprintf(stderr, "pvs bench: equal quality: from-point needs %.2f s (%.0f runs), %.2fx\n",
-                 eq.point_seconds, eq.point_runs, eq.time_ratio);
-  else {
-    std::string detail = eq.note;
-    if (!std::isnan(eq.time_ratio) && !std::isfinite(eq.time_ratio))
-      detail = "the extrapolation never gets there (see bench.json)";
-    else if (std::isfinite(eq.time_ratio))
-      detail = "extrapolated ratio " + cell(eq.time_ratio) +
-               "x (power-law fit of the discovery rate; " + cell(eq.time_ratio_low) + " to " +
-               cell(eq.time_ratio_high) + "x over three fit windows)";
-    std::fprintf(stderr,
-                 "pvs bench: equal quality not reached in %d from-point runs (%zu of %zu "
-                 "triangles): measured ratio > %.2fx; %s\n",
-                 r.options.point_runs, r.point.set.size(), eq.target, eq.time_ratio_lower_bound,
-                 detail.c_str());
-  }
-  std::fprintf(stderr,
-               "pvs bench: at equal time: segment eps %.3f%% PSNR %s SSIM %.5f | point eps %.3f%% "
-               "PSNR %s SSIM %.5f\npvs bench: wrote %s/bench.json (total %.1f s)\n",
-               pct(et.segment.quality.epsilon_mean), cell(et.segment.quality.psnr).c_str(),
-               et.segment.quality.ssim_mean, pct(et.point.quality.epsilon_mean),
-               cell(et.point.quality.psnr).c_str(), et.point.quality.ssim_mean, a.out.c_str(),
-               total_s);
+  vislib::write_file_atomic((fs::path(a.out) / "bench.json").string(),
+                            bench_json(a, scene, r, load_s, total_s, frames, plots).dump(1) + "\n");
+  print_bench(a, r, total_s);
 }
 
 void add_bench(CLI::App& app) {

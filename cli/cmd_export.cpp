@@ -50,7 +50,8 @@ void run_export(const ExportOptions& o) {
                scene.vertex_count(), scene.triangle_count());
   if (scene.sphere_count() == 0) return;
   size_t K = o.time ? 1 : scene.sphere_centers.size();
-  std::string sp = "vislib-spheres 1\n# pvs export of " + o.scene + "\nstates " + std::to_string(K) + "\n";
+  std::string sp =
+      "vislib-spheres 1\n# pvs export of " + o.scene + "\nstates " + std::to_string(K) + "\n";
   for (uint32_t i = 0; i < scene.sphere_count(); ++i) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%.17g", scene.sphere_radius[i]);

@@ -1,4 +1,5 @@
-// pvs info SCENE [--json] [--states K]: scene statistics and hygiene report (vislib/scene/scene_info.h).
+// pvs info SCENE [--json] [--states K]: scene statistics and hygiene report
+// (vislib/scene/scene_info.h).
 #include <cstdio>
 
 #include "cli/commands.h"
@@ -51,7 +52,8 @@ void run_info(const InfoOptions& o) {
 const Registration reg("info", [](CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
   auto* cmd = app.add_subcommand("info", "Print scene statistics and a hygiene report");
-  cmd->add_option("scene", o->scene, "Scene file (.gltf .glb .obj .ply .off .stl .spheres)")->required();
+  cmd->add_option("scene", o->scene, "Scene file (.gltf .glb .obj .ply .off .stl .spheres)")
+      ->required();
   cmd->add_flag("--json", o->json, "Machine-readable JSON on stdout");
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
       ->check(CLI::PositiveNumber);

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli/commands.h"
+#include "pvs_format/pvs_format.h"
 #include "vislib/base/error.h"
 
 namespace pvs_cli {
@@ -45,12 +46,17 @@ vislib::Vec3 parse_vec3(const std::string& text, const std::string& option) {
   return {v[0], v[1], v[2]};
 }
 
-void warn(const std::string& message) { std::fprintf(stderr, "pvs: warning: %s\n", message.c_str()); }
+void warn(const std::string& message) {
+  std::fprintf(stderr, "pvs: warning: %s\n", message.c_str());
+}
 
 }  // namespace pvs_cli
 
 int main(int argc, char** argv) {
-  CLI::App app{"pvs: precomputed visibility for virtual environments (vislib " "0.1.0)", "pvs"};
+  CLI::App app{
+      "pvs: precomputed visibility for virtual environments (vislib "
+      "0.1.0)",
+      "pvs"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "pvs 0.1.0");
   auto& reg = pvs_cli::registry();
@@ -65,6 +71,11 @@ int main(int argc, char** argv) {
     return e.code;
   } catch (const vislib::InputError& e) {
     std::fprintf(stderr, "pvs: error: %s\n", e.what());
+    return 2;
+  } catch (const pvs::FormatError& e) {
+    // A bad PVS file that no command named (commands read PVS files through vislib::reading_pvs,
+    // which names the file); still bad input.
+    std::fprintf(stderr, "pvs: error: PVS file: %s\n", e.what());
     return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pvs: error: %s\n", e.what());

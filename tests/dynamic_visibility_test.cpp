@@ -1,21 +1,24 @@
 // The dynamic kernel (moving triangles, spheres, the two modes) against a double-precision
 // brute-force ray caster at sampled times (math note §8 with §3-4), plus the hard cases H14, H15
 // and the sphere cases of the dynamic-scenes issue.
+#include "vislib/kernel/dynamic_visibility.h"
+
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 
 #include <atomic>
+#include <cmath>
 #include <memory>
 #include <mutex>
-#include <cmath>
 
 #include "tests/scene_builders.h"
+#include "tests/support/ray_oracle.h"
 #include "tests/test_support.h"
 #include "vislib/eval/embree_scene.h"
+#include "vislib/kernel/segment_visibility.h"
+#include "vislib/kernel/static_coverage.h"
 #include "vislib/scene/generate.h"
 #include "vislib/scene/import.h"
-#include "tests/support/ray_oracle.h"
-#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 
@@ -30,7 +33,8 @@ struct RefHit {
 // scene at animation time tau, from `eye` along d, lambda > near.
 RefHit reference(const Scene& s, double tau, Vec3 eye, Vec3 d, double near) {
   RefHit r;
-  OracleSample tri = s.triangle_count() ? brute_force_first_hit(s, tau, eye, d, near) : OracleSample{};
+  OracleSample tri =
+      s.triangle_count() ? brute_force_first_hit(s, tau, eye, d, near) : OracleSample{};
   double best = tri.tri == kNoHit ? INFINITY : tri.lambda;
   r.id = tri.tri;
   r.ambiguous = tri.ambiguous;
@@ -49,7 +53,8 @@ RefHit reference(const Scene& s, double tau, Vec3 eye, Vec3 d, double near) {
     double sq = std::sqrt(g);
     double l1 = h < 0 ? m / (-h + sq) : (-h - sq) / dd, l2 = (-h + sq) / dd;
     double lam = l1 > near ? l1 : (l2 > near ? l2 : INFINITY);
-    if (std::fabs(l1 - near) < 1e-9 * near + 1e-12 || std::fabs(l2 - near) < 1e-9 * near + 1e-12) r.ambiguous = true;
+    if (std::fabs(l1 - near) < 1e-9 * near + 1e-12 || std::fabs(l2 - near) < 1e-9 * near + 1e-12)
+      r.ambiguous = true;
     if (!std::isfinite(lam)) continue;
     if (std::fabs(lam - best) <= 1e-7 * std::max(lam, best)) r.ambiguous = true;
     if (lam < best) {
@@ -68,8 +73,8 @@ struct Counts {
 // Diagonal mode (tau = t): forward check at random t and converse check at every piece middle.
 // With `embree`, the forward check first asks Embree rebuilt at each sampled time (triangles only)
 // and consults the brute-force reference only where Embree disagrees (float vs double).
-Counts check_diagonal(const Scene& s, Vec3 v0, Vec3 v1, const Mat3& R, int n, double near, int samples,
-                      uint64_t seed, bool embree = false) {
+Counts check_diagonal(const Scene& s, Vec3 v0, Vec3 v1, const Mat3& R, int n, double near,
+                      int samples, uint64_t seed, bool embree = false) {
   SegmentOptions o;
   o.resolution = n;
   o.near = near;
@@ -108,9 +113,10 @@ Counts check_diagonal(const Scene& s, Vec3 v0, Vec3 v1, const Mat3& R, int n, do
       (converse ? fp : miss)++;
       std::lock_guard<std::mutex> g(mu);
       if (first.empty())
-        first = std::string(converse ? "false positive" : "miss") + " face " + std::to_string(face) + " x " +
-                std::to_string(x) + " y " + std::to_string(y) + " t " + std::to_string(t) + " kernel " +
-                std::to_string(int(ours)) + " reference " + std::to_string(int(ref.id));
+        first = std::string(converse ? "false positive" : "miss") + " face " +
+                std::to_string(face) + " x " + std::to_string(x) + " y " + std::to_string(y) +
+                " t " + std::to_string(t) + " kernel " + std::to_string(int(ours)) + " reference " +
+                std::to_string(int(ref.id));
     };
     for (size_t ti = 0; ti < ts.size(); ++ti) {
       const double t = ts[ti];
@@ -142,9 +148,12 @@ void expect_clean(const Counts& c, const char* what, double max_ambiguous = 0.01
   EXPECT_EQ(c.false_positives, 0u) << what << ": " << c.first;
   EXPECT_GT(c.forward, 1000u) << what;
   EXPECT_LT(double(c.ambiguous), max_ambiguous * double(c.forward + c.converse) + 5) << what;
-  std::printf("[dynamic oracle] %s: forward %llu, converse %llu, ambiguous %llu, misses %llu, false positives %llu\n",
-              what, (unsigned long long)c.forward, (unsigned long long)c.converse, (unsigned long long)c.ambiguous,
-              (unsigned long long)c.misses, (unsigned long long)c.false_positives);
+  std::printf(
+      "[dynamic oracle] %s: forward %llu, converse %llu, ambiguous %llu, misses %llu, false "
+      "positives %llu\n",
+      what, (unsigned long long)c.forward, (unsigned long long)c.converse,
+      (unsigned long long)c.ambiguous, (unsigned long long)c.misses,
+      (unsigned long long)c.false_positives);
 }
 
 // A soup of triangles each moving (and turning) linearly over `states` key states.
@@ -153,13 +162,16 @@ Scene moving_soup(int count, int states, uint64_t seed, double extent, double si
   Scene s;
   s.positions.resize(states);
   for (int i = 0; i < count; ++i) {
-    Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent), rng.uniform(-extent, extent)};
+    Vec3 c{rng.uniform(-extent, extent), rng.uniform(-extent, extent),
+           rng.uniform(-extent, extent)};
     uint32_t b = uint32_t(s.positions[0].size());
     for (int v = 0; v < 3; ++v) {
-      Vec3 p = c + Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)};
+      Vec3 p =
+          c + Vec3{rng.uniform(-size, size), rng.uniform(-size, size), rng.uniform(-size, size)};
       for (int k = 0; k < states; ++k) {
         s.positions[k].push_back(p);
-        p = p + Vec3{rng.uniform(-motion, motion), rng.uniform(-motion, motion), rng.uniform(-motion, motion)};
+        p = p + Vec3{rng.uniform(-motion, motion), rng.uniform(-motion, motion),
+                     rng.uniform(-motion, motion)};
       }
     }
     s.triangles.push_back({b, b + 1, b + 2});
@@ -194,13 +206,16 @@ TEST(DynamicVisibility, StaticSceneThroughTheDynamicKernelMatchesTheLinearKernel
 TEST(DynamicVisibility, MovingAndTurningTrianglesMatchTheReferenceAtSampledTimes) {
   // Vertices move independently, so triangles turn through edge-on (H14: sigma flips).
   Scene s = moving_soup(250, 3, 7, 6, 1.5, 2.0);
-  expect_clean(check_diagonal(s, {0, 0, 0}, {2, 1, -1}, random_orientation(3), 40, 0.01, 6, 1), "moving soup");
+  expect_clean(check_diagonal(s, {0, 0, 0}, {2, 1, -1}, random_orientation(3), 40, 0.01, 6, 1),
+               "moving soup");
 }
 
 TEST(DynamicVisibility, H14_TriangleTurningThroughEdgeOnIsCoveredExactlyWhenFacingTheRay) {
   // One triangle spinning about the x axis in front of a fixed eye: edge-on at tau = 0.5.
   Scene s;
-  s.positions = {{{-1, -1, 5}, {1, -1, 5}, {0, 1, 5}}, {{-1, -1, 5}, {1, -1, 5}, {0, -1, 7}}, {{-1, -1, 5}, {1, -1, 5}, {0, -3, 5}}};
+  s.positions = {{{-1, -1, 5}, {1, -1, 5}, {0, 1, 5}},
+                 {{-1, -1, 5}, {1, -1, 5}, {0, -1, 7}},
+                 {{-1, -1, 5}, {1, -1, 5}, {0, -3, 5}}};
   s.triangles = {{0, 1, 2}};
   s.triangle_object = {0};
   s.objects = {{"spinner"}};
@@ -209,9 +224,11 @@ TEST(DynamicVisibility, H14_TriangleTurningThroughEdgeOnIsCoveredExactlyWhenFaci
 
 TEST(DynamicVisibility, H15_FourCoverageIntervalsOfOneMovingTriangleAtOnePixel) {
   // The witness of search_intervals.py: z = 10, eye fixed at the origin, d = +z (N = 1 on +Z).
-  double V0[3][2] = {{0.4576821423384487, 0.24706675268238376}, {-0.688258553731099, 0.7557804641488242},
+  double V0[3][2] = {{0.4576821423384487, 0.24706675268238376},
+                     {-0.688258553731099, 0.7557804641488242},
                      {-0.8985668004318588, -0.5328682352724976}};
-  double V1[3][2] = {{-25.563507330937078, -15.818740074503603}, {29.312488846201276, -28.37074709207861},
+  double V1[3][2] = {{-25.563507330937078, -15.818740074503603},
+                     {29.312488846201276, -28.37074709207861},
                      {-28.028873885457422, 28.82514057563443}};
   Scene s;
   s.positions.resize(2);
@@ -229,8 +246,10 @@ TEST(DynamicVisibility, H15_FourCoverageIntervalsOfOneMovingTriangleAtOnePixel) 
   auto r = dynamic_segment_visibility(s, {0, 0, 0}, {0, 0, 0}, o);
   const auto& l = r.general_pieces[4];  // face +Z, pixel (0,0): d = (0,0,1)
   ASSERT_EQ(l.size(), 4u);
-  const double expect[4][2] = {{0.0, 0.0012088241478774916}, {0.015334695445606497, 0.017222377573659204},
-                               {0.02519742889223435, 0.02722625191932012}, {0.7723508078604829, 1.0}};
+  const double expect[4][2] = {{0.0, 0.0012088241478774916},
+                               {0.015334695445606497, 0.017222377573659204},
+                               {0.02519742889223435, 0.02722625191932012},
+                               {0.7723508078604829, 1.0}};
   for (int k = 0; k < 4; ++k) {
     EXPECT_NEAR(l[k].t0, expect[k][0], 1e-12);
     EXPECT_NEAR(l[k].t1, expect[k][1], 1e-12);
@@ -249,13 +268,15 @@ TEST(DynamicVisibility, BouncingSpheresOverAGroundMatchTheReference) {
     Vec3 c{rng.uniform(-15, 15), rng.uniform(0, 6), rng.uniform(-15, 15)};
     for (int k = 0; k < K; ++k) {
       s.sphere_centers[k].push_back(c);
-      c = c + Vec3{rng.uniform(-3, 3), rng.uniform(-2, 2), rng.uniform(-3, 3)};  // may interpenetrate
+      c = c +
+          Vec3{rng.uniform(-3, 3), rng.uniform(-2, 2), rng.uniform(-3, 3)};  // may interpenetrate
     }
     s.sphere_radius.push_back(r);
     s.sphere_object.push_back(uint32_t(s.objects.size()));
     s.objects.push_back({"sphere" + std::to_string(i)});
   }
-  expect_clean(check_diagonal(s, {-2, 1, -1}, {3, 1.5, 2}, random_orientation(4), 40, 0.01, 5, 3), "spheres");
+  expect_clean(check_diagonal(s, {-2, 1, -1}, {3, 1.5, 2}, random_orientation(4), 40, 0.01, 5, 3),
+               "spheres");
 }
 
 TEST(DynamicVisibility, EyeInsideASphereSeesItsInsideAndGrazingRaysDoNotBreakAnything) {
@@ -266,7 +287,8 @@ TEST(DynamicVisibility, EyeInsideASphereSeesItsInsideAndGrazingRaysDoNotBreakAny
   s.objects = {{"a"}, {"b"}, {"c"}};
   // The eye starts inside sphere a and leaves it (the inside is seen through the far root); b is
   // grazed by rays near its silhouette and hidden by a; c and b interpenetrate.
-  expect_clean(check_diagonal(s, {0.2, 0, -0.3}, {0, 0, -3}, Mat3{}, 48, 0.01, 8, 4), "inside/grazing");
+  expect_clean(check_diagonal(s, {0.2, 0, -0.3}, {0, 0, -3}, Mat3{}, 48, 0.01, 8, 4),
+               "inside/grazing");
   SegmentOptions o;
   o.resolution = 16;
   auto r = dynamic_segment_visibility(s, {0.2, 0, -0.3}, {0, 0, -3}, o);
@@ -278,7 +300,7 @@ TEST(DynamicVisibility, DecoupledModeFindsWhatTheDiagonalMissesAndKeepsEverythin
   // in front of the target by mid-animation: on the diagonal the target is never seen; with the
   // eye at v1 early in the animation it is.
   Scene s;
-  vislib_test::add_quad(s, {-1, -1, 10}, {1, -1, 10}, {1, 1, 10}, {-1, 1, 10});          // target 0-1
+  vislib_test::add_quad(s, {-1, -1, 10}, {1, -1, 10}, {1, 1, 10}, {-1, 1, 10});  // target 0-1
   vislib_test::add_quad(s, {-40, -20, 5}, {-0.5, -20, 5}, {-0.5, 20, 5}, {-40, 20, 5});  // wall 2-3
   size_t occ = s.positions[0].size();
   vislib_test::add_quad(s, {20, -3, 8}, {26, -3, 8}, {26, 3, 8}, {20, 3, 8});  // occluder 4-5
@@ -292,7 +314,9 @@ TEST(DynamicVisibility, DecoupledModeFindsWhatTheDiagonalMissesAndKeepsEverythin
   auto a = dynamic_segment_visibility(s, {-5, 0, 0}, {0, 0, 0}, o);
   o.mode = DynamicMode::Decoupled;
   auto b = dynamic_segment_visibility(s, {-5, 0, 0}, {0, 0, 0}, o);
-  auto has = [](const std::vector<uint32_t>& v, uint32_t id) { return std::find(v.begin(), v.end(), id) != v.end(); };
+  auto has = [](const std::vector<uint32_t>& v, uint32_t id) {
+    return std::find(v.begin(), v.end(), id) != v.end();
+  };
   EXPECT_FALSE(has(a.visible, 0) || has(a.visible, 1));
   EXPECT_TRUE(has(b.visible, 0) || has(b.visible, 1));
   for (uint32_t id : a.visible) EXPECT_TRUE(has(b.visible, id));
@@ -310,8 +334,8 @@ TEST(DynamicVisibility, BoxAnimatedMatchesTheReferenceAtSampledTimes) {
   // overlapping coplanar triangles within one face (e.g. ids 246 and 247 both contain the same
   // points at the same depth): the kernel gives such ties to the lower id, the reference cannot
   // judge them and calls them ambiguous (measured: ~6% of samples), hence the 10% budget.
-  expect_clean(check_diagonal(s, c + Vec3{-1.5 * e.x, 0.3 * e.y, 1.2 * e.z}, c + Vec3{1.5 * e.x, 0.1 * e.y, 1.0 * e.z},
-                              Mat3{}, 48, 0.01, 6, 5),
+  expect_clean(check_diagonal(s, c + Vec3{-1.5 * e.x, 0.3 * e.y, 1.2 * e.z},
+                              c + Vec3{1.5 * e.x, 0.1 * e.y, 1.0 * e.z}, Mat3{}, 48, 0.01, 6, 5),
                "BoxAnimated", 0.10);
 }
 
@@ -324,7 +348,8 @@ TEST(DynamicVisibility, SwayingGrassMatchesEmbreeRebuiltAtSampledTimes) {
   Scene s = generate_grass(g);
   ASSERT_TRUE(s.is_dynamic());
   // Eye low over the grass, walking through it.
-  Counts c = check_diagonal(s, {-2, 0.4, -1}, {2, 0.6, 1.5}, random_orientation(6), 48, 0.01, 4, 7, true);
+  Counts c =
+      check_diagonal(s, {-2, 0.4, -1}, {2, 0.6, 1.5}, random_orientation(6), 48, 0.01, 4, 7, true);
   expect_clean(c, "grass");
 }
 
@@ -339,5 +364,6 @@ TEST(DynamicVisibility, GeneratedBouncingSpheresOverAGroundMatchTheReference) {
   Scene ground;
   vislib_test::add_quad(ground, {-25, 0, -25}, {-25, 0, 25}, {25, 0, 25}, {25, 0, -25});
   append_scene(s, ground);
-  expect_clean(check_diagonal(s, {-3, 1.7, -2}, {4, 1.7, 3}, random_orientation(8), 40, 0.01, 5, 9), "bouncing spheres");
+  expect_clean(check_diagonal(s, {-3, 1.7, -2}, {4, 1.7, 3}, random_orientation(8), 40, 0.01, 5, 9),
+               "bouncing spheres");
 }

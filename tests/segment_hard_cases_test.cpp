@@ -7,10 +7,12 @@
 #include <cmath>
 
 #include "tests/scene_builders.h"
-#include "vislib/kernel/footprint.h"
-#include "vislib/base/polynomial.h"
 #include "tests/support/ray_oracle.h"
+#include "vislib/base/polynomial.h"
+#include "vislib/kernel/dynamic_visibility.h"
+#include "vislib/kernel/footprint.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/kernel/static_coverage.h"
 
 using namespace vislib;
 using vislib_test::soup;
@@ -66,7 +68,8 @@ TEST(SegmentHardCases, H2_PersistentOnEdgeTieGivesExactlyOneTriangleAtEveryPixel
   for (int x = 0; x < N; ++x) {
     Vec3 d = pixel_direction(ax, x, 2, N);
     ASSERT_EQ(d.y, 0.0);
-    Cov a = coverage(t1, v0, v1, d, 1e-9, ax.S, ax.T), b = coverage(t2, v0, v1, d, 1e-9, ax.S, ax.T);
+    Cov a = coverage(t1, v0, v1, d, 1e-9, ax.S, ax.T),
+        b = coverage(t2, v0, v1, d, 1e-9, ax.S, ax.T);
     EXPECT_NE(a.covered, b.covered) << "pixel " << x;
     const Cov& w = a.covered ? a : b;
     EXPECT_EQ(w.lo, 0.0);
@@ -109,9 +112,9 @@ TEST(SegmentHardCases, H4_TriangleEdgeOnAlongTheWholeSegmentCoversNothing) {
 }
 
 TEST(SegmentHardCases, H5_DegenerateTrianglesAreNeverVisible) {
-  Scene s = soup({{Vec3{-1, -1, 3}, {0, 0, 3}, {1, 1, 3}},   // collinear
+  Scene s = soup({{Vec3{-1, -1, 3}, {0, 0, 3}, {1, 1, 3}},    // collinear
                   {Vec3{-1, -1, 3}, {-1, -1, 3}, {1, 0, 3}},  // repeated vertex
-                  {Vec3{2, 2, 2}, {2, 2, 2}, {2, 2, 2}}});     // a point
+                  {Vec3{2, 2, 2}, {2, 2, 2}, {2, 2, 2}}});    // a point
   SegmentOptions o;
   o.resolution = 64;
   auto r = segment_visibility(s, {-0.5, 0, 0}, {0.5, 0.2, 0}, o);
@@ -120,8 +123,9 @@ TEST(SegmentHardCases, H5_DegenerateTrianglesAreNeverVisible) {
 
 TEST(SegmentHardCases, H6_BackgroundBehindAJitteredSharedEdgeGridNeverLeaks) {
   Scene s;
-  vislib_test::add_grid(s, 16, -20, 20, -20, 20,
-                        [](double x, double y) { return 5 + 0.3 * std::sin(x) * std::cos(y); }, 7, 0.8);
+  vislib_test::add_grid(
+      s, 16, -20, 20, -20, 20,
+      [](double x, double y) { return 5 + 0.3 * std::sin(x) * std::cos(y); }, 7, 0.8);
   uint32_t first_bg = uint32_t(s.triangle_count());
   vislib_test::add_quad(s, {-6, -6, 10}, {6, -6, 10}, {6, 6, 10}, {-6, 6, 10});
   SegmentOptions o;
@@ -144,8 +148,10 @@ TEST(SegmentHardCases, H7_TJunctionLeaksNothingExactAndNothingAfterEpsLenWhenRou
     // Edge PQ of the big triangle is shared by two small triangles meeting at M on it.
     Vec3 P{-4, -1, 5}, Q{4, 1.3, 5}, M = (P + Q) * 0.5;
     if (rounded) M = M + Vec3{1e-15, -2e-15, 0};
-    Scene s = soup({{P, Q, Vec3{0, 8, 5}}, {M, P, Vec3{-3, -8, 5}}, {Q, M, Vec3{-3, -8, 5}},
-              {Q, Vec3{-3, -8, 5}, Vec3{6, -8, 5}}});
+    Scene s = soup({{P, Q, Vec3{0, 8, 5}},
+                    {M, P, Vec3{-3, -8, 5}},
+                    {Q, M, Vec3{-3, -8, 5}},
+                    {Q, Vec3{-3, -8, 5}, Vec3{6, -8, 5}}});
     uint32_t bg = uint32_t(s.triangle_count());
     vislib_test::add_quad(s, {-2, -2, 9}, {2, -2, 9}, {2, 2, 9}, {-2, 2, 9});
     SegmentOptions o;
@@ -213,9 +219,15 @@ using Q = CGAL::Gmpq;
 struct QV {
   Q x, y, z;
 };
-QV qv(Vec3 a) { return {Q(a.x), Q(a.y), Q(a.z)}; }
-QV operator-(const QV& a, const QV& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Q qdot(const QV& a, const QV& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+QV qv(Vec3 a) {
+  return {Q(a.x), Q(a.y), Q(a.z)};
+}
+QV operator-(const QV& a, const QV& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+Q qdot(const QV& a, const QV& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 QV qcross(const QV& a, const QV& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
@@ -315,7 +327,8 @@ TEST(SegmentHardCases, H12_FootprintContainsEveryCoveredPixelWhenVerticesAreBehi
           for (int x = 0; x < N; ++x) {
             double lo, hi;
             LinearDepth dep;
-            if (!static_coverage(st, pixel_direction(ax, x, y, N), ax.S, ax.T, near, lo, hi, dep)) continue;
+            if (!static_coverage(st, pixel_direction(ax, x, y, N), ax.S, ax.T, near, lo, hi, dep))
+              continue;
             ++covered;
             int x0, x1;
             if (!footprint_row_span(fp, N, y, x0, x1) || x < x0 || x > x1) ++missed;
@@ -355,7 +368,8 @@ TEST(SegmentHardCases, H13_ZeroLengthSegmentEqualsFromPointVisibility) {
           EXPECT_EQ(p.t1, 1.0);
         }
         ASSERT_LE(l.size(), 1u);
-        OracleSample ref = brute_force_first_hit(s, 0.0, v, pixel_direction(ax, x, y, o.resolution), o.near);
+        OracleSample ref =
+            brute_force_first_hit(s, 0.0, v, pixel_direction(ax, x, y, o.resolution), o.near);
         if (ref.ambiguous) continue;
         ++compared;
         uint32_t ours = l.empty() ? kNoHit : l[0].id;

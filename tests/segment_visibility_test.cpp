@@ -1,4 +1,6 @@
 // Semantic, determinism and compositing tests of the from-segment kernel.
+#include "vislib/kernel/segment_visibility.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
@@ -7,13 +9,11 @@
 
 #include "tests/scene_builders.h"
 #include "vislib/kernel/region_visibility.h"
-#include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;
 using vislib_test::random_soup;
 
 namespace {
-
 
 bool same_lists(const std::vector<PieceList>& a, const std::vector<PieceList>& b,
                 const std::vector<uint32_t>* map_b_to_a = nullptr) {
@@ -32,9 +32,10 @@ bool same_lists(const std::vector<PieceList>& a, const std::vector<PieceList>& b
 
 TEST(SegmentVisibility, WallHidesWhatIsBehindItFromTheWholeSegment) {
   Scene s;
-  vislib_test::add_quad(s, {-10, -10, 5}, {10, -10, 5}, {10, 10, 5}, {-10, 10, 5});   // wall, ids 0-1
-  vislib_test::add_quad(s, {-1, -1, 8}, {1, -1, 8}, {1, 1, 8}, {-1, 1, 8});           // hidden, 2-3
-  vislib_test::add_quad(s, {-1, -1, -4}, {1, -1, -4}, {1, 1, -4}, {-1, 1, -4});       // behind eye, 4-5
+  vislib_test::add_quad(s, {-10, -10, 5}, {10, -10, 5}, {10, 10, 5},
+                        {-10, 10, 5});                                           // wall, ids 0-1
+  vislib_test::add_quad(s, {-1, -1, 8}, {1, -1, 8}, {1, 1, 8}, {-1, 1, 8});      // hidden, 2-3
+  vislib_test::add_quad(s, {-1, -1, -4}, {1, -1, -4}, {1, 1, -4}, {-1, 1, -4});  // behind eye, 4-5
   SegmentOptions o;
   o.resolution = 64;
   auto r = segment_visibility(s, {-1, 0, 0}, {1, 0, 0}, o);
@@ -111,7 +112,8 @@ TEST(SegmentVisibility, ShuffledTriangleOrderGivesTheSameSetAndPieces) {
 
 TEST(SegmentVisibility, DepthCullingChangesNothingButWork) {
   Scene s;
-  vislib_test::add_grid(s, 30, -30, 30, -30, 30, [](double x, double y) { return 6 + std::sin(0.3 * x); }, 1, 0.5);
+  vislib_test::add_grid(
+      s, 30, -30, 30, -30, 30, [](double x, double y) { return 6 + std::sin(0.3 * x); }, 1, 0.5);
   Scene far = random_soup(500, 8, 6, 1);
   for (auto& p : far.positions[0]) p.z += 30;  // all behind the grid
   append_scene(s, far);
@@ -133,7 +135,20 @@ TEST(SegmentVisibility, EveryFinalListIsSortedDisjointAndMerged) {
   o.resolution = 32;
   o.want_pieces = true;
   auto r = segment_visibility(s, {-2, 0, 0}, {2, 0, 0}, o);
-  for (const auto& l : r.pieces) EXPECT_TRUE(is_valid(l));
+  // Every pixel's list comes back, and a soup all around the segment covers many pixels: the check
+  // below must see pieces, not pass on empty lists.
+  ASSERT_EQ(r.pieces.size(), size_t(6 * 32 * 32));
+  size_t pixels_with_pieces = 0, pieces = 0;
+  for (const auto& l : r.pieces) {
+    EXPECT_TRUE(is_valid(l));
+    pixels_with_pieces += !l.empty();
+    pieces += l.size();
+  }
+  EXPECT_GT(pixels_with_pieces, r.pieces.size() / 10);
+  EXPECT_EQ(pixels_with_pieces, r.stats.pixels_with_pieces);
+  EXPECT_EQ(pieces, r.stats.final_pieces);
+  EXPECT_GT(pieces,
+            pixels_with_pieces);  // some pixels see more than one triangle along the segment
 }
 
 TEST(IntervalList, ResultDoesNotDependOnInsertionOrder) {
@@ -207,6 +222,7 @@ TEST(RegionVisibility, UnionGrowsWithRunsAndRunZeroIsAxisAligned) {
   ASSERT_EQ(r.runs.size(), 12u);
   EXPECT_TRUE(is_rotation(r.runs[1].orientation));
   EXPECT_EQ(r.runs[0].orientation.m[0], 1.0);
-  for (size_t k = 1; k < r.runs.size(); ++k) EXPECT_GE(r.runs[k].union_size_after, r.runs[k - 1].union_size_after);
+  for (size_t k = 1; k < r.runs.size(); ++k)
+    EXPECT_GE(r.runs[k].union_size_after, r.runs[k - 1].union_size_after);
   EXPECT_EQ(r.runs.back().union_size_after, r.visible.size());
 }

@@ -13,6 +13,21 @@ constexpr double kDefaultEpsLen = 1e-12;
 // towards scanning more pixels (safe: coverage is decided exactly afterwards).
 constexpr double kFootprintMargin = 1e-6;
 
+// Relative part of the footprint margin: the margin grows by this share of the largest |u| or |w|
+// of the footprint's points (face coordinates; points near the near plane project far out and their
+// rounding grows with them). Unitless, relative. Errs towards scanning more pixels (safe).
+constexpr double kFootprintRelativeMargin = 1e-12;
+
+// Quick reject of a primitive against a face's frustum: the planes |u| <= 1 and |w| <= 1 are
+// widened by this relative share of the point's depth (unitless) before all points are tested to
+// lie outside one plane. Errs towards keeping primitives (the exact clip decides afterwards).
+constexpr double kFrustumRejectWidening = 1e-6;
+
+// Two moving spheres whose centres stay farther apart than (1 + this) times the sum of their radii
+// (relative, unitless) keep their depth order, and their crossing search is skipped (math note §4).
+// Errs towards searching (a pair within the band is searched exactly).
+constexpr double kDisjointSpheresSlack = 1e-9;
+
 // Default near plane: view-space depth (scene units, metres for our scenes) below which hits do
 // not count; a typical headset near plane.
 constexpr double kDefaultNear = 0.01;

@@ -13,6 +13,8 @@
 //     moves v0 -> v1.
 // Inside a run, primitives that do not move use the linear events of the static kernel; only
 // moving triangles use quadratic edge events and the cubic in-front condition.
+#include "vislib/kernel/dynamic_visibility.h"
+
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -20,11 +22,13 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 
-#include "vislib/kernel/footprint.h"
 #include "vislib/base/polynomial.h"
-#include "vislib/kernel/segment_visibility.h"
+#include "vislib/base/tolerances.h"
+#include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
+#include "vislib/kernel/static_coverage.h"
 
 namespace vislib {
 
@@ -40,7 +44,8 @@ double GeneralDepth::at(double t) const {
   return h < 0 ? m / (-h + sq) : (-h - sq) / dd;  // stable form of the near root (§4)
 }
 
-int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi, double* out) {
+int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi,
+                    double* out) {
   if (i.kind == GeneralDepth::Rational && j.kind == GeneralDepth::Rational) {
     // sign(lambda_i - lambda_j) = sign(P) sign(D_i D_j), P = N_i D_j - N_j D_i (deg <= 5).
     double P[6] = {};
@@ -64,20 +69,21 @@ int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, dou
     double bb = dot(b, b), tm = bb > 0 ? std::clamp(-dot(a, b) / bb, 0.0, 1.0) : 0.0;
     Vec3 m = a + b * tm;
     double rr = i.c[15] + j.c[15];
-    if (dot(m, m) > rr * rr * (1 + 1e-9)) return 0;
+    if (dot(m, m) > rr * rr * (1 + kDisjointSpheresSlack)) return 0;
   }
   // A sphere is involved. At a crossing the ray's point at the common depth lies on both
   // surfaces, so the crossing times are among the roots of a polynomial (exact, no sampling):
   //   sphere-sphere:   Q = den^2 m_i + 2 den num h_i + num^2 |d|^2   (degree 4), with
-  //                    den = 2 (h_i - h_j), num = m_j - m_i (lambda = num / den on the radical plane);
+  //                    den = 2 (h_i - h_j), num = m_j - m_i (lambda = num / den on the radical
+  //                    plane);
   //   sphere-triangle: Q = D^2 m + 2 N D h + N^2 |d|^2               (degree 6), lambda = N / D.
   // Extra roots (e.g. where the far root meets) only add cut points; each sub-piece's winner is
   // decided at its midpoint.
   double Q[7] = {};
-  auto mul = [](const double* a, int da, const double* b, int db, double* out) {
-    for (int x = 0; x <= da + db; ++x) out[x] = 0;
+  auto mul = [](const double* a, int da, const double* b, int db, double* product) {
+    for (int x = 0; x <= da + db; ++x) product[x] = 0;
     for (int x = 0; x <= da; ++x)
-      for (int y = 0; y <= db; ++y) out[x + y] += a[x] * b[y];
+      for (int y = 0; y <= db; ++y) product[x + y] += a[x] * b[y];
   };
   int deg;
   if (i.kind != GeneralDepth::Rational && j.kind != GeneralDepth::Rational) {
@@ -120,7 +126,15 @@ int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, dou
 
 namespace {
 
-constexpr int kMaxIntervals = 6;
+// Breakpoints of a pixel's coverage along the segment: t = 0 and 1, plus the roots of the three
+// quadratic edge functions and of the cubic near-plane function (moving triangles, §3.3), or of
+// the sphere's two quadratics and one linear function (§4). Between two breakpoints the coverage
+// does not change, so a pixel has at most one interval per pair of consecutive breakpoints:
+// kMaxIntervals is that bound, so that no interval is ever dropped (the coverage functions throw
+// rather than overflow, which would be a bug in the bound).
+constexpr int kMaxTriangleBreakpoints = 1 + 3 * 2 + 3 + 1;
+constexpr int kMaxSphereBreakpoints = 1 + 2 + 1 + 2 + 1;
+constexpr int kMaxIntervals = std::max(kMaxTriangleBreakpoints, kMaxSphereBreakpoints) - 1;
 
 // Sorts a few doubles in place (std::sort on a tiny fixed array trips GCC's -Warray-bounds).
 void sort_small(double* a, int n) {
@@ -132,7 +146,7 @@ void sort_small(double* a, int n) {
 
 struct MovingTriangle {
   bool moving = false;
-  StaticTriangle lin;     // when !moving: the static kernel's linear quantities
+  StaticTriangle lin;  // when !moving: the static kernel's linear quantities
   Vec3 K0[3], K1[3], K2[3];
   double rho[3];
   Vec3 n0, n1, n2;
@@ -145,7 +159,8 @@ bool less6(Vec3 a0, Vec3 a1, Vec3 b0, Vec3 b1) {
   return lex_less(a1, b1);
 }
 
-MovingTriangle prepare_moving(const std::array<Vec3, 3>& c0, const std::array<Vec3, 3>& c1, Vec3 e0, Vec3 e1) {
+MovingTriangle prepare_moving(const std::array<Vec3, 3>& c0, const std::array<Vec3, 3>& c1, Vec3 e0,
+                              Vec3 e1) {
   MovingTriangle mt;
   mt.moving = c0 != c1;
   const Vec3 delta = e1 - e0;
@@ -210,7 +225,8 @@ int moving_coverage(const MovingTriangle& mt, Vec3 d, Vec3 S, Vec3 T, double nea
     double s0 = dot(d, mt.K0[e]), s1 = dot(d, mt.K1[e]), s2 = dot(d, mt.K2[e]);
     if (s0 == 0 && s1 == 0 && s2 == 0) {  // persistent on-edge tie: d + eps S + eps^2 T (§2.5)
       s0 = dot(S, mt.K0[e]), s1 = dot(S, mt.K1[e]), s2 = dot(S, mt.K2[e]);
-      if (s0 == 0 && s1 == 0 && s2 == 0) s0 = dot(T, mt.K0[e]), s1 = dot(T, mt.K1[e]), s2 = dot(T, mt.K2[e]);
+      if (s0 == 0 && s1 == 0 && s2 == 0)
+        s0 = dot(T, mt.K0[e]), s1 = dot(T, mt.K1[e]), s2 = dot(T, mt.K2[e]);
     }
     Sx[e][0] = mt.rho[e] * s0;
     Sx[e][1] = mt.rho[e] * s1;
@@ -218,7 +234,7 @@ int moving_coverage(const MovingTriangle& mt, Vec3 d, Vec3 S, Vec3 T, double nea
   }
   double D[3] = {dot(d, mt.n0), dot(d, mt.n1), dot(d, mt.n2)};
   double G[4] = {mt.N[0] - near * D[0], mt.N[1] - near * D[1], mt.N[2] - near * D[2], mt.N[3]};
-  double pts[16];
+  double pts[kMaxTriangleBreakpoints];
   int np = 0;
   pts[np++] = 0;
   for (int e = 0; e < 3; ++e) np += poly_roots_in(Sx[e], 2, 0, 1, pts + np);
@@ -238,8 +254,8 @@ int moving_coverage(const MovingTriangle& mt, Vec3 d, Vec3 S, Vec3 T, double nea
       out[n - 1].hi = b;
       continue;
     }
-    assert(n < kMaxIntervals);
-    if (n == kMaxIntervals) break;
+    if (n == kMaxIntervals)
+      throw std::logic_error("moving_coverage: more intervals than breakpoints");
     out[n].lo = a;
     out[n].hi = b;
     out[n].depth.kind = GeneralDepth::Rational;
@@ -264,7 +280,7 @@ int sphere_coverage(const MovingSphere& sp, Vec3 d, double near, Interval* out) 
   double hn[2] = {dot(d, sp.w0) + near * dd, dot(d, sp.w1)};
   Vec3 z0 = sp.w0 + d * near;
   double M[3] = {dot(z0, z0) - r2, 2.0 * dot(z0, sp.w1), dot(sp.w1, sp.w1)};
-  double pts[10];
+  double pts[kMaxSphereBreakpoints];
   int np = 0;
   pts[np++] = 0;
   np += poly_roots_in(g, 2, 0, 1, pts + np);
@@ -304,7 +320,8 @@ int sphere_coverage(const MovingSphere& sp, Vec3 d, double near, Interval* out) 
       out[n - 1].hi = b;
       continue;
     }
-    if (n == kMaxIntervals) break;
+    if (n == kMaxIntervals)
+      throw std::logic_error("sphere_coverage: more intervals than breakpoints");
     out[n].lo = a;
     out[n].hi = b;
     out[n].depth = base;
@@ -318,8 +335,8 @@ int sphere_coverage(const MovingSphere& sp, Vec3 d, double near, Interval* out) 
 // and their bounding box (the projection of the swept capsule is the convex hull of the two end
 // projections, which the union of the two boxes does not always contain). When the sphere reaches
 // the near plane at an end: the projection of its clipped bounding box.
-bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, double near, int n, int& x0,
-                         int& x1, int& y0, int& y1) {
+bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, double near, int n,
+                         int& x0, int& x1, int& y0, int& y1) {
   double z0 = dot(ax.F, c0w), z1 = dot(ax.F, c1w);
   if (z0 + r <= near && z1 + r <= near) return false;  // the swept ball is behind the near plane
   double umin = INFINITY, umax = -INFINITY, wmin = INFINITY, wmax = -INFINITY;
@@ -327,10 +344,10 @@ bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, doubl
     // The swept ball reaches the near plane: bound it by the box around both end balls (face
     // coordinates), clip the box at z >= near and project its 8 corners (a perspective image of a
     // convex set in z > 0 is convex, so the corners give its extent).
-    Vec3 lo{std::min(dot(ax.S, c0w), dot(ax.S, c1w)) - r, std::min(dot(ax.T, c0w), dot(ax.T, c1w)) - r,
-            std::max(near, std::min(z0, z1) - r)};
-    Vec3 hi{std::max(dot(ax.S, c0w), dot(ax.S, c1w)) + r, std::max(dot(ax.T, c0w), dot(ax.T, c1w)) + r,
-            std::max(z0, z1) + r};
+    Vec3 lo{std::min(dot(ax.S, c0w), dot(ax.S, c1w)) - r,
+            std::min(dot(ax.T, c0w), dot(ax.T, c1w)) - r, std::max(near, std::min(z0, z1) - r)};
+    Vec3 hi{std::max(dot(ax.S, c0w), dot(ax.S, c1w)) + r,
+            std::max(dot(ax.T, c0w), dot(ax.T, c1w)) + r, std::max(z0, z1) + r};
     for (int k = 0; k < 8; ++k) {
       double x = (k & 1) ? hi.x : lo.x, y = (k & 2) ? hi.y : lo.y, z = (k & 4) ? hi.z : lo.z;
       umin = std::min(umin, x / z);
@@ -351,10 +368,16 @@ bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, doubl
     wmax = std::max(wmax, (cy * cz + r * sw) / den);
   }
   if (!(umin <= umax)) return false;
-  double m = kFootprintMargin + 1e-12 * std::max({std::fabs(umin), std::fabs(umax), std::fabs(wmin), std::fabs(wmax)});
+  double m = kFootprintMargin +
+             kFootprintRelativeMargin *
+                 std::max({std::fabs(umin), std::fabs(umax), std::fabs(wmin), std::fabs(wmax)});
   if (umax < -1 - m || umin > 1 + m || wmax < -1 - m || wmin > 1 + m) return false;
-  auto lo = [n](double c) { return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n))))); };
-  auto hi = [n](double c) { return std::min(n - 1, int(std::floor(std::min(double(n) + 1, pixel_coord(c, n))))); };
+  auto lo = [n](double c) {
+    return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n)))));
+  };
+  auto hi = [n](double c) {
+    return std::min(n - 1, int(std::floor(std::min(double(n) + 1, pixel_coord(c, n)))));
+  };
   x0 = lo(umin - m);
   x1 = hi(umax + m);
   y0 = lo(wmin - m);
@@ -365,23 +388,32 @@ bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, doubl
 // ---- One run ------------------------------------------------------------------------------
 
 struct Run {
-  Vec3 e0, e1;          // eye at s = 0 and s = 1
-  size_t k0, k1;        // key states at s = 0 and s = 1 (vertices and sphere centres)
-  double t0, t1;        // segment parameter at s = 0, 1
-  double tau0, tau1;    // animation time at s = 0, 1
-  bool diagonal;        // part of the Diagonal mode (its pieces map onto t)
+  Vec3 e0, e1;        // eye at s = 0 and s = 1
+  size_t k0, k1;      // key states at s = 0 and s = 1 (vertices and sphere centres)
+  double t0, t1;      // segment parameter at s = 0, 1
+  double tau0, tau1;  // animation time at s = 0, 1
+  bool diagonal;      // part of the Diagonal mode (its pieces map onto t)
 };
 
 void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
                 tbb::enumerable_thread_specific<FoundMarks>& found_by_thread,
-                std::vector<std::vector<GeneralPiece>>* pieces, std::vector<SegmentStats>& all_stats) {
+                std::vector<std::vector<GeneralPiece>>* pieces,
+                std::vector<SegmentStats>& all_stats) {
   const int N = opt.resolution, TS = opt.tile_size;
   const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
   const size_t ntri = scene.triangle_count(), nsph = scene.sphere_count(), nprim = ntri + nsph;
-  const auto& P0 = scene.positions.empty() ? std::vector<Vec3>{} : scene.positions[std::min(run.k0, scene.positions.size() - 1)];
-  const auto& P1 = scene.positions.empty() ? std::vector<Vec3>{} : scene.positions[std::min(run.k1, scene.positions.size() - 1)];
-  const auto& C0 = scene.sphere_centers.empty() ? std::vector<Vec3>{} : scene.sphere_centers[std::min(run.k0, scene.sphere_centers.size() - 1)];
-  const auto& C1 = scene.sphere_centers.empty() ? std::vector<Vec3>{} : scene.sphere_centers[std::min(run.k1, scene.sphere_centers.size() - 1)];
+  const auto& P0 = scene.positions.empty()
+                       ? std::vector<Vec3>{}
+                       : scene.positions[std::min(run.k0, scene.positions.size() - 1)];
+  const auto& P1 = scene.positions.empty()
+                       ? std::vector<Vec3>{}
+                       : scene.positions[std::min(run.k1, scene.positions.size() - 1)];
+  const auto& C0 = scene.sphere_centers.empty()
+                       ? std::vector<Vec3>{}
+                       : scene.sphere_centers[std::min(run.k0, scene.sphere_centers.size() - 1)];
+  const auto& C1 = scene.sphere_centers.empty()
+                       ? std::vector<Vec3>{}
+                       : scene.sphere_centers[std::min(run.k1, scene.sphere_centers.size() - 1)];
   auto tri_corners = [&](const std::vector<Vec3>& P, size_t t) {
     const auto& ix = scene.triangles[t];
     return std::array<Vec3, 3>{P[ix[0]], P[ix[1]], P[ix[2]]};
@@ -402,177 +434,198 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
     std::vector<double> far;  // per pixel: farthest zmax over its pieces once they cover [0,1]
   };
   tbb::enumerable_thread_specific<Scratch> scratch([TS] {
-    return Scratch{std::vector<std::vector<GeneralPiece>>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS)};
+    return Scratch{std::vector<std::vector<GeneralPiece>>(size_t(TS) * TS),
+                   std::vector<double>(size_t(TS) * TS)};
   });
 
   for (int face = 0; face < 6; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nprim, 512), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t p = r.begin(); p != r.end(); ++p) {
-        int* b = &bbox[p * 4];
-        bool ok;
-        if (p < ntri) {
-          auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
-          Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0, a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
-          ok = footprint_pixel_bounds(compute_footprint(rel, 6, axes, opt.near), N, b[0], b[1], b[2], b[3]);
-          double lo = INFINITY, hi = -INFINITY;
-          for (const Vec3& q : rel) {
-            lo = std::min(lo, dot(axes.F, q));
-            hi = std::max(hi, dot(axes.F, q));
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, nprim, 512), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t p = r.begin(); p != r.end(); ++p) {
+            int* b = &bbox[p * 4];
+            bool ok;
+            if (p < ntri) {
+              auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
+              Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0,
+                             a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
+              ok = footprint_pixel_bounds(compute_footprint(rel, 6, axes, opt.near), N, b[0], b[1],
+                                          b[2], b[3]);
+              double lo = INFINITY, hi = -INFINITY;
+              for (const Vec3& q : rel) {
+                lo = std::min(lo, dot(axes.F, q));
+                hi = std::max(hi, dot(axes.F, q));
+              }
+              zmin[p] = lo;
+              zmax[p] = hi;
+            } else {
+              size_t s = p - ntri;
+              const double radius = scene.sphere_radius[s];
+              ok = sphere_pixel_bounds(C0[s] - run.e0, C1[s] - run.e1, radius, axes, opt.near, N,
+                                       b[0], b[1], b[2], b[3]);
+              double z0 = dot(axes.F, C0[s] - run.e0), z1 = dot(axes.F, C1[s] - run.e1);
+              zmin[p] = std::min(z0, z1) - radius;
+              zmax[p] = std::max(z0, z1) + radius;
+            }
+            if (!ok) b[0] = 1, b[1] = 0;
           }
-          zmin[p] = lo;
-          zmax[p] = hi;
-        } else {
-          size_t s = p - ntri;
-          double r = scene.sphere_radius[s];
-          ok = sphere_pixel_bounds(C0[s] - run.e0, C1[s] - run.e1, r, axes, opt.near, N, b[0], b[1], b[2], b[3]);
-          double z0 = dot(axes.F, C0[s] - run.e0), z1 = dot(axes.F, C1[s] - run.e1);
-          zmin[p] = std::min(z0, z1) - r;
-          zmax[p] = std::max(z0, z1) + r;
-        }
-        if (!ok) b[0] = 1, b[1] = 0;
-      }
+        });
+    bin_by_tile(bbox, nprim, TS, tiles_x, bin_start, bins, [&](size_t p) {
+      return Binned{uint32_t(p), zmin[p]};
     });
-    bin_by_tile(bbox, nprim, TS, tiles_x, bin_start, bins, [&](size_t p) { return Binned{uint32_t(p), zmin[p]}; });
-    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-      Scratch& sc = scratch.local();
-      auto& lists = sc.lists;
-      FoundMarks& found = found_by_thread.local();
-      for (int tile = r.begin(); tile != r.end(); ++tile) {
-        SegmentStats& stats = all_stats[size_t(face) * tile_count + tile];
-        const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
-        const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
-        const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
-        for (auto& l : lists) l.clear();
-        std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-        Binned* tb = bins.data() + bin_start[tile];
-        Binned* te = bins.data() + bin_start[tile + 1];
-        // Front to back by nearest possible depth (ties by id); exact depth culling as in the
-        // static kernel, with each piece's primitive's zmax as its farthest depth.
-        std::sort(tb, te, [](const Binned& a, const Binned& b) { return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id); });
-        auto update_far = [&](size_t k) {
-          const auto& l = lists[k];
-          if (!covers_segment(l)) return;
-          double f = -INFINITY;
-          for (const GeneralPiece& pc : l) f = std::max(f, zmax[pc.id]);
-          sc.far[k] = f;
-        };
-        Interval iv[kMaxIntervals];
-        double tile_far = INFINITY;
-        int since_check = 0;
-        for (Binned* bp = tb; bp != te; ++bp) {
-          const uint32_t p = bp->id;
-          ++stats.triangle_tiles;
-          if (opt.depth_culling) {
-            if (++since_check >= 16 || bp == tb) {
-              since_check = 0;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
+          Scratch& sc = scratch.local();
+          auto& lists = sc.lists;
+          FoundMarks& found = found_by_thread.local();
+          for (int tile = r.begin(); tile != r.end(); ++tile) {
+            SegmentStats& stats = all_stats[size_t(face) * tile_count + tile];
+            const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
+            const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
+            const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
+            for (auto& l : lists) l.clear();
+            std::fill(sc.far.begin(), sc.far.end(), INFINITY);
+            Binned* tb = bins.data() + bin_start[tile];
+            Binned* te = bins.data() + bin_start[tile + 1];
+            // Front to back by nearest possible depth (ties by id); exact depth culling as in the
+            // static kernel, with each piece's primitive's zmax as its farthest depth.
+            std::sort(tb, te, [](const Binned& a, const Binned& b) {
+              return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
+            });
+            auto update_far = [&](size_t k) {
+              const auto& l = lists[k];
+              if (!covers_segment(l)) return;
               double f = -INFINITY;
-              for (int yy = 0; yy < th && f < INFINITY; ++yy)
-                for (int xx = 0; xx < tw; ++xx) f = std::max(f, sc.far[size_t(yy) * TS + xx]);
-              tile_far = f;
-            }
-            if (bp->zmin > tile_far) {
-              stats.culled_triangle_tiles += uint64_t(te - bp);
-              stats.triangle_tiles += uint64_t(te - bp) - 1;
-              break;
-            }
-          }
-          const int* b = &bbox[size_t(p) * 4];
-          const int y0 = std::max(ty0, b[2]), y1 = std::min(ty1, b[3]);
-          if (p < ntri) {
-            auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
-            MovingTriangle mt = prepare_moving(a0, a1, run.e0, run.e1);
-            if (!mt.moving && mt.lin.n == Vec3{0, 0, 0}) continue;  // degenerate (H5)
-            Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0, a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
-            Footprint fp = compute_footprint(rel, 6, axes, opt.near);
-            for (int y = y0; y <= y1; ++y) {
-              int x0, x1;
-              if (!footprint_row_span(fp, N, y, x0, x1)) continue;
-              x0 = std::max(x0, tx0);
-              x1 = std::min(x1, tx1);
-              for (int x = x0; x <= x1; ++x) {
-                const size_t k = size_t(y - ty0) * TS + (x - tx0);
-                if (opt.depth_culling && bp->zmin > sc.far[k]) {
-                  ++stats.culled_pairs;
-                  continue;
+              for (const GeneralPiece& pc : l) f = std::max(f, zmax[pc.id]);
+              sc.far[k] = f;
+            };
+            Interval iv[kMaxIntervals];
+            double tile_far = INFINITY;
+            int since_check = 0;
+            for (Binned* bp = tb; bp != te; ++bp) {
+              const uint32_t p = bp->id;
+              ++stats.triangle_tiles;
+              if (opt.depth_culling) {
+                if (++since_check >= 16 || bp == tb) {
+                  since_check = 0;
+                  double f = -INFINITY;
+                  for (int yy = 0; yy < th && f < INFINITY; ++yy)
+                    for (int xx = 0; xx < tw; ++xx) f = std::max(f, sc.far[size_t(yy) * TS + xx]);
+                  tile_far = f;
                 }
-                ++stats.pair_tests;
-                int n = moving_coverage(mt, pixel_direction(axes, x, y, N), axes.S, axes.T, opt.near, iv);
-                if (n) ++stats.covered_pairs;
-                bool changed = false;
-                for (int i = 0; i < n; ++i) changed |= insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
-                if (changed && opt.depth_culling) update_far(k);
-              }
-            }
-          } else {
-            size_t s = p - ntri;
-            MovingSphere sp{run.e0 - C0[s], (run.e1 - run.e0) - (C1[s] - C0[s]), scene.sphere_radius[s]};
-            for (int y = y0; y <= y1; ++y)
-              for (int x = std::max(tx0, b[0]); x <= std::min(tx1, b[1]); ++x) {
-                const size_t k = size_t(y - ty0) * TS + (x - tx0);
-                if (opt.depth_culling && bp->zmin > sc.far[k]) {
-                  ++stats.culled_pairs;
-                  continue;
+                if (bp->zmin > tile_far) {
+                  stats.culled_triangle_tiles += uint64_t(te - bp);
+                  stats.triangle_tiles += uint64_t(te - bp) - 1;
+                  break;
                 }
-                ++stats.pair_tests;
-                int n = sphere_coverage(sp, pixel_direction(axes, x, y, N), opt.near, iv);
-                if (n) ++stats.covered_pairs;
-                bool changed = false;
-                for (int i = 0; i < n; ++i) changed |= insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
-                if (changed && opt.depth_culling) update_far(k);
               }
-          }
-        }
-        size_t bytes = 0;
-        for (int y = ty0; y <= ty1; ++y)
-          for (int x = tx0; x <= tx1; ++x) {
-            auto& l = lists[size_t(y - ty0) * TS + (x - tx0)];
-            bytes += l.capacity() * sizeof(GeneralPiece);
-            if (l.empty()) continue;
-            ++stats.pixels_with_pieces;
-            stats.final_pieces += l.size();
-            stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-            for (const GeneralPiece& pc : l) {
-              // Length in the segment parameter (Diagonal) or in animation time (eye fixed).
-              double span = std::max(std::fabs(run.t1 - run.t0), std::fabs(run.tau1 - run.tau0));
-              double len = (pc.t1 - pc.t0) * span;
-              if (!(len > opt.eps_len)) continue;
-              double sm = 0.5 * (pc.t0 + pc.t1);
-              bool sph = pc.id >= ntri;
-              Witness w;
-              w.tri = sph ? uint32_t(pc.id - ntri) : pc.id;
-              w.is_sphere = sph;
-              w.face = face;
-              w.x = x;
-              w.y = y;
-              w.t = run.t0 + sm * (run.t1 - run.t0);
-              w.tau = run.tau0 + sm * (run.tau1 - run.tau0);
-              found.mark(pc.id, len, w);
-            }
-            if (pieces && run.diagonal) {
-              auto& dst = (*pieces)[(size_t(face) * N + y) * N + x];
-              for (GeneralPiece pc : l) {
-                pc.t0 = run.t0 + pc.t0 * (run.t1 - run.t0);
-                pc.t1 = pc.t1 == 1.0 ? run.t1 : run.t0 + pc.t1 * (run.t1 - run.t0);
-                if (!(pc.t0 < pc.t1)) continue;
-                // Depth functions stay in the run's local parameter; callers that evaluate them
-                // map t back with (t - run.t0) / (run.t1 - run.t0).
-                if (!dst.empty() && dst.back().id == pc.id && dst.back().t1 == pc.t0 && pc.t0 == run.t0)
-                  dst.back().t1 = pc.t1;
-                else
-                  dst.push_back(pc);
+              const int* b = &bbox[size_t(p) * 4];
+              const int y0 = std::max(ty0, b[2]), y1 = std::min(ty1, b[3]);
+              if (p < ntri) {
+                auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
+                MovingTriangle mt = prepare_moving(a0, a1, run.e0, run.e1);
+                if (!mt.moving && mt.lin.n == Vec3{0, 0, 0}) continue;  // degenerate (H5)
+                Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0,
+                               a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
+                Footprint fp = compute_footprint(rel, 6, axes, opt.near);
+                for (int y = y0; y <= y1; ++y) {
+                  int x0, x1;
+                  if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+                  x0 = std::max(x0, tx0);
+                  x1 = std::min(x1, tx1);
+                  for (int x = x0; x <= x1; ++x) {
+                    const size_t k = size_t(y - ty0) * TS + (x - tx0);
+                    if (opt.depth_culling && bp->zmin > sc.far[k]) {
+                      ++stats.culled_pairs;
+                      continue;
+                    }
+                    ++stats.pair_tests;
+                    int n = moving_coverage(mt, pixel_direction(axes, x, y, N), axes.S, axes.T,
+                                            opt.near, iv);
+                    if (n) ++stats.covered_pairs;
+                    bool changed = false;
+                    for (int i = 0; i < n; ++i)
+                      changed |=
+                          insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                    if (changed && opt.depth_culling) update_far(k);
+                  }
+                }
+              } else {
+                size_t s = p - ntri;
+                MovingSphere sp{run.e0 - C0[s], (run.e1 - run.e0) - (C1[s] - C0[s]),
+                                scene.sphere_radius[s]};
+                for (int y = y0; y <= y1; ++y)
+                  for (int x = std::max(tx0, b[0]); x <= std::min(tx1, b[1]); ++x) {
+                    const size_t k = size_t(y - ty0) * TS + (x - tx0);
+                    if (opt.depth_culling && bp->zmin > sc.far[k]) {
+                      ++stats.culled_pairs;
+                      continue;
+                    }
+                    ++stats.pair_tests;
+                    int n = sphere_coverage(sp, pixel_direction(axes, x, y, N), opt.near, iv);
+                    if (n) ++stats.covered_pairs;
+                    bool changed = false;
+                    for (int i = 0; i < n; ++i)
+                      changed |=
+                          insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                    if (changed && opt.depth_culling) update_far(k);
+                  }
               }
             }
+            size_t bytes = 0;
+            for (int y = ty0; y <= ty1; ++y)
+              for (int x = tx0; x <= tx1; ++x) {
+                auto& l = lists[size_t(y - ty0) * TS + (x - tx0)];
+                bytes += l.capacity() * sizeof(GeneralPiece);
+                if (l.empty()) continue;
+                ++stats.pixels_with_pieces;
+                stats.final_pieces += l.size();
+                stats.max_pieces_per_pixel =
+                    std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+                for (const GeneralPiece& pc : l) {
+                  // Length in the segment parameter (Diagonal) or in animation time (eye fixed).
+                  double span =
+                      std::max(std::fabs(run.t1 - run.t0), std::fabs(run.tau1 - run.tau0));
+                  double len = (pc.t1 - pc.t0) * span;
+                  if (!(len > opt.eps_len)) continue;
+                  double sm = 0.5 * (pc.t0 + pc.t1);
+                  bool sph = pc.id >= ntri;
+                  Witness w;
+                  w.tri = sph ? uint32_t(pc.id - ntri) : pc.id;
+                  w.is_sphere = sph;
+                  w.face = face;
+                  w.x = x;
+                  w.y = y;
+                  w.t = run.t0 + sm * (run.t1 - run.t0);
+                  w.tau = run.tau0 + sm * (run.tau1 - run.tau0);
+                  found.mark(pc.id, len, w);
+                }
+                if (pieces && run.diagonal) {
+                  auto& dst = (*pieces)[(size_t(face) * N + y) * N + x];
+                  for (GeneralPiece pc : l) {
+                    pc.t0 = run.t0 + pc.t0 * (run.t1 - run.t0);
+                    pc.t1 = pc.t1 == 1.0 ? run.t1 : run.t0 + pc.t1 * (run.t1 - run.t0);
+                    if (!(pc.t0 < pc.t1)) continue;
+                    // Depth functions stay in the run's local parameter; callers that evaluate them
+                    // map t back with (t - run.t0) / (run.t1 - run.t0).
+                    if (!dst.empty() && dst.back().id == pc.id && dst.back().t1 == pc.t0 &&
+                        pc.t0 == run.t0)
+                      dst.back().t1 = pc.t1;
+                    else
+                      dst.push_back(pc);
+                  }
+                }
+              }
+            stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
           }
-        stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
-      }
-    });
+        });
   }
 }
 
 }  // namespace
 
-SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
+SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
+                                         const SegmentOptions& opt) {
   assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
   auto start = std::chrono::steady_clock::now();
   const size_t K = std::max<size_t>(1, scene.state_count());
@@ -593,15 +646,18 @@ SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, c
       runs.push_back({v0, v0, k, k + 1, 0.0, 0.0, tau_of(k), tau_of(k + 1), false});
       runs.push_back({v1, v1, k, k + 1, 1.0, 1.0, tau_of(k), tau_of(k + 1), false});
     }
-    for (size_t k = 0; k < K; ++k) runs.push_back({v0, v1, k, k, 0.0, 1.0, tau_of(k), tau_of(k), false});
+    for (size_t k = 0; k < K; ++k)
+      runs.push_back({v0, v1, k, k, 0.0, 1.0, tau_of(k), tau_of(k), false});
   }
   SegmentResult result;
   if (opt.want_pieces) result.general_pieces.resize(size_t(6) * opt.resolution * opt.resolution);
-  tbb::enumerable_thread_specific<FoundMarks> found_by_thread([&] { return FoundMarks(nprim, opt.want_witnesses); });
+  tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
+      [&] { return FoundMarks(nprim, opt.want_witnesses); });
   const int tiles_x = (opt.resolution + opt.tile_size - 1) / opt.tile_size;
   std::vector<SegmentStats> stats(size_t(6) * tiles_x * tiles_x);
   for (const Run& run : runs)
-    run_kernel(scene, run, opt, found_by_thread, opt.want_pieces ? &result.general_pieces : nullptr, stats);
+    run_kernel(scene, run, opt, found_by_thread, opt.want_pieces ? &result.general_pieces : nullptr,
+               stats);
   for (const SegmentStats& ts : stats) result.stats.add(ts);
   std::vector<uint8_t> seen;
   std::vector<Witness> best;
@@ -614,7 +670,8 @@ SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, c
       result.visible_spheres.push_back(uint32_t(p - ntri));
     if (opt.want_witnesses) result.witnesses.push_back(best[p]);
   }
-  result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.stats.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }
 

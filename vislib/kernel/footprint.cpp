@@ -9,7 +9,9 @@
 namespace vislib {
 namespace {
 
-double cross2(Vec2 o, Vec2 a, Vec2 b) { return (a.u - o.u) * (b.w - o.w) - (a.w - o.w) * (b.u - o.u); }
+double cross2(Vec2 o, Vec2 a, Vec2 b) {
+  return (a.u - o.u) * (b.w - o.w) - (a.w - o.w) * (b.u - o.u);
+}
 
 // Andrew's monotone chain over pts[0, n) (reordered in place); writes the CCW hull (collinear
 // points dropped) to `out` and returns its size.
@@ -38,8 +40,9 @@ int convex_hull(Vec2* pts, int n, Vec2* out) {
 // near plane project far out; their rounding grows with them).
 double margin_of(const Footprint& fp) {
   double m = 0;
-  for (int i = 0; i < fp.size; ++i) m = std::max({m, std::fabs(fp.hull[i].u), std::fabs(fp.hull[i].w)});
-  return kFootprintMargin + 1e-12 * m;
+  for (int i = 0; i < fp.size; ++i)
+    m = std::max({m, std::fabs(fp.hull[i].u), std::fabs(fp.hull[i].w)});
+  return kFootprintMargin + kFootprintRelativeMargin * m;
 }
 
 }  // namespace
@@ -47,11 +50,13 @@ double margin_of(const Footprint& fp) {
 Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near) {
   Vec3 q[12];
   count = std::min(count, 12);
-  for (int i = 0; i < count; ++i) q[i] = {dot(axes.S, rel[i]), dot(axes.T, rel[i]), dot(axes.F, rel[i])};
+  for (int i = 0; i < count; ++i)
+    q[i] = {dot(axes.S, rel[i]), dot(axes.T, rel[i]), dot(axes.F, rel[i])};
   // Quick reject: all points on the outer side of one plane of the face's frustum (near plane, or
-  // one of |u| <= 1, |w| <= 1 widened by a relative 1e-6), so the clipped hull misses the face.
+  // one of |u| <= 1, |w| <= 1 widened by kFrustumRejectWidening), so the clipped hull misses the
+  // face.
   {
-    const double g = 1.0 + 1e-6;
+    const double g = 1.0 + kFrustumRejectWidening;
     bool behind = true, right = true, left = true, up = true, down = true;
     for (int i = 0; i < count; ++i) {
       const double z = std::fabs(q[i].z) * g;
@@ -94,7 +99,9 @@ bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y
     wmax = std::max(wmax, p.w);
   }
   if (umax < -1 - m || umin > 1 + m || wmax < -1 - m || wmin > 1 + m) return false;
-  auto lo = [n](double c) { return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n))))); };
+  auto lo = [n](double c) {
+    return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n)))));
+  };
   auto hi = [n](double c) {
     return std::min(n - 1, int(std::floor(std::min(double(n) + 1, pixel_coord(c, n)))));
   };

@@ -100,7 +100,8 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
         break;
       }
       double lo = std::max(cur, I.t0), hi = std::min(f, I.t1);
-      changes = detail::crossings(I, p, lo, hi, cuts) > 0 || &detail::front(I, p, 0.5 * (lo + hi)) == &p;
+      changes =
+          detail::crossings(I, p, lo, hi, cuts) > 0 || &detail::front(I, p, 0.5 * (lo + hi)) == &p;
       cur = hi;
     }
     if (!changes && cur >= f) return false;

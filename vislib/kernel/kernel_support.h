@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "vislib/kernel/segment_visibility.h"
+#include "vislib/kernel/witness.h"
 
 namespace vislib {
 
@@ -14,8 +14,8 @@ namespace vislib {
 // Fills `start` (tile_count + 1 offsets) and `items` (make(p) for each primitive p in each tile
 // its box touches, in primitive order within a tile). tile = ty * tiles_x + tx, tiles of side ts.
 template <class Item, class Make>
-void bin_by_tile(const std::vector<int>& bbox, size_t count, int ts, int tiles_x, std::vector<uint32_t>& start,
-                 std::vector<Item>& items, Make make) {
+void bin_by_tile(const std::vector<int>& bbox, size_t count, int ts, int tiles_x,
+                 std::vector<uint32_t>& start, std::vector<Item>& items, Make make) {
   const int tile_count = tiles_x * tiles_x;
   start.assign(size_t(tile_count) + 1, 0);
   auto for_tiles = [&](size_t p, auto f) {
@@ -28,7 +28,8 @@ void bin_by_tile(const std::vector<int>& bbox, size_t count, int ts, int tiles_x
   for (int i = 0; i < tile_count; ++i) start[size_t(i) + 1] += start[size_t(i)];
   items.resize(start[size_t(tile_count)]);
   std::vector<uint32_t> fill(start.begin(), start.end() - 1);
-  for (size_t p = 0; p < count; ++p) for_tiles(p, [&](int tile) { items[fill[size_t(tile)]++] = make(p); });
+  for (size_t p = 0; p < count; ++p)
+    for_tiles(p, [&](int tile) { items[fill[size_t(tile)]++] = make(p); });
 }
 
 // Witness order: longer piece first, then lower face, row, column, t, tau. A missing witness has
@@ -76,7 +77,8 @@ void reduce_found(const Range& found, size_t count, bool witnesses, std::vector<
     for (size_t p = 0; p < count; ++p) seen[p] |= f.seen[p];
     if (witnesses)
       for (size_t p = 0; p < count; ++p)
-        if (f.witness_len[p] >= 0 && better_witness(f.witness_len[p], f.witness[p], best_len[p], best[p])) {
+        if (f.witness_len[p] >= 0 &&
+            better_witness(f.witness_len[p], f.witness[p], best_len[p], best[p])) {
           best_len[p] = f.witness_len[p];
           best[p] = f.witness[p];
         }

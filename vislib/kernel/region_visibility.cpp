@@ -43,19 +43,21 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
   RegionResult result;
   result.segments = perimeter_segments(box);
   const size_t total = result.segments.size() * size_t(options.runs);
-  std::vector<uint8_t> in_union(scene.triangle_count(), 0), sphere_in_union(scene.sphere_count(), 0);
+  std::vector<uint8_t> in_union(scene.triangle_count(), 0),
+      sphere_in_union(scene.sphere_count(), 0);
   size_t union_size = 0;
   for (size_t s = 0; s < result.segments.size(); ++s) {
     for (int k = 0; k < options.runs; ++k) {
       SegmentOptions so = options.segment;
       so.orientation = run_orientation(options.seed, s, k);
-      SegmentResult sr = segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
+      SegmentResult sr =
+          segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
       for (uint32_t id : sr.visible)
         if (!in_union[id]) {
           in_union[id] = 1;
           ++union_size;
         }
-      for (uint32_t s : sr.visible_spheres) sphere_in_union[s] = 1;
+      for (uint32_t sphere : sr.visible_spheres) sphere_in_union[sphere] = 1;
       result.seconds += sr.stats.seconds;
       RunRecord rec;
       rec.segment = s;

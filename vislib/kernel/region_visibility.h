@@ -40,17 +40,17 @@ struct RunRecord {
   size_t segment = 0;
   int run = 0;
   Mat3 orientation;
-  std::vector<uint32_t> visible;  // triangle ids of this run
+  std::vector<uint32_t> visible;          // triangle ids of this run
   std::vector<uint32_t> visible_spheres;  // sphere indices of this run
   SegmentStats stats;
-  size_t union_size_after = 0;    // triangles in the union after this run
-  double seconds_after = 0;       // cumulative kernel seconds after this run
+  size_t union_size_after = 0;  // triangles in the union after this run
+  double seconds_after = 0;     // cumulative kernel seconds after this run
 };
 
 struct RegionResult {
   std::vector<Segment> segments;
-  std::vector<RunRecord> runs;     // segment-major, run-minor
-  std::vector<uint32_t> visible;   // union of triangle ids, sorted
+  std::vector<RunRecord> runs;            // segment-major, run-minor
+  std::vector<uint32_t> visible;          // union of triangle ids, sorted
   std::vector<uint32_t> visible_spheres;  // union of sphere indices, sorted
   double seconds = 0;
 };

@@ -19,8 +19,10 @@
 #include <chrono>
 #include <cmath>
 
+#include "vislib/kernel/dynamic_visibility.h"
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
+#include "vislib/kernel/static_coverage.h"
 
 namespace vislib {
 
@@ -98,7 +100,8 @@ struct FaceTriangle {
 
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
   assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
-  if (scene.sphere_count() > 0 || scene.is_dynamic()) return dynamic_segment_visibility(scene, v0, v1, opt);
+  if (scene.sphere_count() > 0 || scene.is_dynamic())
+    return dynamic_segment_visibility(scene, v0, v1, opt);
   auto start = std::chrono::steady_clock::now();
   const int N = opt.resolution;
   const int TS = opt.tile_size;
@@ -118,10 +121,11 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     std::vector<double> far;
   };
   tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
-    return TileScratch{std::vector<PieceList>(size_t(TS) * TS), std::vector<uint8_t>(size_t(TS) * TS),
-                       std::vector<double>(size_t(TS) * TS)};
+    return TileScratch{std::vector<PieceList>(size_t(TS) * TS),
+                       std::vector<uint8_t>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS)};
   });
-  tbb::enumerable_thread_specific<FoundMarks> found_by_thread([&] { return FoundMarks(ntri, opt.want_witnesses); });
+  tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
+      [&] { return FoundMarks(ntri, opt.want_witnesses); });
 
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
@@ -131,125 +135,131 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   for (int face = 0; face < 6; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
     // (1) footprint bounds and nearest depth of every triangle on this face.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t t = r.begin(); t != r.end(); ++t) {
-        auto c = scene.corners(uint32_t(t), opt.state);
-        Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-        int* b = &bbox[t * 4];
-        Footprint fp = compute_footprint(rel, 6, axes, opt.near);
-        if (!footprint_pixel_bounds(fp, N, b[0], b[1], b[2], b[3])) {
-          b[0] = 1;
-          b[1] = 0;  // empty
-          continue;
-        }
-        double z = INFINITY;
-        for (const Vec3& q : rel) z = std::min(z, dot(axes.F, q));
-        float zf = float(z);
-        if (double(zf) > z) zf = std::nextafter(zf, -INFINITY);
-        zmin[t] = zf;
-      }
-    });
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t t = r.begin(); t != r.end(); ++t) {
+            auto c = scene.corners(uint32_t(t), opt.state);
+            Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
+            int* b = &bbox[t * 4];
+            Footprint fp = compute_footprint(rel, 6, axes, opt.near);
+            if (!footprint_pixel_bounds(fp, N, b[0], b[1], b[2], b[3])) {
+              b[0] = 1;
+              b[1] = 0;  // empty
+              continue;
+            }
+            double z = INFINITY;
+            for (const Vec3& q : rel) z = std::min(z, dot(axes.F, q));
+            float zf = float(z);
+            if (double(zf) > z) zf = std::nextafter(zf, -INFINITY);
+            zmin[t] = zf;
+          }
+        });
     // (2) bin by tile (counting sort, in id order).
-    bin_by_tile(bbox, ntri, TS, tiles_x, bin_start, bins,
-                [&](size_t t) { return FaceTriangle{uint32_t(t), zmin[t]}; });
+    bin_by_tile(bbox, ntri, TS, tiles_x, bin_start, bins, [&](size_t t) {
+      return FaceTriangle{uint32_t(t), zmin[t]};
+    });
 
     // (3) tiles in parallel.
-    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-      TileScratch& sc = scratch.local();
-      auto& lists = sc.lists;
-      FoundMarks& found = found_by_thread.local();
-      for (int tile = r.begin(); tile != r.end(); ++tile) {
-        SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
-        const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
-        const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
-        const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
-        for (auto& l : lists) l.clear();
-        std::fill(sc.full.begin(), sc.full.end(), 0);
-        std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-        FaceTriangle* tb = bins.data() + bin_start[tile];
-        FaceTriangle* te = bins.data() + bin_start[tile + 1];
-        // Front to back (nearest possible depth), ties by id: the order only affects speed.
-        std::sort(tb, te, [](const FaceTriangle& a, const FaceTriangle& b) {
-          return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
-        });
-        stats.triangle_tiles += uint64_t(te - tb);
-        // Depth culling (exact): a pixel whose list covers [0,1] with every piece nearer than a
-        // triangle's nearest possible depth cannot show that triangle; when that holds for every
-        // pixel of the tile, no later triangle (sorted by that depth) can show anywhere in it.
-        double tile_far = INFINITY;
-        int since_check = 0;
-        for (FaceTriangle* ft = tb; ft != te; ++ft) {
-          const double tz = double(ft->zmin);
-          if (opt.depth_culling) {
-            if (++since_check >= 16 || ft == tb) {
-              since_check = 0;
-              double far = -INFINITY;
-              for (int k = 0; k < th && far < INFINITY; ++k)
-                for (int i = 0; i < tw; ++i) far = std::max(far, sc.far[size_t(k) * TS + i]);
-              tile_far = far;
-            }
-            if (tz > tile_far) {
-              stats.culled_triangle_tiles += uint64_t(te - ft);
-              break;
-            }
-          }
-          auto c = scene.corners(ft->id, opt.state);
-          Vec3 corners[3] = {c[0], c[1], c[2]};
-          StaticTriangle st = prepare_static_triangle(corners, v0, v1);
-          if (st.n == Vec3{0, 0, 0}) continue;  // degenerate: never covers (H5)
-          Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-          Footprint fp = compute_footprint(rel, 6, axes, opt.near);
-          int y0 = std::max(ty0, bbox[size_t(ft->id) * 4 + 2]);
-          int y1 = std::min(ty1, bbox[size_t(ft->id) * 4 + 3]);
-          for (int y = y0; y <= y1; ++y) {
-            int x0, x1;
-            if (!footprint_row_span(fp, N, y, x0, x1)) continue;
-            x0 = std::max(x0, tx0);
-            x1 = std::min(x1, tx1);
-            for (int x = x0; x <= x1; ++x) {
-              const size_t k = size_t(y - ty0) * TS + (x - tx0);
-              if (opt.depth_culling && tz > sc.far[k]) {
-                ++stats.culled_pairs;
-                continue;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
+          TileScratch& sc = scratch.local();
+          auto& lists = sc.lists;
+          FoundMarks& found = found_by_thread.local();
+          for (int tile = r.begin(); tile != r.end(); ++tile) {
+            SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
+            const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
+            const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
+            const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
+            for (auto& l : lists) l.clear();
+            std::fill(sc.full.begin(), sc.full.end(), 0);
+            std::fill(sc.far.begin(), sc.far.end(), INFINITY);
+            FaceTriangle* tb = bins.data() + bin_start[tile];
+            FaceTriangle* te = bins.data() + bin_start[tile + 1];
+            // Front to back (nearest possible depth), ties by id: the order only affects speed.
+            std::sort(tb, te, [](const FaceTriangle& a, const FaceTriangle& b) {
+              return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
+            });
+            stats.triangle_tiles += uint64_t(te - tb);
+            // Depth culling (exact): a pixel whose list covers [0,1] with every piece nearer than a
+            // triangle's nearest possible depth cannot show that triangle; when that holds for
+            // every pixel of the tile, no later triangle (sorted by that depth) can show anywhere
+            // in it.
+            double tile_far = INFINITY;
+            int since_check = 0;
+            for (FaceTriangle* ft = tb; ft != te; ++ft) {
+              const double tz = double(ft->zmin);
+              if (opt.depth_culling) {
+                if (++since_check >= 16 || ft == tb) {
+                  since_check = 0;
+                  double far = -INFINITY;
+                  for (int k = 0; k < th && far < INFINITY; ++k)
+                    for (int i = 0; i < tw; ++i) far = std::max(far, sc.far[size_t(k) * TS + i]);
+                  tile_far = far;
+                }
+                if (tz > tile_far) {
+                  stats.culled_triangle_tiles += uint64_t(te - ft);
+                  break;
+                }
               }
-              ++stats.pair_tests;
-              Vec3 d = pixel_direction(axes, x, y, N);
-              double lo, hi;
-              LinearDepth depth;
-              if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
-              ++stats.covered_pairs;
-              PieceList& l = lists[k];
-              if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling && covers_segment(l))
-                sc.far[k] = farthest_depth(l);
+              auto c = scene.corners(ft->id, opt.state);
+              Vec3 corners[3] = {c[0], c[1], c[2]};
+              StaticTriangle st = prepare_static_triangle(corners, v0, v1);
+              if (st.n == Vec3{0, 0, 0}) continue;  // degenerate: never covers (H5)
+              Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
+              Footprint fp = compute_footprint(rel, 6, axes, opt.near);
+              int y0 = std::max(ty0, bbox[size_t(ft->id) * 4 + 2]);
+              int y1 = std::min(ty1, bbox[size_t(ft->id) * 4 + 3]);
+              for (int y = y0; y <= y1; ++y) {
+                int x0, x1;
+                if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+                x0 = std::max(x0, tx0);
+                x1 = std::min(x1, tx1);
+                for (int x = x0; x <= x1; ++x) {
+                  const size_t k = size_t(y - ty0) * TS + (x - tx0);
+                  if (opt.depth_culling && tz > sc.far[k]) {
+                    ++stats.culled_pairs;
+                    continue;
+                  }
+                  ++stats.pair_tests;
+                  Vec3 d = pixel_direction(axes, x, y, N);
+                  double lo, hi;
+                  LinearDepth depth;
+                  if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
+                  ++stats.covered_pairs;
+                  PieceList& l = lists[k];
+                  if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling &&
+                      covers_segment(l))
+                    sc.far[k] = farthest_depth(l);
+                }
+              }
             }
+            // Tile results: marks, witnesses, statistics.
+            size_t bytes = 0;
+            for (int y = ty0; y <= ty1; ++y)
+              for (int x = tx0; x <= tx1; ++x) {
+                PieceList& l = lists[size_t(y - ty0) * TS + (x - tx0)];
+                bytes += l.capacity() * sizeof(Piece);
+                if (l.empty()) continue;
+                ++stats.pixels_with_pieces;
+                stats.final_pieces += l.size();
+                stats.max_pieces_per_pixel =
+                    std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+                for (const Piece& p : l) {
+                  double len = p.t1 - p.t0;
+                  if (!(len > opt.eps_len)) continue;
+                  Witness w;
+                  w.tri = p.id;
+                  w.face = face;
+                  w.x = x;
+                  w.y = y;
+                  w.t = 0.5 * (p.t0 + p.t1);
+                  found.mark(p.id, len, w);
+                }
+                if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
+              }
+            stats.peak_tile_bytes = double(bytes);
           }
-        }
-        // Tile results: marks, witnesses, statistics.
-        size_t bytes = 0;
-        for (int y = ty0; y <= ty1; ++y)
-          for (int x = tx0; x <= tx1; ++x) {
-            PieceList& l = lists[size_t(y - ty0) * TS + (x - tx0)];
-            bytes += l.capacity() * sizeof(Piece);
-            if (l.empty()) continue;
-            ++stats.pixels_with_pieces;
-            stats.final_pieces += l.size();
-            stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-            for (const Piece& p : l) {
-              double len = p.t1 - p.t0;
-              if (!(len > opt.eps_len)) continue;
-              Witness w;
-              w.tri = p.id;
-              w.face = face;
-              w.x = x;
-              w.y = y;
-              w.t = 0.5 * (p.t0 + p.t1);
-              found.mark(p.id, len, w);
-            }
-            if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
-          }
-        stats.peak_tile_bytes = double(bytes);
-      }
-    });
+        });
   }
 
   // (4) reduce: statistics in tile order; marks and witnesses over threads by a total order.

@@ -17,9 +17,11 @@
 #include <vector>
 
 #include "vislib/base/cubemap.h"
-#include "vislib/kernel/interval_list.h"
-#include "vislib/scene/scene.h"
 #include "vislib/base/tolerances.h"
+#include "vislib/kernel/general_depth.h"
+#include "vislib/kernel/interval_list.h"
+#include "vislib/kernel/witness.h"
+#include "vislib/scene/scene.h"
 
 namespace vislib {
 
@@ -33,39 +35,29 @@ namespace vislib {
 enum class DynamicMode { Diagonal, Decoupled };
 
 struct SegmentOptions {
-  int resolution = 512;                   // N: each cube face is N x N pixels; must be >= 1
-  double near = kDefaultNear;             // z_near > 0, view depth in scene units
-  Mat3 orientation;                       // cube orientation R (world = R * local); a rotation
-  double eps_len = kDefaultEpsLen;        // final pieces must be longer (in t) to count
-  bool want_witnesses = false;            // one witness per visible triangle
-  bool want_pieces = false;               // keep every pixel's final list (memory: 6 N^2 lists)
-  int tile_size = 32;                     // pixels per tile side (memory/parallelism grain)
-  bool depth_culling = true;              // skip triangles behind a tile's fully covered pixels
-  size_t state = 0;                       // static scenes: which key state to use
+  int resolution = 512;                      // N: each cube face is N x N pixels; must be >= 1
+  double near = kDefaultNear;                // z_near > 0, view depth in scene units
+  Mat3 orientation;                          // cube orientation R (world = R * local); a rotation
+  double eps_len = kDefaultEpsLen;           // final pieces must be longer (in t) to count
+  bool want_witnesses = false;               // one witness per visible triangle
+  bool want_pieces = false;                  // keep every pixel's final list (memory: 6 N^2 lists)
+  int tile_size = 32;                        // pixels per tile side (memory/parallelism grain)
+  bool depth_culling = true;                 // skip triangles behind a tile's fully covered pixels
+  size_t state = 0;                          // static scenes: which key state to use
   DynamicMode mode = DynamicMode::Diagonal;  // dynamic scenes (moving vertices or spheres)
 };
 
-// A pixel and a t at which `tri` is the first hit: the middle of its longest final piece
-// (ties: lowest face, then row, then column).
-struct Witness {
-  uint32_t tri = 0;        // triangle id, or sphere index when is_sphere
-  bool is_sphere = false;
-  int face = 0, x = 0, y = 0;
-  double t = 0;            // eye at v0 + t (v1 - v0)
-  double tau = 0;          // animation time in [0,1] (static scenes: 0)
-};
-
 struct SegmentStats {
-  uint64_t pair_tests = 0;         // (triangle, pixel) coverage evaluations
-  uint64_t culled_pairs = 0;       // (triangle, pixel) pairs skipped by per-pixel depth culling
-  uint64_t covered_pairs = 0;      // of which gave a non-empty interval
-  uint64_t final_pieces = 0;       // pieces in all final lists
+  uint64_t pair_tests = 0;     // (triangle, pixel) coverage evaluations
+  uint64_t culled_pairs = 0;   // (triangle, pixel) pairs skipped by per-pixel depth culling
+  uint64_t covered_pairs = 0;  // of which gave a non-empty interval
+  uint64_t final_pieces = 0;   // pieces in all final lists
   uint64_t pixels_with_pieces = 0;
   uint64_t max_pieces_per_pixel = 0;
-  uint64_t triangle_tiles = 0;     // (triangle, tile) pairs binned
+  uint64_t triangle_tiles = 0;         // (triangle, tile) pairs binned
   uint64_t culled_triangle_tiles = 0;  // of which skipped by depth culling
-  double peak_tile_bytes = 0;      // largest memory held by one tile's pixel lists
-  double seconds = 0;              // wall time of the call
+  double peak_tile_bytes = 0;          // largest memory held by one tile's pixel lists
+  double seconds = 0;                  // wall time of the call
   // Adds another part's counts (maxima for the max fields).
   void add(const SegmentStats& o) {
     pair_tests += o.pair_tests;
@@ -73,7 +65,8 @@ struct SegmentStats {
     covered_pairs += o.covered_pairs;
     final_pieces += o.final_pieces;
     pixels_with_pieces += o.pixels_with_pieces;
-    max_pieces_per_pixel = max_pieces_per_pixel > o.max_pieces_per_pixel ? max_pieces_per_pixel : o.max_pieces_per_pixel;
+    max_pieces_per_pixel = max_pieces_per_pixel > o.max_pieces_per_pixel ? max_pieces_per_pixel
+                                                                         : o.max_pieces_per_pixel;
     triangle_tiles += o.triangle_tiles;
     culled_triangle_tiles += o.culled_triangle_tiles;
     peak_tile_bytes = peak_tile_bytes > o.peak_tile_bytes ? peak_tile_bytes : o.peak_tile_bytes;
@@ -83,28 +76,10 @@ struct SegmentStats {
   }
 };
 
-// Depth along a pixel ray in the dynamic kernel (math note §3.2, §4): a rational N(t)/D(t)
-// (cubic over quadratic; static triangles have degrees 1 and 0) or a sphere's near or far root.
-struct GeneralDepth {
-  enum Kind : uint8_t { Rational, SphereNear, SphereFar };
-  Kind kind = Rational;
-  // Rational: N0..N3 then D0..D2. Sphere: h0 h1 (d.w), m0 m1 m2 (|w|^2 - r^2), g0 g1 g2
-  // (r^2|d|^2 - |d x w|^2), |d|^2, then w0 (3), w1 (3) and r of w(t) = eye(t) - centre(t), used
-  // to skip the crossing search for spheres that stay disjoint (math note §4).
-  double c[16] = {};
-  double at(double t) const;
-};
-// Crossings of two depths inside (lo, hi), pair in id order, as polynomial roots (isolated on
-// monotone pieces, bisected): P = N_i D_j - N_j D_i for two triangles (degree <= 5); for spheres,
-// the condition that the ray's point at the common depth lies on both surfaces (degree 4
-// sphere-sphere, 6 sphere-triangle). Spheres that stay disjoint over the run have none.
-int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi, double* out);
-using GeneralPiece = PieceT<GeneralDepth>;
-
 struct SegmentResult {
-  std::vector<uint32_t> visible;     // sorted triangle ids
+  std::vector<uint32_t> visible;          // sorted triangle ids
   std::vector<uint32_t> visible_spheres;  // sorted sphere indices (dynamic kernel)
-  std::vector<Witness> witnesses;    // if requested: one per visible id, in id order
+  std::vector<Witness> witnesses;         // if requested: one per visible id, in id order
   // If requested: final list of pixel (face, x, y) at index (face * N + y) * N + x.
   std::vector<PieceList> pieces;
   // If requested, for dynamic scenes in Diagonal mode (instead of `pieces`): same indexing; ids
@@ -118,27 +93,9 @@ struct SegmentResult {
 // Visibility of the scene's triangles and spheres from the segment v0 -> v1. A static scene
 // without spheres takes the linear path (key state `options.state`); a scene with moving vertices
 // or spheres takes the dynamic kernel (dynamic_visibility.cpp; quadratic events only for what
-// moves) in `options.mode`. Thread-safe (reads the scene only); parallel with TBB.
-SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& options);
-
-// The dynamic kernel alone (also for static scenes, e.g. to compare both paths in tests).
-SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
-                                         const SegmentOptions& options);
-
-// ---- The steps, exposed for tests ----------------------------------------------------------
-
-// Per-triangle quantities of §2 for one segment, re-centred at v0.
-struct StaticTriangle {
-  Vec3 KA[3], KB[3];  // per edge ab, bc, ca: (Q-P) x Delta and (Q-P) x (v0-P), canonical P<Q
-  double rho[3];      // +1 if the triangle runs P->Q, else -1
-  Vec3 n;             // (b-a) x (c-a)
-  double N0, N1;      // n.(a-v0), n.Delta
-};
-StaticTriangle prepare_static_triangle(const Vec3 corners[3], Vec3 v0, Vec3 v1);
-
-// Coverage interval [lo, hi) and depth of a prepared triangle at pixel direction d (world,
-// un-normalised) with face axes S, T used by the tie rule. False when empty.
-bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double near, double& lo,
-                     double& hi, LinearDepth& depth);
+// moves; dynamic_visibility.h) in `options.mode`. Thread-safe (reads the scene only); parallel with
+// TBB.
+SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
+                                 const SegmentOptions& options);
 
 }  // namespace vislib

@@ -1,0 +1,58 @@
+// bake_progress.cpp: the progress output of `pvs bake`.
+#include "cli/bake_progress.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace pvs_cli {
+
+std::string format_duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  long t = long(s + 0.5);
+  char buf[32];
+  if (t >= 3600)
+    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%ld:%02ld", t / 60, t % 60);
+  return buf;
+}
+
+vislib::BakeProgressFn progress_printer() {
+  struct State {
+    bool tty = isatty(fileno(stderr));
+    double last_line = -1;
+    uint32_t last_done = 0;
+  };
+  auto st = std::make_shared<State>();
+  return [st](const vislib::BakeProgress& p) {
+    uint32_t baked = p.done - p.resumed;
+    double eta = baked > 0 ? p.elapsed / baked * double(p.total - p.done) : NAN;
+    if (st->tty) {
+      const int width = 30;
+      int fill = p.total ? int(double(width) * p.done / p.total) : width;
+      std::string bar(size_t(fill), '#');
+      bar.resize(width, '.');
+      std::fprintf(stderr, "\rpvs bake: [%s] %u/%u cells", bar.c_str(), p.done, p.total);
+      if (p.resumed) std::fprintf(stderr, " (%u resumed)", p.resumed);
+      std::fprintf(stderr, "  %s elapsed  ETA %s   ", format_duration(p.elapsed).c_str(),
+                   p.done == p.total ? "0:00" : format_duration(eta).c_str());
+      if (p.done == p.total) std::fprintf(stderr, "\n");
+      std::fflush(stderr);
+      return;
+    }
+    bool first = st->last_line < 0, last = p.done == p.total;
+    bool step = p.done >= st->last_done + std::max<uint32_t>(1, p.total / 20);
+    if (!first && !last && !step && p.elapsed - st->last_line < 10) return;
+    st->last_line = p.elapsed;
+    st->last_done = p.done;
+    std::fprintf(stderr, "pvs bake: %u/%u cells (%u resumed), %s elapsed, ETA %s\n", p.done,
+                 p.total, p.resumed, format_duration(p.elapsed).c_str(),
+                 last ? "0:00" : format_duration(eta).c_str());
+  };
+}
+
+}  // namespace pvs_cli

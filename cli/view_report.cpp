@@ -1,0 +1,84 @@
+// view_report.cpp: the JSON and text output of `pvs view`.
+#include "cli/view_report.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "vislib/eval/metrics.h"
+
+namespace pvs_cli {
+
+using nlohmann::json;
+
+json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
+                  const vislib::Frame& test) {
+  vislib::FrameQuality q = vislib::frame_quality(truth, test);
+  vislib::ObjectCompletion c = vislib::object_completion(scene, truth, test);
+  // Share of pixels showing another triangle than the truth (epsilon compares depths, and the
+  // morph and the environment map change depths even where the right surface is shown).
+  size_t other = 0;
+  for (size_t p = 0; p < truth.pixel_count(); ++p) other += truth.tri[p] != test.tri[p];
+  return {{"triangle_mismatch", double(other) / double(truth.pixel_count())},
+          {"epsilon", q.epsilon},
+          {"missed_pixels", q.missed_pixels},
+          {"psnr", std::isfinite(q.psnr) ? json(q.psnr) : json(nullptr)},
+          {"ssim", q.ssim},
+          {"ovc", c.ovc},
+          {"ofc", c.ofc},
+          {"objects_in_truth", c.objects}};
+}
+
+// "dir/name.png" -> "dir/name<suffix>.png"
+std::string sibling(const std::string& out, const std::string& suffix) {
+  std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
+}
+
+json growth_json(const vislib::GrowthRun& g) {
+  json steps = json::array();
+  for (const vislib::GrowthStep& s : g.steps) {
+    json step = {{"ring", s.ring},
+                 {"ring_radius", s.ring_radius},
+                 {"radius", s.radius},
+                 {"ssim_to_truth", s.ssim_to_truth}};
+    if (s.ssim_to_previous) step["ssim_to_previous"] = *s.ssim_to_previous;
+    steps.push_back(step);
+  }
+  return json{{"radii", g.radii},
+              {"min_consecutive_ssim",
+               g.min_consecutive_ssim ? json(*g.min_consecutive_ssim) : json(nullptr)},
+              {"frames", g.steps.size()},
+              {"steps", steps}};
+}
+
+void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
+  auto fmt_psnr = [](const json& v) {
+    return v.is_null() ? std::string("inf") : std::to_string(v.get<double>());
+  };
+  const json& w = j["without_morph"];
+  std::fprintf(
+      stderr,
+      "cell %u: visible %zu triangles: near %zu, intermediate %zu, far %zu (env map %zu)\n"
+      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f triangle mismatch %.4f\n"
+      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f triangle mismatch %.4f\n",
+      j["cell"].get<uint32_t>(), j["triangles"]["visible"].get<size_t>(), rc.near, rc.intermediate,
+      rc.far, rc.env_map, j["epsilon"].get<double>(), fmt_psnr(j["psnr"]).c_str(),
+      j["ssim"].get<double>(), j["ovc"].get<double>(), j["ofc"].get<double>(),
+      j["triangle_mismatch"].get<double>(), w["epsilon"].get<double>(), fmt_psnr(w["psnr"]).c_str(),
+      w["ssim"].get<double>(), w["ovc"].get<double>(), w["ofc"].get<double>(),
+      w["triangle_mismatch"].get<double>());
+  if (dynamic)
+    std::fprintf(stderr, "  tau %.4f: dynamic far triangles drawn %zu, shown %zu\n",
+                 j["tau"].get<double>(), rc.far_dynamic, rc.far_dynamic_shown);
+  if (j.contains("continuity"))
+    for (const char* k : {"merged", "equal_area"}) {
+      const json& g = j["continuity"][k];
+      if (g["min_consecutive_ssim"].is_null()) continue;
+      std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
+                   g["radii"].size(), g["frames"].get<size_t>(),
+                   g["min_consecutive_ssim"].get<double>());
+    }
+}
+
+}  // namespace pvs_cli

@@ -1,0 +1,29 @@
+// view_report.h: the JSON and text output of `pvs view` (cmd_view.cpp): frame metrics, the
+// growth of the near region, the summary on stderr, and the names of the images written.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "vislib/eval/render.h"
+#include "vislib/render/near_far_render.h"
+#include "vislib/render/near_region_growth.h"
+#include "vislib/scene/scene.h"
+
+namespace pvs_cli {
+
+// epsilon, PSNR (null when infinite), SSIM, OVC, OFC and the share of pixels showing another
+// triangle than the truth, of `test` against `truth`.
+nlohmann::json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
+                            const vislib::Frame& test);
+
+// "dir/name.png" -> "dir/name<suffix>.png"
+std::string sibling(const std::string& out, const std::string& suffix);
+
+// One growth of the near region: radii, frames, steps and the minimum consecutive SSIM.
+nlohmann::json growth_json(const vislib::GrowthRun& g);
+
+// The summary on stderr of the view's JSON `j`.
+void print_view(const nlohmann::json& j, const vislib::RegionCounts& rc, bool dynamic);
+
+}  // namespace pvs_cli

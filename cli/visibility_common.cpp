@@ -1,0 +1,112 @@
+// visibility_common.cpp: options and JSON output shared by `pvs segment` and `pvs region`.
+#include "cli/visibility_common.h"
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cstdio>
+
+#include "cli/load_scene.h"
+#include "vislib/base/file_util.h"
+
+namespace pvs_cli {
+
+using nlohmann::json;
+
+void add_common(CLI::App* cmd, VisibilityArgs& a) {
+  cmd->add_option("SCENE", a.scene, "Scene file (.glb .gltf .obj .ply .off .stl)")->required();
+  cmd->add_option("--res", a.resolution, "Cube face resolution N (N x N pixels per face)")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--near", a.near, "Near plane: view depth below which hits do not count")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--eps-len", a.eps_len, "Final pieces must be longer than this (in t) to count")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--granularity", a.granularity, "Report visible triangles or objects")
+      ->check(CLI::IsMember({"triangle", "object"}))
+      ->capture_default_str();
+  cmd->add_option("--threads", a.threads, "Worker threads (0 = all cores)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--tile", a.tile, "Tile side in pixels (memory/parallelism grain)")
+      ->check(CLI::Range(1, 4096))
+      ->capture_default_str();
+  cmd->add_option("--states", a.states,
+                  "Key states to sample glTF animations into (dynamic scenes)")
+      ->check(CLI::Range(1, 100000));
+  cmd->add_option(
+         "--mode", a.mode,
+         "Dynamic scenes: 'diagonal' (animation time advances with the eye, the paper's mode) or "
+         "'decoupled' (also the eye fixed at each end while the scene animates, and the scene "
+         "frozen at each state while the eye moves)")
+      ->check(CLI::IsMember({"diagonal", "decoupled"}))
+      ->capture_default_str();
+  cmd->add_option("--json", a.json_out, "Write the result as JSON to this file ('-' = stdout)")
+      ->required();
+}
+
+vislib::SegmentOptions segment_options(const VisibilityArgs& a) {
+  vislib::SegmentOptions o;
+  o.resolution = a.resolution;
+  o.near = a.near;
+  o.eps_len = a.eps_len;
+  o.tile_size = a.tile;
+  o.mode = a.mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
+  return o;
+}
+
+double peak_rss_bytes() {
+  struct rusage ru;
+  getrusage(RUSAGE_SELF, &ru);
+  return double(ru.ru_maxrss) * 1024.0;  // Linux: kilobytes
+}
+
+json vec_json(vislib::Vec3 v) {
+  return json::array({v.x, v.y, v.z});
+}
+json mat_json(const vislib::Mat3& m) {
+  return json(std::vector<double>(m.m, m.m + 9));
+}
+
+json counts_json(const vislib::SegmentStats& s) {
+  return {{"triangle_pixel_pairs", s.pair_tests},
+          {"culled_pixel_pairs", s.culled_pairs},
+          {"covered_pairs", s.covered_pairs},
+          {"final_pieces", s.final_pieces},
+          {"pixels_with_pieces", s.pixels_with_pieces},
+          {"pieces_per_pixel", s.pieces_per_pixel()},
+          {"max_pieces_per_pixel", s.max_pieces_per_pixel},
+          {"triangle_tiles", s.triangle_tiles},
+          {"culled_triangle_tiles", s.culled_triangle_tiles},
+          {"peak_tile_bytes", s.peak_tile_bytes}};
+}
+
+std::vector<uint32_t> at_granularity(const vislib::Scene& scene, const std::vector<uint32_t>& tris,
+                                     const std::vector<uint32_t>& spheres,
+                                     const std::string& granularity) {
+  return granularity == "object" ? vislib::objects_of(scene, tris, spheres) : tris;
+}
+
+void write_json(const std::string& path, const json& j) {
+  std::string text = j.dump(1) + "\n";
+  if (path == "-")
+    std::fwrite(text.data(), 1, text.size(), stdout);
+  else
+    vislib::write_file_atomic(path, text);
+}
+
+vislib::Scene load(const VisibilityArgs& a, double& seconds) {
+  auto t0 = std::chrono::steady_clock::now();
+  vislib::Scene scene = load_scene_for_cli(a.scene, a.states);
+  seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return scene;
+}
+
+std::unique_ptr<tbb::global_control> thread_limit(int threads) {
+  if (threads <= 0) return nullptr;
+  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                               threads);
+}
+
+}  // namespace pvs_cli

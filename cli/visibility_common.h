@@ -1,0 +1,51 @@
+// visibility_common.h: what `pvs segment` and `pvs region` (cmd_visibility.cpp) share: their
+// common options, the kernel options they map to, and their JSON output.
+#pragma once
+
+#include <tbb/global_control.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/scene.h"
+
+namespace pvs_cli {
+
+// Options shared by `segment` and `region`.
+struct VisibilityArgs {
+  std::string scene;
+  int resolution = 512;
+  double near = vislib::kDefaultNear;
+  double eps_len = vislib::kDefaultEpsLen;
+  int threads = 0;
+  int tile = 32;
+  int states = 1;
+  std::string granularity = "triangle";
+  std::string mode = "diagonal";
+  std::string json_out;
+};
+
+void add_common(CLI::App* cmd, VisibilityArgs& a);
+vislib::SegmentOptions segment_options(const VisibilityArgs& a);
+double peak_rss_bytes();  // of this process, bytes
+nlohmann::json vec_json(vislib::Vec3 v);
+nlohmann::json mat_json(const vislib::Mat3& m);
+nlohmann::json counts_json(const vislib::SegmentStats& s);
+// The visible triangles, or their objects (spheres included) when granularity is "object".
+std::vector<uint32_t> at_granularity(const vislib::Scene& scene, const std::vector<uint32_t>& tris,
+                                     const std::vector<uint32_t>& spheres,
+                                     const std::string& granularity);
+// Writes j to `path` (atomically), or to stdout when path is "-".
+void write_json(const std::string& path, const nlohmann::json& j);
+// Loads the scene of `a`; `seconds` gets the time it took.
+vislib::Scene load(const VisibilityArgs& a, double& seconds);
+// Limits TBB to `threads` workers while the result lives (none when threads <= 0).
+std::unique_ptr<tbb::global_control> thread_limit(int threads);
+
+}  // namespace pvs_cli

@@ -1,0 +1,137 @@
+// Per-pixel compositing of coverage intervals (interval_list.h, math note §7): insertion-order
+// independence with crossings and ties, interpenetrating surfaces, merging, hidden insertions and
+// lists far longer than any pixel holds in practice.
+#include "vislib/kernel/interval_list.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "vislib/base/random.h"
+
+using namespace vislib;
+
+namespace {
+
+// depth(t) = a + b t
+LinearDepth line(double a, double b) {
+  return LinearDepth{a, -b, 1.0};
+}
+
+PieceList insert_all(const std::vector<Piece>& in) {
+  PieceList l;
+  for (const Piece& p : in) insert_piece(l, p);
+  return l;
+}
+
+void expect_same(const PieceList& a, const PieceList& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].id, b[i].id) << i;
+    EXPECT_EQ(a[i].t0, b[i].t0) << i;
+    EXPECT_EQ(a[i].t1, b[i].t1) << i;
+  }
+}
+
+}  // namespace
+
+TEST(IntervalList, InsertionOrderDoesNotChangeTheListWithCrossingsAndTies) {
+  Rng rng(21);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<Piece> in;
+    for (uint32_t id = 0; id < 30; ++id) {
+      // Few distinct ends and depths, so that pieces share ends, tie in depth and cross.
+      double a = rng.below(9) / 8.0, b = rng.below(9) / 8.0;
+      if (a > b) std::swap(a, b);
+      if (a == b) continue;
+      in.push_back(Piece{a, b, id, line(double(1 + rng.below(4)), double(rng.below(5)) - 2.0)});
+    }
+    const PieceList ref = insert_all(in);
+    ASSERT_TRUE(is_valid(ref));
+    ASSERT_FALSE(ref.empty());
+    for (int k = 0; k < 8; ++k) {
+      for (size_t i = in.size(); i > 1; --i) std::swap(in[i - 1], in[rng.below(i)]);
+      expect_same(insert_all(in), ref);
+    }
+  }
+}
+
+TEST(IntervalList, InterpenetratingSurfacesSplitAtTheirCrossing) {
+  // id 0: depth 1 + 2t, id 1: depth 2: they cross at t = 0.5; in front: id 0 before, id 1 after.
+  const Piece a{0, 1, 0, line(1, 2)}, b{0, 1, 1, line(2, 0)};
+  for (const PieceList& l : {insert_all({a, b}), insert_all({b, a})}) {
+    ASSERT_EQ(l.size(), 2u);
+    EXPECT_EQ(l[0].id, 0u);
+    EXPECT_EQ(l[0].t0, 0.0);
+    EXPECT_DOUBLE_EQ(l[0].t1, 0.5);
+    EXPECT_EQ(l[1].id, 1u);
+    EXPECT_DOUBLE_EQ(l[1].t0, 0.5);
+    EXPECT_EQ(l[1].t1, 1.0);
+  }
+}
+
+TEST(IntervalList, DepthTiesGoToTheLowerId) {
+  const Piece a{0.25, 0.75, 7, line(3, 0)}, b{0, 1, 4, line(3, 0)};
+  for (const PieceList& l : {insert_all({a, b}), insert_all({b, a})}) {
+    ASSERT_EQ(l.size(), 1u);
+    EXPECT_EQ(l[0].id, 4u);
+    EXPECT_EQ(l[0].t0, 0.0);
+    EXPECT_EQ(l[0].t1, 1.0);
+  }
+}
+
+TEST(IntervalList, TouchingPiecesOfOneIdMerge) {
+  PieceList l;
+  EXPECT_TRUE(insert_piece(l, Piece{0, 0.25, 3, line(5, 0)}));
+  EXPECT_TRUE(insert_piece(l, Piece{0.25, 0.5, 3, line(5, 0)}));
+  ASSERT_EQ(l.size(), 1u);
+  EXPECT_EQ(l[0].t0, 0.0);
+  EXPECT_EQ(l[0].t1, 0.5);
+  // A closer piece in the middle splits it in three; one more touching piece of id 3 beyond.
+  EXPECT_TRUE(insert_piece(l, Piece{0.1, 0.2, 9, line(1, 0)}));
+  EXPECT_TRUE(insert_piece(l, Piece{0.5, 0.75, 3, line(5, 0)}));
+  ASSERT_EQ(l.size(), 3u);
+  EXPECT_EQ(l[0].id, 3u);
+  EXPECT_EQ(l[1].id, 9u);
+  EXPECT_EQ(l[2].id, 3u);
+  EXPECT_EQ(l[2].t0, 0.2);
+  EXPECT_EQ(l[2].t1, 0.75);
+  EXPECT_TRUE(is_valid(l));
+}
+
+TEST(IntervalList, HiddenInsertionLeavesTheListUnchanged) {
+  PieceList l;
+  insert_piece(l, Piece{0, 1, 2, line(1, 0)});
+  const PieceList before = l;
+  EXPECT_FALSE(insert_piece(l, Piece{0.2, 0.9, 1, line(4, 1)}));
+  expect_same(l, before);
+}
+
+TEST(IntervalList, ThousandsOfDisjointPiecesAreAllKeptInOrder) {
+  // No capacity limit: a list holds as many pieces as the pixel needs (the vector grows).
+  const int n = 5000;
+  std::vector<Piece> in;
+  for (int i = 0; i < n; ++i)
+    in.push_back(Piece{i / double(n), (i + 0.5) / double(n), uint32_t(i), line(1 + i % 7, 0)});
+  Rng rng(5);
+  for (size_t i = in.size(); i > 1; --i) std::swap(in[i - 1], in[rng.below(i)]);
+  PieceList l = insert_all(in);
+  ASSERT_EQ(l.size(), size_t(n));
+  ASSERT_TRUE(is_valid(l));
+  for (int i = 0; i < n; ++i) {
+    auto p = lookup(l, (i + 0.25) / double(n));
+    ASSERT_TRUE(p.has_value()) << i;
+    EXPECT_EQ(p->id, uint32_t(i));
+    EXPECT_FALSE(lookup(l, (i + 0.75) / double(n)).has_value()) << i;
+  }
+  EXPECT_FALSE(covers_segment(l));
+}
+
+TEST(IntervalList, ValidityCheckRejectsOverlapsUnmergedNeighboursAndEmptyPieces) {
+  EXPECT_TRUE(is_valid(PieceList{}));
+  EXPECT_FALSE(is_valid(PieceList{Piece{0, 0.5, 1, {}}, Piece{0.4, 1, 2, {}}}));
+  EXPECT_FALSE(is_valid(PieceList{Piece{0, 0.5, 1, {}}, Piece{0.5, 1, 1, {}}}));
+  EXPECT_FALSE(is_valid(PieceList{Piece{0.5, 0.5, 1, {}}}));
+  EXPECT_TRUE(is_valid(PieceList{Piece{0, 0.5, 1, {}}, Piece{0.5, 1, 2, {}}}));
+}

@@ -1,0 +1,45 @@
+// cell_set.h: one cell's visible set read back from a PVS file, for the scene it was baked for
+// (pvs inspect, pvs view): the file's universe checked against the scene, object ids expanded to
+// the objects' triangles, PVS format errors turned into InputError naming the file.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pvs_format/pvs_format.h"
+#include "vislib/base/error.h"
+#include "vislib/base/vec.h"
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+// The granularity of a PVS file's ids.
+Granularity granularity_of(const pvs::FileInfo& info);
+
+// Throws InputError(path, ...) when the file's universe (objects or triangles, by its granularity)
+// is not the scene's count.
+void check_universe(const std::string& path, const pvs::FileInfo& info, const Scene& scene);
+
+// The triangles of a visible set: Triangle granularity: `ids` itself; Object: every triangle of
+// those objects, ascending. Ids must be < objects.size() (Object) or < triangle_count() (Triangle).
+std::vector<uint32_t> visible_triangles(const Scene& scene, const std::vector<uint32_t>& ids,
+                                        Granularity granularity);
+
+// The centre of a cell's view region (scene units).
+Vec3 view_region_centre(const pvs::CellLayout& layout, uint32_t cell);
+
+// Runs f() and returns its result; a pvs::FormatError thrown inside becomes InputError(path, its
+// message): the I/O boundary of code that reads the PVS file at `path`.
+template <class F>
+auto reading_pvs(const std::string& path, F&& f) -> decltype(f()) {
+  try {
+    return std::forward<F>(f)();
+  } catch (const pvs::FormatError& e) {
+    throw InputError(path, e.what());
+  }
+}
+
+}  // namespace vislib
