@@ -9,6 +9,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "vislib/base/file_util.h"
 
 namespace pvs_cli {
@@ -27,6 +28,7 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 }
 
 void run_export(const ExportOptions& o) {
+  check_output_file(o.out, "--output");  // before any work (issue 17 item 1)
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
   double tau = o.time.value_or(0.0);
   std::string obj = "# pvs export of " + o.scene + ": face i is triangle id i\n";
@@ -46,8 +48,9 @@ void run_export(const ExportOptions& o) {
            std::to_string(tri[2] + 1) + "\n";
   }
   vislib::write_file_atomic(o.out, obj);
-  std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
-               scene.vertex_count(), scene.triangle_count());
+  if (show_progress())
+    std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
+                 scene.vertex_count(), scene.triangle_count());
   if (scene.sphere_count() == 0) return;
   size_t K = o.time ? 1 : scene.sphere_centers.size();
   std::string sp =
@@ -63,8 +66,9 @@ void run_export(const ExportOptions& o) {
     sp += "\n";
   }
   vislib::write_file_atomic(o.out + ".spheres", sp);
-  std::fprintf(stderr, "pvs: wrote %s.spheres (%zu spheres, %zu states)\n", o.out.c_str(),
-               scene.sphere_count(), K);
+  if (show_progress())
+    std::fprintf(stderr, "pvs: wrote %s.spheres (%zu spheres, %zu states)\n", o.out.c_str(),
+                 scene.sphere_count(), K);
 }
 
 const Registration reg("export", [](CLI::App& app) {
@@ -74,9 +78,9 @@ const Registration reg("export", [](CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file")->required();
   cmd->add_option("-o,--output", o->out, "Output .obj")->required();
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->add_option("--time", o->time, "Animation time in [0,1] (default: state 0)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(in_range(0.0, 1.0));
   cmd->callback([o] { run_export(*o); });
 });
 

@@ -12,6 +12,7 @@
 #include "cli/commands.h"
 #include "cli/inspect_report.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/cell_set.h"
 #include "vislib/bake/pvs_summary.h"
@@ -48,15 +49,14 @@ void add_inspect(CLI::App& app) {
       "Check and summarise a PVS file (cells, bytes, compression mix, visible counts), or "
       "show one cell and export the scene reduced to its visible set as glTF");
   cmd->add_option("PVS", a->file, "PVS file")->required();
-  auto* cell_opt =
-      cmd->add_option("--cell", a->cell, "Show this cell")->check(CLI::NonNegativeNumber);
+  auto* cell_opt = cmd->add_option("--cell", a->cell, "Show this cell")->check(non_negative());
   cmd->add_option("--at", a->at, "Show the cell containing the point x,y,z")->excludes(cell_opt);
   cmd->add_flag("--json", a->json_out, "Print JSON instead of text (all visible ids of a cell)");
   cmd->add_option("--scene", a->scene,
                   "The scene the PVS was baked for (checked by its fingerprint)");
   cmd->add_option("--states", a->states,
                   "With --scene: key states to sample animations into (as for the bake)")
-      ->check(CLI::Range(1, 100000));
+      ->check(in_range(1, 100000));
   cmd->add_option("--export-gltf", a->gltf,
                   "With --scene and a cell: write the scene reduced to the cell's set (.glb), with the "
                   "source's normals, UVs, materials, textures and copyright");
@@ -70,21 +70,23 @@ void add_inspect(CLI::App& app) {
   cmd->add_option("--max-ids", a->max_ids, "Text output: print at most this many ids of a cell")
       ->capture_default_str();
   cmd->callback([a] {
-    pvs::ReadOptions opt;
-    vislib::Scene scene;
-    if (!a->scene.empty()) {
-      scene = load_scene_for_cli(a->scene, a->states);
-      opt.expected_fingerprint = vislib::scene_fingerprint(scene);
-    }
     if (!a->gltf.empty()) {
       if (a->scene.empty()) throw CLI::ValidationError("--export-gltf", "needs --scene");
       if (a->cell < 0 && a->at.empty())
         throw CLI::ValidationError("--export-gltf", "needs --cell or --at");
+      check_output_file(a->gltf, "--export-gltf");  // before any work (issue 17 item 1)
     }
     if (!a->render_dir.empty()) {
       if (a->scene.empty()) throw CLI::ValidationError("--render", "needs --scene");
       if (a->cell < 0 && a->at.empty())
         throw CLI::ValidationError("--render", "needs --cell or --at");
+      check_output_dir(a->render_dir, "--render");
+    }
+    pvs::ReadOptions opt;
+    vislib::Scene scene;
+    if (!a->scene.empty()) {
+      scene = load_scene_for_cli(a->scene, a->states);
+      opt.expected_fingerprint = vislib::scene_fingerprint(scene);
     }
     int fw = 0, fh = 0;
     if (std::sscanf(a->frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||

@@ -11,6 +11,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "cli/view_report.h"
 #include "pvs_format/pvs_format.h"
 #include "runtime/near_far.h"
@@ -77,6 +78,8 @@ ViewCell read_view_cell(const ViewArgs& a, vislib::Vec3 eye) {
 }
 
 void run_view(const ViewArgs& a) {
+  check_output_file(a.output, "--output");  // before any work (issue 17 item 1)
+  if (!a.json_path.empty()) check_output_file(a.json_path, "--json", true);
   int fw = 0, fh = 0;
   if (std::sscanf(a.frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
       fh > 8192)
@@ -230,13 +233,13 @@ void add_view(CLI::App& app) {
                 "Also render the progressive near region (CloVR rings up to r2) and report "
                 "the minimum SSIM between consecutive frames");
   cmd->add_option("--rings", a->rings, "--grow: equal-area rings up to r2")
-      ->check(CLI::Range(1, 1000))
+      ->check(in_range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--frames-per-ring", a->frames_per_ring,
                   "--grow: frames over which each ring is injected (Alg. 1 with R animated from "
                   "the previous "
                   "ring's radius to the ring's)")
-      ->check(CLI::Range(1, 1000))
+      ->check(in_range(1, 1000))
       ->capture_default_str();
   cmd->add_option(
       "--merge-min", a->merge_min,
@@ -244,18 +247,18 @@ void add_view(CLI::App& app) {
       "region) each (default: the mean over the equal-area rings)");
   cmd->add_option("--states", a->states,
                   "Key states to sample glTF animations into (as for the bake)")
-      ->check(CLI::Range(1, 100000))
+      ->check(in_range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--time", a->tau, "Animation time tau in [0,1] of the frame (dynamic scenes)")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(in_range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--near-fraction", a->near_fraction, "--grow: R_n / R of Alg. 1")
-      ->check(CLI::Range(0.01, 0.99))
+      ->check(in_range(0.01, 0.99))
       ->capture_default_str();
   cmd->add_option("--frame", a->frame, "Frame size WxH")->capture_default_str();
   cmd->add_option("--env-size", a->env_size,
                   "Environment map face side in pixels (default: the frame height)")
-      ->check(CLI::Range(0, 8192));
+      ->check(in_range(0, 8192));
   cmd->add_option("--lookup", a->lookup,
                   "Environment map lookup: eye (along the eye ray, the paper) or cylinder "
                   "(from O through the eye ray's exit point on the r2 cylinder)")

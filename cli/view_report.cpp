@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "cli/options.h"
 #include "vislib/eval/metrics.h"
 
 namespace pvs_cli {
@@ -53,6 +54,7 @@ json growth_json(const vislib::GrowthRun& g) {
 }
 
 void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
+  if (!show_progress()) return;  // the summary on stderr obeys -q (the JSON has it all)
   auto fmt_psnr = [](const json& v) {
     return v.is_null() ? std::string("inf") : std::to_string(v.get<double>());
   };
@@ -75,9 +77,10 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
     for (const char* k : {"merged", "equal_area"}) {
       const json& g = j["continuity"][k];
       if (g["min_consecutive_ssim"].is_null()) continue;
-      std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
-                   g["radii"].size(), g["frames"].get<size_t>(),
-                   g["min_consecutive_ssim"].get<double>());
+      if (show_progress())
+        std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
+                     g["radii"].size(), g["frames"].get<size_t>(),
+                     g["min_consecutive_ssim"].get<double>());
     }
 }
 
