@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
   auto& reg = pvs_cli::registry();
   std::sort(reg.begin(), reg.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [name, add] : reg) add(app);
-  for (CLI::App* sub : app.get_subcommands({})) pvs_cli::add_common_options(*sub);
+  for (CLI::App* sub : app.get_subcommands({}))
+    if (!sub->get_name().empty()) pvs_cli::add_common_options(*sub);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

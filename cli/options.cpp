@@ -69,7 +69,8 @@ void add_common_options(CLI::App& cmd) {
       "Verbose: also print what is loaded, created and chosen");
   cmd.add_flag_callback(
       "-q,--quiet", [] { set_verbosity(0); }, "Quiet: no progress and no warnings, errors only");
-  for (CLI::App* sub : cmd.get_subcommands({})) add_common_options(*sub);
+  for (CLI::App* sub : cmd.get_subcommands({}))
+    if (!sub->get_name().empty()) add_common_options(*sub);  // not option groups
 }
 
 void check_output_file(const std::string& path, const std::string& option, bool allow_stdout) {

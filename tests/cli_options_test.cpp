@@ -4,6 +4,7 @@
 // first, validator messages without DBL_MAX, and progress inside a long cell.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 #include <tiny_gltf.h>
 
+#include <sys/wait.h>
+
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
