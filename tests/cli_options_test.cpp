@@ -104,7 +104,7 @@ TEST(CliOutputs, ParentFoldersAreCreatedForEveryOutput) {
   EXPECT_TRUE(fs::exists(base + "/r/report.json"));
   // pvs view -o into a missing folder (it failed before).
   EXPECT_EQ(run_pvs("view " + base + "/b/c/city.pvs --scene " + city() +
-                        " --at 0,1.6,0 --look 10,1.6,0 --frame 32x24 -o " + base + "/v/w/frame.png",
+                        " --at -15,1.6,-15 --look 10,1.6,0 --centre -15,1.65,-15 --near-far 5,10 --frame 32x24 -o " + base + "/v/w/frame.png",
                     &out),
             0)
       << out;
