@@ -1025,13 +1025,16 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
             if (!skinned || p.joints.empty()) {
               nrm = unit_or_nan(transform_normal(world[0][n], p.normals[v]));
             } else {
+              // The weight blend of the joints' normal transforms; joints whose matrix is
+              // singular (scaled to 0) are skipped, and the node transform is the fallback.
               Vec3 acc{0, 0, 0};
-              for (int c = 0; c < 4; ++c)
-                if (p.weights[v][c] != 0 && p.joints[v][c] < joint_m[0].size())
-                  acc = acc +
-                        unit_or_nan(transform_normal(joint_m[0][p.joints[v][c]], p.normals[v])) *
-                            p.weights[v][c];
+              for (int c = 0; c < 4; ++c) {
+                if (p.weights[v][c] == 0 || p.joints[v][c] >= joint_m[0].size()) continue;
+                Vec3 t = unit_or_nan(transform_normal(joint_m[0][p.joints[v][c]], p.normals[v]));
+                if (is_finite(t)) acc = acc + t * p.weights[v][c];
+              }
               nrm = unit_or_nan(acc);
+              if (!is_finite(nrm)) nrm = unit_or_nan(transform_normal(world[0][n], p.normals[v]));
             }
           }
           app.normals.push_back(nrm);
