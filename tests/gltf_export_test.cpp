@@ -2,9 +2,8 @@
 // viewer needs survives (materials, textures, normals, UVs, copyright), the triangles come back
 // in order, and the Khronos glTF validator finds no error in the export of every shared scene.
 #include <gtest/gtest.h>
-#include <tiny_gltf.h>
-
 #include <sys/wait.h>
+#include <tiny_gltf.h>
 
 #include <algorithm>
 #include <cmath>
@@ -72,7 +71,7 @@ int validate(const std::string& file, std::string* report) {
 
 }  // namespace
 
-TEST(GltfExport, FoxKeepsCopyrightMaterialTextureNormalsAndUvs) {
+TEST(GltfExport, FoxKeepsCopyrightMaterialTextureAndUvs) {
   VISLIB_REQUIRE_SHARED(shared);
   const std::string fox = shared + "/scenes/khronos_fox/Fox.glb";
   Scene scene = load_scene(fox);
@@ -83,7 +82,9 @@ TEST(GltfExport, FoxKeepsCopyrightMaterialTextureNormalsAndUvs) {
   ASSERT_FALSE(app.materials.empty());
   ASSERT_GE(app.materials[0].base_color_image, 0);
   EXPECT_FALSE(app.images[size_t(app.materials[0].base_color_image)].bytes.empty());
-  for (const Vec3& n : app.normals) ASSERT_NEAR(length(n), 1.0, 1e-9);
+  // Fox.glb has no NORMAL attribute: every normal is NaN (absent), so none is exported.
+  for (const Vec3& n : app.normals)
+    ASSERT_TRUE(std::isnan(n.x) && std::isnan(n.y) && std::isnan(n.z));
 
   std::vector<uint32_t> ids = every_other(scene);
   Scene sub = scene_subset(scene, ids, Granularity::Triangle);
@@ -99,7 +100,7 @@ TEST(GltfExport, FoxKeepsCopyrightMaterialTextureNormalsAndUvs) {
   EXPECT_EQ(m.images[0].mimeType, app.images[size_t(app.materials[0].base_color_image)].mime_type);
   ASSERT_EQ(m.meshes.size(), 1u);
   for (const auto& p : m.meshes[0].primitives) {
-    EXPECT_TRUE(p.attributes.count("NORMAL"));
+    EXPECT_FALSE(p.attributes.count("NORMAL"));
     EXPECT_TRUE(p.attributes.count("TEXCOORD_0"));
     EXPECT_EQ(p.material, 0);
   }
@@ -113,6 +114,41 @@ TEST(GltfExport, FoxKeepsCopyrightMaterialTextureNormalsAndUvs) {
     for (int c = 0; c < 3; ++c)
       ASSERT_LE(length(a[c] - b[c]), 1e-4 * (1 + length(a[c]))) << "triangle " << i;
   }
+}
+
+TEST(GltfExport, NormalsAreUnitInWorldSpaceAndExported) {
+  VISLIB_REQUIRE_SHARED(shared);
+  const std::string box = shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf";
+  Scene scene = load_scene(box);
+  SceneAppearance app = load_appearance(box);
+  ASSERT_EQ(app.normals.size(), scene.vertex_count());
+  size_t with = 0;
+  for (const Vec3& n : app.normals)
+    if (!std::isnan(n.x)) {
+      ++with;
+      ASSERT_NEAR(length(n), 1.0, 1e-9);
+    }
+  ASSERT_GT(with, 0u);
+  // Each triangle's normals point to the side its winding faces (flat boxes: within 60 degrees).
+  size_t agree = 0, checked = 0;
+  for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
+    auto c = scene.corners(t);
+    Vec3 f = cross(c[1] - c[0], c[2] - c[0]);
+    const Vec3& n = app.normals[scene.triangles[t][0]];
+    if (std::isnan(n.x) || !(length(f) > 0)) continue;
+    ++checked;
+    agree += dot(f, n) > 0.5 * length(f);
+  }
+  EXPECT_GT(checked, 0u);
+  EXPECT_EQ(agree, checked);
+  std::vector<uint32_t> ids = every_other(scene);
+  Scene sub = scene_subset(scene, ids, Granularity::Triangle);
+  SceneAppearance sub_app = appearance_subset(scene, app, ids, Granularity::Triangle);
+  tinygltf::Model m = parse_glb(scene_to_glb(sub, &sub_app));
+  size_t with_normals = 0;
+  for (const auto& mesh : m.meshes)
+    for (const auto& p : mesh.primitives) with_normals += p.attributes.count("NORMAL");
+  EXPECT_GT(with_normals, 0u);
 }
 
 TEST(GltfExport, MaterialRunsBecomePrimitivesAndOrderIsKept) {
