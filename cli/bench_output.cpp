@@ -40,7 +40,7 @@ json set_json(const vislib::SetComparison& c) {
           {"extra", c.extra}};
 }
 
-json method_json(const vislib::Checkpoint& c, const vislib::SetComparison& vs_reference) {
+json method_json(const vislib::QualityCheckpoint& c, const vislib::SetComparison& vs_reference) {
   json j = quality_json(c.quality);
   j["runs"] = c.runs;
   j["seconds"] = num(c.seconds);

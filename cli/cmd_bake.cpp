@@ -36,6 +36,8 @@ struct BakeArgs {
   double near = vislib::kDefaultNear, eps_len = vislib::kDefaultEpsLen;
   std::string granularity = "triangle";
   std::string mode = "diagonal";
+  std::string coplanar = "both";
+  double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
   std::string preset = "default";
 };
@@ -164,6 +166,14 @@ void add_bake(CLI::App& app) {
                   "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))
       ->capture_default_str();
+  cmd->add_option("--coplanar", a->coplanar,
+                  "Depth ties: 'both' (within --eps-z) or 'first' (as for pvs segment)")
+      ->check(CLI::IsMember({"both", "first"}))
+      ->capture_default_str();
+  cmd->add_option("--eps-z", a->eps_z,
+                  "Depth tie tolerance, relative to the front depth (as for pvs segment)")
+      ->check(in_range(0.0, 0.1))
+      ->capture_default_str();
   cmd->add_option("--granularity", a->granularity,
                   "Store triangle ids (spheres after them) or object ids")
       ->check(CLI::IsMember({"triangle", "object"}))
@@ -216,6 +226,11 @@ void add_bake(CLI::App& app) {
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                     a->threads);
     std::string checkpoint = a->checkpoint.empty() ? a->output + ".ckpt" : a->checkpoint;
+    // One bake per output at a time (the checkpoint has its own lock too): taken before looking
+    // at the checkpoint, so a second bake is told that the first is running (exit 2).
+    std::unique_ptr<vislib::FileLock> lock;
+    if (!a->dry_run)
+      lock = std::make_unique<vislib::FileLock>(a->output + ".lock", "the output " + a->output);
     if (!a->resume && file_exists(checkpoint)) {
       std::fprintf(stderr,
                    "pvs: error: %s: a checkpoint of an interrupted bake exists: pass --resume to "
@@ -225,11 +240,10 @@ void add_bake(CLI::App& app) {
     }
     auto t0 = std::chrono::steady_clock::now();
     vislib::Scene scene = load_scene_for_cli(a->scene, a->states);
-    if (scene.sphere_count() > 0)
-      warn(a->scene + ": spheres are not handled by the static kernel; ignored");
-    if (scene.triangle_count() >= 0xFFFFFFFFull)
-      throw vislib::InputError(a->scene, "more than 2^32-1 triangles");
-    vislib::ViewCells cells = make_cells(*a, scene);
+    if (scene.triangle_count() + scene.sphere_count() >= 0xFFFFFFFFull)
+      throw vislib::InputError(a->scene, "more than 2^32-1 triangles and spheres");
+    vislib::ViewCells cells =
+        vislib::with_memory_stage("placing view cells", [&] { return make_cells(*a, scene); });
     double setup_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     uint32_t n = cells.layout.cell_count();
     if (n == 0) {
@@ -265,9 +279,19 @@ void add_bake(CLI::App& app) {
         a->granularity == "object" ? vislib::Granularity::Object : vislib::Granularity::Triangle;
     s.region.segment.mode =
         a->mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
-    vislib::BakeFiles files{a->output, checkpoint, a->resume};
+    s.region.segment.coplanar =
+        a->coplanar == "first" ? vislib::CoplanarRule::First : vislib::CoplanarRule::Both;
+    s.region.segment.eps_z = a->eps_z;
+    vislib::BakeFiles files{a->output, checkpoint, a->resume, /*lock=*/false};
     vislib::BakeReport r = vislib::bake(scene, cells, s, shard, files, progress_printer());
 
+    if (r.checkpoint_dropped_records)
+      std::fprintf(stderr,
+                   "pvs bake: checkpoint %s: %zu damaged or torn record(s) dropped (%llu bytes); "
+                   "their cells "
+                   "were baked again, %u valid records kept\n",
+                   checkpoint.c_str(), r.checkpoint_dropped_records,
+                   static_cast<unsigned long long>(r.checkpoint_dropped_bytes), r.resumed);
     double kernel = 0;
     for (double x : r.cell_seconds) kernel += x;
     if (show_progress())

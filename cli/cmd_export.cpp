@@ -2,6 +2,8 @@
 // triangle id i. One `o <object name>` line each time the object changes along the id order,
 // all vertices as `v` lines (%.17g, exact round trip) in vertex order, one `f` line per triangle.
 // Positions are those at animation time TAU (Scene::position_at; default 0 = state 0).
+// --id-map FILE.json: the runs of consecutive triangle ids of one object with their vertex blocks
+// (vislib/scene/id_map.h), so an engine maps PVS ids to its draw calls.
 // Spheres, if any, go to OUT.spheres in the sphere text format (docs/sphere-format.md): all key
 // states without --time, the single state at TAU with --time.
 #include <cstdio>
@@ -11,12 +13,13 @@
 #include "cli/load_scene.h"
 #include "cli/options.h"
 #include "vislib/base/file_util.h"
+#include "vislib/scene/id_map.h"
 
 namespace pvs_cli {
 namespace {
 
 struct ExportOptions {
-  std::string scene, out;
+  std::string scene, out, id_map;
   int states = 1;
   std::optional<double> time;
 };
@@ -29,6 +32,7 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 
 void run_export(const ExportOptions& o) {
   check_output_file(o.out, "--output");  // before any work (issue 17 item 1)
+  if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
   double tau = o.time.value_or(0.0);
   std::string obj = "# pvs export of " + o.scene + ": face i is triangle id i\n";
@@ -50,7 +54,14 @@ void run_export(const ExportOptions& o) {
   vislib::write_file_atomic(o.out, obj);
   if (show_progress())
     std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
-                 scene.vertex_count(), scene.triangle_count());
+               scene.vertex_count(), scene.triangle_count());
+  if (!o.id_map.empty()) {
+    const vislib::IdMap map = vislib::id_map(scene);
+    vislib::write_file_atomic(o.id_map, vislib::id_map_json(scene, map));
+    if (show_progress())
+      std::fprintf(stderr, "pvs: wrote %s (%zu runs, vertices %s)\n", o.id_map.c_str(),
+                 map.runs.size(), map.vertices_tiled ? "tiled per run" : "shared between runs");
+  }
   if (scene.sphere_count() == 0) return;
   size_t K = o.time ? 1 : scene.sphere_centers.size();
   std::string sp =
@@ -81,6 +92,10 @@ const Registration reg("export", [](CLI::App& app) {
       ->check(positive());
   cmd->add_option("--time", o->time, "Animation time in [0,1] (default: state 0)")
       ->check(in_range(0.0, 1.0));
+  cmd->add_option(
+      "--id-map", o->id_map,
+      "Also write FILE.json: runs of consecutive triangle ids of one object and their vertex "
+      "blocks (PVS ids to draw calls; docs/runtime.md)");
   cmd->callback([o] { run_export(*o); });
 });
 

@@ -43,7 +43,14 @@ void run_info(const InfoOptions& o) {
     std::snprintf(buf, sizeof buf, "%g", info.diagonal);
     row("diagonal", buf);
   }
-  row("units", info.units_guess);
+  if (!info.bbox.empty()) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "centre %g from the origin (%g diagonals)%s", info.origin_offset,
+                  info.diagonal > 0 ? info.origin_offset / info.diagonal : 0.0,
+                  info.far_from_origin ? ": far (float32 consumers lose precision)" : "");
+    row("placement", buf);
+  }
+  row("units", "not recorded by mesh formats (glTF: metres); vislib makes no guess");
   row("degenerate triangles", num(info.degenerate_triangles));
   row("non-finite vertices", num(info.nonfinite_vertices));
   row("duplicate vertices", num(info.duplicate_vertices));

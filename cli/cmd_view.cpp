@@ -9,6 +9,8 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "cli/cmd_view_ods.h"
+#include "cli/cmd_view_stereo.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
@@ -33,7 +35,7 @@ namespace {
 using nlohmann::json;
 
 struct ViewArgs {
-  std::string file, scene, at, look, near_far = "10,20", centre, output, json_path;
+  std::string file, scene, at, look, near_far, centre, output, json_path, frames_out;
   std::string frame = "640x480", lookup = "eye";
   bool grow = false;
   int env_size = 0, rings = 8, states = 1, frames_per_ring = 4;
@@ -47,6 +49,7 @@ struct ViewCell {
   std::vector<uint32_t> tris;
   vislib::Vec3 centre;  // of the cell's view region
   vislib::Box3 region;  // the cell's view region
+  pvs::Box box;         // the cell's lookup box
 };
 
 ViewCell read_view_cell(const ViewArgs& a, vislib::Vec3 eye) {
@@ -73,21 +76,23 @@ ViewCell read_view_cell(const ViewArgs& a, vislib::Vec3 eye) {
         vislib::visible_triangles(v.full_scene, r.read_cell(v.cell), vislib::granularity_of(info));
     v.centre = vislib::view_region_centre(info.layout, v.cell);
     v.region = vislib::to_box3(info.layout.view_region(v.cell));
+    v.box = info.layout.cell_box(v.cell);
   });
   return v;
 }
 
-void run_view(const ViewArgs& a) {
-  check_output_file(a.output, "--output");  // before any work (issue 17 item 1)
-  if (!a.json_path.empty()) check_output_file(a.json_path, "--json", true);
+void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
   int fw = 0, fh = 0;
   if (std::sscanf(a.frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
       fh > 8192)
     throw CLI::ValidationError("--frame",
                                "expected WxH with 11 <= W, H <= 8192, got '" + a.frame + "'");
-  std::vector<double> radii = parse_doubles(a.near_far, "--near-far", 2);
-  if (!(radii[0] >= 0 && radii[0] < radii[1]))
-    throw CLI::ValidationError("--near-far", "expected 0 <= r1 < r2, got '" + a.near_far + "'");
+  std::vector<double> radii;
+  if (!a.near_far.empty()) {
+    radii = parse_doubles(a.near_far, "--near-far", 2);
+    if (!(radii[0] >= 0 && radii[0] < radii[1]))
+      throw CLI::ValidationError("--near-far", "expected 0 <= r1 < r2, got '" + a.near_far + "'");
+  }
   const vislib::Vec3 eye = parse_vec3(a.at, "--at"), target = parse_vec3(a.look, "--look");
   if (length(target - eye) == 0) throw CLI::ValidationError("--look", "must differ from --at");
 
@@ -108,6 +113,12 @@ void run_view(const ViewArgs& a) {
   }
   const double eye_axis =
       pvs_runtime::axis_distance({eye.x, eye.y, eye.z}, {centre.x, centre.y, centre.z});
+  if (radii.empty()) {  // derived from the cell, as pvs_rt_cell_near_far (docs/runtime.md)
+    const double half_diagonal =
+        0.5 * std::hypot(v.box.max[0] - v.box.min[0], v.box.max[2] - v.box.min[2]);
+    const double r1 = 1.25 * std::max({half_diagonal, eye_axis, 1e-6});
+    radii = {r1, 2 * r1};
+  }
   if (!(eye_axis < radii[0]))
     throw CLI::ValidationError("--near-far", "the eye is " + std::to_string(eye_axis) +
                                                  " from the centre's axis: r1 must exceed it");
@@ -186,8 +197,21 @@ void run_view(const ViewArgs& a) {
     g.near_fraction = a.near_fraction;
     g.env_size = s.env_size;
     g.frames_per_ring = a.frames_per_ring;
+    auto frames_to = [&](const char* prefix) {
+      if (!a.frames_out.empty()) {
+        std::filesystem::create_directories(a.frames_out);
+        g.on_frame = [&a, prefix, fw, fh](size_t i, const vislib::GrowthStep&,
+                                          const vislib::Frame& f) {
+          char name[64];
+          std::snprintf(name, sizeof name, "/%s_%04zu.png", prefix, i);
+          vislib::write_rgb8_image(a.frames_out + name, fw, fh, f.rgb);
+        };
+      }
+    };
+    frames_to("merged");
     json merged_json =
         growth_json(vislib::grow_near_region(scene, rt, tris, cam, truth, plan.merged, g));
+    frames_to("equal_area");
     json equal_json =
         growth_json(vislib::grow_near_region(scene, rt, tris, cam, truth, plan.equal, g));
     j["continuity"] = {{"min_consecutive_ssim", merged_json["min_consecutive_ssim"]},
@@ -200,6 +224,7 @@ void run_view(const ViewArgs& a) {
                        {"equal_area", equal_json}};
   }
 
+  if (stereo.enabled()) j["stereo"] = run_view_stereo(stereo, a.file, scene, rt, cam, a.output);
   print_view(j, rc, !moving.empty() && v.full_scene.is_dynamic());
   if (a.json_path == "-") {
     std::printf("%s\n", j.dump(1).c_str());
@@ -221,10 +246,14 @@ void add_view(CLI::App& app) {
                   "The scene the PVS was baked for (checked by its fingerprint)")
       ->required();
   cmd->add_option("--at", a->at, "User eye x,y,z (its cell's visible set is used)")->required();
-  cmd->add_option("--look", a->look, "Point x,y,z the user looks at")->required();
-  cmd->add_option("--near-far", a->near_far,
-                  "Radii r1,r2 of the cylinders about the centre (scene units)")
-      ->capture_default_str();
+  cmd->add_option("--look", a->look, "Point x,y,z the user looks at (required without --ods)");
+  cmd->add_option(
+      "--near-far", a->near_far,
+      "Radii r1,r2 of the cylinders about the centre (scene units; default: r1 = 1.25 x "
+      "the half x-z diagonal of the cell's box, r2 = 2 r1, as pvs_rt_cell_near_far)");
+  cmd->add_option("--frames-out", a->frames_out,
+                  "--grow: also write every growth frame as DIR/merged_NNNN.png and "
+                  "DIR/equal_area_NNNN.png");
   cmd->add_option("--centre", a->centre,
                   "Centre O x,y,z of the cylinders and environment map (default: the "
                   "centre of the cell's view region, or the free sample of the region nearest "
@@ -269,7 +298,22 @@ void add_view(CLI::App& app) {
                   "<out>_nomorph.png are written next to it")
       ->required();
   cmd->add_option("--json", a->json_path, "Write the metrics as JSON ('-' = stdout)");
-  cmd->callback([a] { run_view(*a); });
+  auto ods = std::make_shared<OdsViewArgs>();
+  add_ods_view_options(cmd, ods);
+  std::shared_ptr<ViewStereoArgs> stereo = add_view_stereo_options(cmd);
+  cmd->callback([a, ods, stereo] {
+    // Every output checked before any work, --ods and --stereo too (issue 17 item 1).
+    check_output_file(a->output, "--output");
+    if (!a->json_path.empty()) check_output_file(a->json_path, "--json", true);
+    if (ods->enabled && stereo->enabled())
+      throw CLI::ValidationError("--stereo", "cannot be combined with --ods");
+    if (ods->enabled)
+      return run_view_ods(*ods,
+                          {a->file, a->scene, a->at, a->output, a->json_path, a->states, a->tau});
+    if (a->look.empty()) throw CLI::ValidationError("--look", "is required (except with --ods)");
+    stereo->ipd = ods->ipd_m * ods->units_per_metre;  // --ipd and --units-per-metre are shared
+    run_view(*a, *stereo);
+  });
 }
 
 Registration view_registration("view", add_view);

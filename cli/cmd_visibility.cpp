@@ -12,6 +12,7 @@
 #include "cli/load_scene.h"
 #include "cli/options.h"
 #include "cli/visibility_common.h"
+#include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/import.h"
@@ -55,7 +56,10 @@ void add_segment(CLI::App& app) {
     vislib::Vec3 v0 = parse_vec3(*from, "--from"), v1 = parse_vec3(*to, "--to");
     double load_s;
     vislib::Scene scene = load(*a, load_s);
-    vislib::SegmentResult r = vislib::segment_visibility(scene, v0, v1, so);
+    vislib::SegmentResult r = vislib::with_memory_stage(
+        "computing from-segment visibility at N = " + std::to_string(so.resolution) + " on " +
+            std::to_string(scene.triangle_count()) + " triangles",
+        [&] { return vislib::segment_visibility(scene, v0, v1, so); });
     json j = {{"scene", a->scene},
               {"resolution", so.resolution},
               {"near", so.near},
@@ -65,18 +69,14 @@ void add_segment(CLI::App& app) {
               {"orientation", mat_json(so.orientation)},
               {"granularity", a->granularity},
               {"mode", a->mode},
+              {"coplanar", a->coplanar},
+              {"eps_z", so.eps_z},
               {"states", scene.state_count()},
               {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
               {"visible_spheres", r.visible_spheres},
               {"visible_triangles", r.visible.size()}};
     json w = json::array();
-    for (const auto& x : r.witnesses)
-      w.push_back({{x.is_sphere ? "sphere" : "tri", x.tri},
-                   {"face", x.face},
-                   {"x", x.x},
-                   {"y", x.y},
-                   {"t", x.t},
-                   {"tau", x.tau}});
+    for (const auto& x : r.witnesses) w.push_back(witness_json(x));
     j["witnesses"] = w;
     j["timings"] = {{"load_seconds", load_s}, {"visibility_seconds", r.stats.seconds}};
     j["counts"] = counts_json(r.stats);
@@ -97,6 +97,7 @@ void add_region(CLI::App& app) {
   auto box = std::make_shared<std::string>();
   auto runs = std::make_shared<int>(1);
   auto seed = std::make_shared<uint64_t>(1);
+  auto witness = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "region",
       "Triangles visible from a view region: from-segment runs on the perimeter of a view "
@@ -108,6 +109,9 @@ void add_region(CLI::App& app) {
       ->check(in_range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--seed", *seed, "Seed of the random orientations")->capture_default_str();
+  cmd->add_flag("--witness", *witness,
+                "Add one witness per id of the union: the perimeter segment and run that saw it, "
+                "and its (face, x, y, t, tau) in that run");
   cmd->callback([=] {
     check_output_file(a->json_out, "--json", true);  // before any work (issue 17 item 1)
     auto limit = thread_limit(a->threads);
@@ -117,6 +121,7 @@ void add_region(CLI::App& app) {
     region.extend({b[3], b[4], b[5]});
     vislib::RegionOptions ro;
     ro.segment = segment_options(*a);
+    ro.segment.want_witnesses = *witness;
     ro.runs = *runs;
     ro.seed = *seed;
     double load_s;
@@ -159,6 +164,8 @@ void add_region(CLI::App& app) {
         {"granularity", a->granularity},
         {"segments", segs},
         {"mode", a->mode},
+        {"coplanar", a->coplanar},
+        {"eps_z", ro.segment.eps_z},
         {"states", scene.state_count()},
         {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
         {"visible_spheres", r.visible_spheres},
@@ -166,6 +173,16 @@ void add_region(CLI::App& app) {
         {"timings", {{"load_seconds", load_s}, {"visibility_seconds", r.seconds}}},
         {"counts",
          {{"scene_triangles", scene.triangle_count()}, {"peak_rss_bytes", peak_rss_bytes()}}}};
+    if (*witness) {
+      json w = json::array();
+      for (const auto& x : r.witnesses) {
+        json e = witness_json(x.witness);
+        e["segment"] = x.segment;
+        e["run"] = x.run;
+        w.push_back(e);
+      }
+      j["witnesses"] = w;
+    }
     write_json(a->json_out, j);
     if (show_progress())
       std::fprintf(

@@ -5,6 +5,7 @@
 
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
 
@@ -24,6 +25,19 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states) {
                 scene.state_count(),
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   info(buf);
+  vislib::Box3 b = scene.bounds();
+  if (vislib::far_from_origin(b)) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "%s: the scene lies far from the origin (centre %g away, %g times its size): "
+                  "vislib works in "
+                  "double and is not affected, but float32 consumers (the Embree baseline, "
+                  "renderers, engines) "
+                  "lose precision there; consider re-centring it",
+                  path.c_str(), length((b.min + b.max) * 0.5),
+                  length((b.min + b.max) * 0.5) / length(b.max - b.min));
+    warn(buf);
+  }
   return scene;
 }
 

@@ -89,6 +89,12 @@ int main(int argc, char** argv) {
     // which names the file); still bad input.
     std::fprintf(stderr, "pvs: error: PVS file: %s\n", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    // Out of memory outside every named stage: still say how much was asked for.
+    std::fprintf(
+        stderr, "pvs: error: %s\n",
+        vislib::OutOfMemory("running the command", vislib::failed_allocation_bytes()).what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "pvs: error: %s\n", e.what());
     return 1;

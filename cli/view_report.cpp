@@ -27,6 +27,7 @@ json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
           {"ssim", q.ssim},
           {"ovc", c.ovc},
           {"ofc", c.ofc},
+          {"ofc_eq2", c.ofc_eq2},
           {"objects_in_truth", c.objects}};
 }
 
@@ -44,11 +45,14 @@ json growth_json(const vislib::GrowthRun& g) {
                  {"radius", s.radius},
                  {"ssim_to_truth", s.ssim_to_truth}};
     if (s.ssim_to_previous) step["ssim_to_previous"] = *s.ssim_to_previous;
+    if (s.whole_ssim_to_previous) step["whole_ssim_to_previous"] = *s.whole_ssim_to_previous;
     steps.push_back(step);
   }
   return json{{"radii", g.radii},
               {"min_consecutive_ssim",
                g.min_consecutive_ssim ? json(*g.min_consecutive_ssim) : json(nullptr)},
+              {"min_consecutive_whole_ssim",
+               g.min_consecutive_whole_ssim ? json(*g.min_consecutive_whole_ssim) : json(nullptr)},
               {"frames", g.steps.size()},
               {"steps", steps}};
 }
@@ -62,14 +66,16 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
   std::fprintf(
       stderr,
       "cell %u: visible %zu triangles: near %zu, intermediate %zu, far %zu (env map %zu)\n"
-      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f triangle mismatch %.4f\n"
-      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f triangle mismatch %.4f\n",
+      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f (CloVR Eq. 2: %.3f) triangle "
+      "mismatch %.4f\n"
+      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f (CloVR Eq. 2: %.3f) triangle "
+      "mismatch %.4f\n",
       j["cell"].get<uint32_t>(), j["triangles"]["visible"].get<size_t>(), rc.near, rc.intermediate,
       rc.far, rc.env_map, j["epsilon"].get<double>(), fmt_psnr(j["psnr"]).c_str(),
       j["ssim"].get<double>(), j["ovc"].get<double>(), j["ofc"].get<double>(),
-      j["triangle_mismatch"].get<double>(), w["epsilon"].get<double>(), fmt_psnr(w["psnr"]).c_str(),
-      w["ssim"].get<double>(), w["ovc"].get<double>(), w["ofc"].get<double>(),
-      w["triangle_mismatch"].get<double>());
+      j["ofc_eq2"].get<double>(), j["triangle_mismatch"].get<double>(), w["epsilon"].get<double>(),
+      fmt_psnr(w["psnr"]).c_str(), w["ssim"].get<double>(), w["ovc"].get<double>(),
+      w["ofc"].get<double>(), w["ofc_eq2"].get<double>(), w["triangle_mismatch"].get<double>());
   if (dynamic)
     std::fprintf(stderr, "  tau %.4f: dynamic far triangles drawn %zu, shown %zu\n",
                  j["tau"].get<double>(), rc.far_dynamic, rc.far_dynamic_shown);
@@ -77,10 +83,12 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
     for (const char* k : {"merged", "equal_area"}) {
       const json& g = j["continuity"][k];
       if (g["min_consecutive_ssim"].is_null()) continue;
-      if (show_progress())
-        std::fprintf(stderr, "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f\n", k,
-                     g["radii"].size(), g["frames"].get<size_t>(),
-                     g["min_consecutive_ssim"].get<double>());
+      std::fprintf(stderr,
+                   "  growth (%s, %zu rings): %zu frames, min consecutive SSIM %.4f (whole "
+                   "image %.4f)\n",
+                   k, g["radii"].size(), g["frames"].get<size_t>(),
+                   g["min_consecutive_ssim"].get<double>(),
+                   g["min_consecutive_whole_ssim"].get<double>());
     }
 }
 

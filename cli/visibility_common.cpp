@@ -43,6 +43,19 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
          "frozen at each state while the eye moves)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))
       ->capture_default_str();
+  cmd->add_option(
+         "--coplanar", a.coplanar,
+         "Depth ties (coplanar or near-coplanar overlaps): 'both' = surfaces within --eps-z of the "
+         "front depth are visible too (a z-buffer z-fights there); 'first' = the old rule, the "
+         "nearer surface wins and exact ties go to the lower id")
+      ->check(CLI::IsMember({"both", "first"}))
+      ->capture_default_str();
+  cmd->add_option(
+         "--eps-z", a.eps_z,
+         "Depth tie tolerance with --coplanar both, relative to the front depth (unitless: 1e-6 = "
+         "1 um at 1 m)")
+      ->check(in_range(0.0, 0.1))
+      ->capture_default_str();
   cmd->add_option("--json", a.json_out, "Write the result as JSON to this file ('-' = stdout)")
       ->required();
 }
@@ -54,6 +67,8 @@ vislib::SegmentOptions segment_options(const VisibilityArgs& a) {
   o.eps_len = a.eps_len;
   o.tile_size = a.tile;
   o.mode = a.mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
+  o.coplanar = a.coplanar == "first" ? vislib::CoplanarRule::First : vislib::CoplanarRule::Both;
+  o.eps_z = a.eps_z;
   return o;
 }
 
@@ -61,6 +76,15 @@ double peak_rss_bytes() {
   struct rusage ru;
   getrusage(RUSAGE_SELF, &ru);
   return double(ru.ru_maxrss) * 1024.0;  // Linux: kilobytes
+}
+
+json witness_json(const vislib::Witness& x) {
+  return {{x.is_sphere ? "sphere" : "tri", x.tri},
+          {"face", x.face},
+          {"x", x.x},
+          {"y", x.y},
+          {"t", x.t},
+          {"tau", x.tau}};
 }
 
 json vec_json(vislib::Vec3 v) {

@@ -28,6 +28,8 @@ struct VisibilityArgs {
   int states = 1;
   std::string granularity = "triangle";
   std::string mode = "diagonal";
+  std::string coplanar = "both";
+  double eps_z = vislib::kDefaultEpsZ;
   std::string json_out;
 };
 
@@ -37,6 +39,8 @@ double peak_rss_bytes();  // of this process, bytes
 nlohmann::json vec_json(vislib::Vec3 v);
 nlohmann::json mat_json(const vislib::Mat3& m);
 nlohmann::json counts_json(const vislib::SegmentStats& s);
+// {"tri"|"sphere": id, "face", "x", "y", "t", "tau"}
+nlohmann::json witness_json(const vislib::Witness& w);
 // The visible triangles, or their objects (spheres included) when granularity is "object".
 std::vector<uint32_t> at_granularity(const vislib::Scene& scene, const std::vector<uint32_t>& tris,
                                      const std::vector<uint32_t>& spheres,

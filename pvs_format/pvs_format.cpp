@@ -18,10 +18,14 @@ FormatError::FormatError(uint64_t offset, const std::string& problem)
 
 const char* encoding_name(Encoding e) {
   switch (e) {
-    case Encoding::SortedDelta: return "sorted-delta";
-    case Encoding::RunLength: return "run-length";
-    case Encoding::Delta: return "delta";
-    case Encoding::Absent: return "absent";
+    case Encoding::SortedDelta:
+      return "sorted-delta";
+    case Encoding::RunLength:
+      return "run-length";
+    case Encoding::Delta:
+      return "delta";
+    case Encoding::Absent:
+      return "absent";
   }
   return "unknown";
 }
@@ -77,7 +81,9 @@ uint64_t fnv1a64(const void* data, size_t size, uint64_t hash) {
 
 namespace {
 
-void put_u8(std::string& out, uint8_t v) { out.push_back(char(v)); }
+void put_u8(std::string& out, uint8_t v) {
+  out.push_back(char(v));
+}
 void put_u32(std::string& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
 }
@@ -140,8 +146,7 @@ class Cursor {
     uint64_t start = offset();
     uint64_t v = 0;
     for (int i = 0; i < 5; ++i) {
-      if (remaining() < 1)
-        throw FormatError(start, std::string(what_) + " ends inside a varint");
+      if (remaining() < 1) throw FormatError(start, std::string(what_) + " ends inside a varint");
       uint8_t b = uint8_t(bytes_[pos_++]);
       v |= uint64_t(b & 0x7F) << (7 * i);
       if (!(b & 0x80)) {
@@ -181,31 +186,40 @@ std::vector<uint32_t> decode_set(Cursor& c, Encoding e, uint32_t universe, uint6
   if (e == Encoding::SortedDelta) {
     uint64_t start = c.offset();
     uint32_t n = c.varint();
-    if (n > limit) throw FormatError(start, "set of " + std::to_string(n) + " ids, at most " + std::to_string(limit) + " allowed here");
+    if (n > limit)
+      throw FormatError(start, "set of " + std::to_string(n) + " ids, at most " +
+                                   std::to_string(limit) + " allowed here");
     // Each id takes at least one byte: a count larger than the bytes left is corrupt (and must not
     // drive an allocation).
-    if (n > c.remaining()) throw FormatError(start, "set of " + std::to_string(n) + " ids in " + std::to_string(c.remaining()) + " bytes");
+    if (n > c.remaining())
+      throw FormatError(start, "set of " + std::to_string(n) + " ids in " +
+                                   std::to_string(c.remaining()) + " bytes");
     ids.reserve(n);
     uint64_t next = 0;
     for (uint32_t i = 0; i < n; ++i) {
       uint64_t at = c.offset();
       uint64_t id = next + c.varint();
       if (id >= universe)
-        throw FormatError(at, "id " + std::to_string(id) + " is not below the universe " + std::to_string(universe));
+        throw FormatError(at, "id " + std::to_string(id) + " is not below the universe " +
+                                  std::to_string(universe));
       ids.push_back(uint32_t(id));
       next = id + 1;
     }
   } else {
     uint64_t start = c.offset();
     uint32_t m = c.varint();
-    if (m > c.remaining() / 2) throw FormatError(start, std::to_string(m) + " runs in " + std::to_string(c.remaining()) + " bytes");
+    if (m > c.remaining() / 2)
+      throw FormatError(start,
+                        std::to_string(m) + " runs in " + std::to_string(c.remaining()) + " bytes");
     uint64_t next = 0;
     for (uint32_t r = 0; r < m; ++r) {
       uint64_t at = c.offset();
       uint64_t first = next + c.varint() + (r > 0 ? 1 : 0);
       uint64_t length = uint64_t(c.varint()) + 1;
       if (first + length > universe)
-        throw FormatError(at, "run [" + std::to_string(first) + ", " + std::to_string(first + length) + ") goes past the universe " + std::to_string(universe));
+        throw FormatError(at, "run [" + std::to_string(first) + ", " +
+                                  std::to_string(first + length) + ") goes past the universe " +
+                                  std::to_string(universe));
       if (ids.size() + length > limit)
         throw FormatError(at, "runs hold more than " + std::to_string(limit) + " ids");
       for (uint64_t id = first; id < first + length; ++id) ids.push_back(uint32_t(id));
@@ -215,7 +229,8 @@ std::vector<uint32_t> decode_set(Cursor& c, Encoding e, uint32_t universe, uint6
   return ids;
 }
 
-std::vector<uint32_t> symmetric_difference(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+std::vector<uint32_t> symmetric_difference(const std::vector<uint32_t>& a,
+                                           const std::vector<uint32_t>& b) {
   std::vector<uint32_t> out;
   out.reserve(a.size() + b.size());
   std::set_symmetric_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
@@ -254,7 +269,8 @@ void append_run_length(std::string& out, const std::vector<uint32_t>& ids) {
   }
 }
 
-std::vector<uint32_t> decode_sorted_delta(std::string_view payload, uint32_t universe, uint64_t base_offset) {
+std::vector<uint32_t> decode_sorted_delta(std::string_view payload, uint32_t universe,
+                                          uint64_t base_offset) {
   Cursor c(payload, base_offset, "sorted-delta set");
   std::vector<uint32_t> ids = decode_set(c, Encoding::SortedDelta, universe, universe);
   if (!c.done()) c.fail(std::to_string(c.remaining()) + " bytes after the set");
@@ -314,7 +330,9 @@ std::optional<uint32_t> CellLayout::find_cell(const double p[3]) const {
     idx[a] = i;
   }
   for (int a = 0; a < 3; ++a) {
-    auto lo = [&](uint32_t i) { return grid_box.min[a] + (grid_box.max[a] - grid_box.min[a]) * double(i) / double(n[a]); };
+    auto lo = [&](uint32_t i) {
+      return grid_box.min[a] + (grid_box.max[a] - grid_box.min[a]) * double(i) / double(n[a]);
+    };
     while (idx[a] > 0 && p[a] <= lo(idx[a])) --idx[a];
     while (idx[a] + 1 < n[a] && p[a] > lo(idx[a] + 1)) ++idx[a];
   }
@@ -328,13 +346,17 @@ namespace {
 void check_box(const Box& b, const char* what) {
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(b.min[a]) || !std::isfinite(b.max[a]) || !(b.min[a] <= b.max[a]))
-      throw std::invalid_argument(std::string("write_pvs: ") + what + " is not finite with min <= max");
+      throw std::invalid_argument(std::string("write_pvs: ") + what +
+                                  " is not finite with min <= max");
 }
 
 void put_box(std::string& out, const Box& b) {
   for (double v : b.min) put_f64(out, v);
   for (double v : b.max) put_f64(out, v);
 }
+
+// Box-list layouts: how far back (in cells) a Delta reference may be (write_pvs).
+constexpr uint32_t kBoxDeltaWindow = 4096;
 
 // Smallest encoding of one cell's set. `candidates` are earlier present cells allowed as Delta
 // references, in preference order.
@@ -343,9 +365,11 @@ struct Choice {
   int depth = 0;
 };
 
+// `set_of(ref)` gives the ids of an earlier present cell.
+template <class SetOf>
 Choice encode_cell(const std::vector<uint32_t>& ids, uint32_t cell,
-                   const std::vector<uint32_t>& candidates, const std::vector<CellSet>& cells,
-                   const std::vector<int>& depth) {
+                   const std::vector<uint32_t>& candidates, const SetOf& set_of,
+                   const std::vector<uint8_t>& depth) {
   Choice best;
   best.block.push_back(char(Encoding::SortedDelta));
   append_sorted_delta(best.block, ids);
@@ -353,7 +377,7 @@ Choice encode_cell(const std::vector<uint32_t>& ids, uint32_t cell,
   append_run_length(rle, ids);
   if (rle.size() < best.block.size()) best.block = rle;
   for (uint32_t ref : candidates) {
-    std::vector<uint32_t> diff = symmetric_difference(ids, *cells[ref]);
+    std::vector<uint32_t> diff = symmetric_difference(ids, set_of(ref));
     for (Encoding inner : {Encoding::SortedDelta, Encoding::RunLength}) {
       std::string b(1, char(Encoding::Delta));
       put_varint(b, cell - ref);
@@ -371,11 +395,13 @@ Choice encode_cell(const std::vector<uint32_t>& ids, uint32_t cell,
   return best;
 }
 
-std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<CellSet>& cells,
-                                       const std::vector<int>& depth, uint32_t cell) {
+// Delta reference candidates of `cell` among earlier cells, in preference order (write_pvs).
+// present[r]: cell r has a set; depth[r]: its delta chain length.
+std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<bool>& present,
+                                       const std::vector<uint8_t>& depth, uint32_t cell) {
   std::vector<uint32_t> out;
   auto consider = [&](uint32_t ref) {
-    if (!cells[ref] || depth[ref] + 1 > int(info.max_delta_depth)) return;
+    if (!present[ref] || depth[ref] + 1 > int(info.max_delta_depth)) return;
     if (std::find(out.begin(), out.end(), ref) == out.end()) out.push_back(ref);
   };
   const CellLayout& L = info.layout;
@@ -389,9 +415,9 @@ std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<C
     auto centre = [&](uint32_t c, int a) { return 0.5 * (L.boxes[c].min[a] + L.boxes[c].max[a]); };
     double best = std::numeric_limits<double>::infinity();
     uint32_t best_ref = cell;
-    uint32_t lo = cell > 4096 ? cell - 4096 : 0;
+    uint32_t lo = cell > kBoxDeltaWindow ? cell - kBoxDeltaWindow : 0;
     for (uint32_t r = cell; r-- > lo;) {
-      if (!cells[r] || depth[r] + 1 > int(info.max_delta_depth)) continue;
+      if (!present[r] || depth[r] + 1 > int(info.max_delta_depth)) continue;
       double d2 = 0;
       for (int a = 0; a < 3; ++a) {
         double d = centre(r, a) - centre(cell, a);
@@ -409,11 +435,29 @@ std::vector<uint32_t> delta_candidates(const FileInfo& info, const std::vector<C
 
 }  // namespace
 
-std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, WriteStats* stats) {
+struct StreamWriter::Impl {
+  FileInfo info;
+  Sink sink;
+  uint32_t n = 0, next = 0;
+  uint64_t index_offset = 0, blocks_offset = 0, at = 0;
+  size_t layout_size = 0;
+  std::string index;           // n entries of 16 bytes, written at finish()
+  std::vector<bool> present;   // per cell
+  std::vector<uint8_t> depth;  // per cell: delta chain length
+  // The sets a later cell may reference (grid: the previous nx*ny cells; box list: the previous
+  // kBoxDeltaWindow), sorted-delta encoded to keep them small, in a ring indexed by cell % window.
+  uint64_t window = 1;
+  std::vector<std::string> recent;
+  bool finished = false;
+};
+
+StreamWriter::StreamWriter(FileInfo info, Sink sink) : impl_(std::make_unique<Impl>()) {
   const CellLayout& L = info.layout;
   if (L.kind == LayoutKind::Grid) {
-    if (L.nx == 0 || L.ny == 0 || L.nz == 0) throw std::invalid_argument("write_pvs: grid dimensions must be >= 1");
-    if (uint64_t(L.nx) * L.ny * L.nz > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: grid has more than 2^32-1 cells");
+    if (L.nx == 0 || L.ny == 0 || L.nz == 0)
+      throw std::invalid_argument("write_pvs: grid dimensions must be >= 1");
+    if (uint64_t(L.nx) * L.ny * L.nz > 0xFFFFFFFFull)
+      throw std::invalid_argument("write_pvs: grid has more than 2^32-1 cells");
     check_box(L.grid_box, "grid box");
     for (int a = 0; a < 3; ++a)
       if (!std::isfinite(L.grid_box.max[a] - L.grid_box.min[a]))
@@ -424,22 +468,18 @@ std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, W
     if (L.boxes.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: too many cells");
     for (const Box& b : L.boxes) check_box(b, "cell box");
   }
-  if (cells.size() != L.cell_count()) throw std::invalid_argument("write_pvs: cells.size() differs from the layout's cell count");
-  if (info.metadata.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: metadata too long");
-  for (const CellSet& s : cells) {
-    if (!s) {
-      if (!info.partial) throw std::invalid_argument("write_pvs: absent cell in a file not marked partial");
-      continue;
-    }
-    for (size_t i = 0; i < s->size(); ++i)
-      if ((*s)[i] >= info.universe || (i > 0 && (*s)[i] <= (*s)[i - 1]))
-        throw std::invalid_argument("write_pvs: a cell's ids are not sorted, unique and below the universe");
-  }
-
-  const uint32_t n = uint32_t(cells.size());
+  if (info.metadata.size() > 0xFFFFFFFFull)
+    throw std::invalid_argument("write_pvs: metadata too long");
+  Impl& w = *impl_;
+  w.n = L.cell_count();
+  w.window =
+      std::max<uint64_t>(1, L.kind == LayoutKind::Grid ? uint64_t(L.nx) * L.ny : kBoxDeltaWindow);
+  w.window = std::min<uint64_t>(w.window, std::max<uint32_t>(1, w.n));
+  w.recent.resize(size_t(w.window));
+  w.present.assign(w.n, false);
+  w.depth.assign(w.n, 0);
+  // Header (zeros until finish()), layout section, index (zeros until finish()).
   std::string out(kHeaderSize, '\0');
-  // Layout section.
-  size_t layout_start = out.size();
   if (L.kind == LayoutKind::Grid) {
     put_box(out, L.grid_box);
     put_u32(out, L.nx);
@@ -452,61 +492,124 @@ std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, W
   }
   put_u32(out, uint32_t(info.metadata.size()));
   out += info.metadata;
-  put_u32(out, crc32c(out.data() + layout_start, out.size() - layout_start));
-  const size_t layout_size = out.size() - layout_start;
+  put_u32(out, crc32c(out.data() + kHeaderSize, out.size() - kHeaderSize));
+  w.layout_size = out.size() - kHeaderSize;
+  w.index_offset = out.size();
+  w.blocks_offset = w.index_offset + uint64_t(w.n) * kIndexEntrySize + 4;
+  w.at = w.blocks_offset;
+  w.info = std::move(info);
+  w.sink = std::move(sink);
+  w.sink(0, out);
+  w.index.reserve(size_t(w.n) * kIndexEntrySize + 4);
+}
 
-  // Blocks, encoded first so that the index can be filled in.
-  std::vector<int> depth(n, 0);
-  std::vector<std::string> blocks(n);
-  for (uint32_t c = 0; c < n; ++c) {
-    std::string b;
-    if (!cells[c]) {
-      b.push_back(char(Encoding::Absent));
-    } else {
-      Choice ch = encode_cell(*cells[c], c, delta_candidates(info, cells, depth, c), cells, depth);
-      depth[c] = ch.depth;
-      b = std::move(ch.block);
-    }
-    put_u32(b, crc32c(b.data(), b.size()));
-    blocks[c] = std::move(b);
-  }
-  const size_t index_offset = out.size();
-  const uint64_t blocks_offset = index_offset + uint64_t(n) * kIndexEntrySize + 4;
-  uint64_t at = blocks_offset;
-  for (uint32_t c = 0; c < n; ++c) {
-    if (blocks[c].size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: block larger than 4 GiB");
-    put_u64(out, at);
-    put_u32(out, uint32_t(blocks[c].size()));
-    put_u32(out, cells[c] ? uint32_t(cells[c]->size()) : 0);
-    at += blocks[c].size();
-  }
-  put_u32(out, crc32c(out.data() + index_offset, out.size() - index_offset));
-  for (const std::string& b : blocks) out += b;
+StreamWriter::~StreamWriter() = default;
+StreamWriter::StreamWriter(StreamWriter&&) noexcept = default;
 
+uint32_t StreamWriter::next_cell() const {
+  return impl_->next;
+}
+
+void StreamWriter::add(const CellSet& s) {
+  Impl& w = *impl_;
+  if (w.finished || w.next >= w.n)
+    throw std::invalid_argument("write_pvs: more cells than the layout has");
+  const uint32_t c = w.next;
+  if (!s) {
+    if (!w.info.partial)
+      throw std::invalid_argument("write_pvs: absent cell in a file not marked partial");
+  } else {
+    for (size_t i = 0; i < s->size(); ++i)
+      if ((*s)[i] >= w.info.universe || (i > 0 && (*s)[i] <= (*s)[i - 1]))
+        throw std::invalid_argument(
+            "write_pvs: a cell's ids are not sorted, unique and below the universe");
+  }
+  std::string b;
+  if (!s) {
+    b.push_back(char(Encoding::Absent));
+  } else {
+    auto set_of = [&](uint32_t ref) {
+      const std::string& enc = w.recent[size_t(ref % w.window)];
+      return decode_sorted_delta(enc, w.info.universe, 0);
+    };
+    Choice ch =
+        encode_cell(*s, c, delta_candidates(w.info, w.present, w.depth, c), set_of, w.depth);
+    w.depth[c] = uint8_t(ch.depth);
+    b = std::move(ch.block);
+    w.present[c] = true;
+    std::string& slot = w.recent[size_t(c % w.window)];
+    slot.clear();
+    append_sorted_delta(slot, *s);
+    slot.shrink_to_fit();
+  }
+  put_u32(b, crc32c(b.data(), b.size()));
+  if (b.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: block larger than 4 GiB");
+  put_u64(w.index, w.at);
+  put_u32(w.index, uint32_t(b.size()));
+  put_u32(w.index, s ? uint32_t(s->size()) : 0);
+  w.sink(w.at, b);
+  w.at += b.size();
+  ++w.next;
+}
+
+WriteStats StreamWriter::finish() {
+  Impl& w = *impl_;
+  if (w.finished) throw std::invalid_argument("write_pvs: finish() twice");
+  if (w.next != w.n)
+    throw std::invalid_argument("write_pvs: cells.size() differs from the layout's cell count");
+  w.finished = true;
+  put_u32(w.index, crc32c(w.index.data(), w.index.size()));
+  w.sink(w.index_offset, w.index);
   // Header last: it holds the total size.
+  const CellLayout& L = w.info.layout;
   std::string h;
   h.append(kMagic, 8);
   put_u32(h, kFormatVersion);
-  put_u32(h, info.partial ? 1u : 0u);
-  put_u64(h, out.size());
-  put_u64(h, info.scene_fingerprint);
-  put_u32(h, info.universe);
-  put_u32(h, n);
-  put_u8(h, uint8_t(info.granularity));
+  put_u32(h, w.info.partial ? 1u : 0u);
+  put_u64(h, w.at);
+  put_u64(h, w.info.scene_fingerprint);
+  put_u32(h, w.info.universe);
+  put_u32(h, w.n);
+  put_u8(h, uint8_t(w.info.granularity));
   put_u8(h, uint8_t(L.kind));
-  put_u8(h, info.max_delta_depth);
+  put_u8(h, w.info.max_delta_depth);
   put_u8(h, 0);
-  put_u32(h, uint32_t(layout_size));
+  put_u32(h, uint32_t(w.layout_size));
   h.append(12, '\0');
   put_u32(h, crc32c(h.data(), h.size()));
-  out.replace(0, kHeaderSize, h);
-  if (stats) {
-    stats->file_bytes = out.size();
-    stats->header_bytes = kHeaderSize;
-    stats->layout_bytes = layout_size;
-    stats->index_bytes = blocks_offset - index_offset;
-    stats->block_bytes = out.size() - blocks_offset;
+  w.sink(0, h);
+  WriteStats stats;
+  stats.file_bytes = w.at;
+  stats.header_bytes = kHeaderSize;
+  stats.layout_bytes = w.layout_size;
+  stats.index_bytes = w.blocks_offset - w.index_offset;
+  stats.block_bytes = w.at - w.blocks_offset;
+  return stats;
+}
+
+std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, WriteStats* stats) {
+  if (cells.size() != info.layout.cell_count())
+    throw std::invalid_argument("write_pvs: cells.size() differs from the layout's cell count");
+  // Every set is checked before anything is encoded (as the contract says).
+  for (const CellSet& s : cells) {
+    if (!s) {
+      if (!info.partial)
+        throw std::invalid_argument("write_pvs: absent cell in a file not marked partial");
+      continue;
+    }
+    for (size_t i = 0; i < s->size(); ++i)
+      if ((*s)[i] >= info.universe || (i > 0 && (*s)[i] <= (*s)[i - 1]))
+        throw std::invalid_argument(
+            "write_pvs: a cell's ids are not sorted, unique and below the universe");
   }
+  std::string out;
+  StreamWriter w(info, [&out](uint64_t offset, std::string_view bytes) {
+    if (out.size() < offset + bytes.size()) out.resize(size_t(offset + bytes.size()));
+    std::memcpy(&out[size_t(offset)], bytes.data(), bytes.size());
+  });
+  for (const CellSet& s : cells) w.add(s);
+  WriteStats st = w.finish();
+  if (stats) *stats = st;
   return out;
 }
 
@@ -530,7 +633,9 @@ struct MemorySource : Reader::Source {
 struct ViewSource : Reader::Source {
   std::string_view bytes;
   uint64_t size() const override { return bytes.size(); }
-  std::string read(uint64_t offset, size_t n) override { return std::string(bytes.substr(size_t(offset), n)); }
+  std::string read(uint64_t offset, size_t n) override {
+    return std::string(bytes.substr(size_t(offset), n));
+  }
 };
 
 struct FileSource : Reader::Source {
@@ -542,7 +647,8 @@ struct FileSource : Reader::Source {
     in.clear();
     in.seekg(std::streamoff(offset));
     in.read(out.data(), std::streamsize(n));
-    if (size_t(in.gcount()) != n) throw FormatError(offset + uint64_t(in.gcount()), "read error (file changed or unreadable)");
+    if (size_t(in.gcount()) != n)
+      throw FormatError(offset + uint64_t(in.gcount()), "read error (file changed or unreadable)");
     return out;
   }
 };
@@ -594,13 +700,16 @@ void Reader::open(const ReadOptions& options) {
   for (size_t i = 0; i < m; ++i)
     if (head[i] != kMagic[i]) throw FormatError(i, "not a PVS file (bad magic bytes)");
   if (size < kHeaderSize)
-    throw FormatError(size, "truncated: the file has " + std::to_string(size) + " bytes, the header alone needs 64");
+    throw FormatError(size, "truncated: the file has " + std::to_string(size) +
+                                " bytes, the header alone needs 64");
   Cursor h(head, 0, "header");
   h.bytes(8);
   uint32_t version = h.u32();
   if (version == 0) throw FormatError(8, "invalid format version 0");
   if (version > kFormatVersion)
-    throw FormatError(8, "format version " + std::to_string(version) + " is newer than this reader (reads up to " + std::to_string(kFormatVersion) + ")");
+    throw FormatError(8, "format version " + std::to_string(version) +
+                             " is newer than this reader (reads up to " +
+                             std::to_string(kFormatVersion) + ")");
   verify_checksums_ = options.verify_checksums;
   uint32_t stored_crc = 0;
   {
@@ -609,22 +718,30 @@ void Reader::open(const ReadOptions& options) {
   }
   uint32_t crc = crc32c(head.data(), 60);
   if (verify_checksums_ && crc != stored_crc)
-    throw FormatError(60, "header checksum mismatch (stored " + std::to_string(stored_crc) + ", computed " + std::to_string(crc) + ")");
+    throw FormatError(60, "header checksum mismatch (stored " + std::to_string(stored_crc) +
+                              ", computed " + std::to_string(crc) + ")");
   info_.version = version;
   uint32_t flags = h.u32();
   if (flags & ~1u) throw FormatError(12, "unknown flags " + std::to_string(flags));
   info_.partial = flags & 1u;
   uint64_t declared_size = h.u64();
   if (declared_size > size)
-    throw FormatError(size, "truncated: the header says " + std::to_string(declared_size) + " bytes, the file has " + std::to_string(size));
+    throw FormatError(size, "truncated: the header says " + std::to_string(declared_size) +
+                                " bytes, the file has " + std::to_string(size));
   if (declared_size < size)
-    throw FormatError(declared_size, "trailing bytes: the header says " + std::to_string(declared_size) + " bytes, the file has " + std::to_string(size));
+    throw FormatError(declared_size, "trailing bytes: the header says " +
+                                         std::to_string(declared_size) + " bytes, the file has " +
+                                         std::to_string(size));
   info_.scene_fingerprint = h.u64();
   if (options.expected_fingerprint && *options.expected_fingerprint != info_.scene_fingerprint)
-    throw FormatError(24, "scene fingerprint " + hex64(info_.scene_fingerprint) + " does not match the scene's " + hex64(*options.expected_fingerprint) + " (this PVS was baked for another scene)");
+    throw FormatError(
+        24, "scene fingerprint " + hex64(info_.scene_fingerprint) + " does not match the scene's " +
+                hex64(*options.expected_fingerprint) + " (this PVS was baked for another scene)");
   info_.universe = h.u32();
   if (info_.universe > options.max_universe)
-    throw FormatError(32, "universe of " + std::to_string(info_.universe) + " ids exceeds the reader's limit " + std::to_string(options.max_universe));
+    throw FormatError(32, "universe of " + std::to_string(info_.universe) +
+                              " ids exceeds the reader's limit " +
+                              std::to_string(options.max_universe));
   uint32_t n = h.u32();
   uint8_t gran = h.u8();
   if (gran > 1) throw FormatError(40, "unknown granularity " + std::to_string(gran));
@@ -641,15 +758,19 @@ void Reader::open(const ReadOptions& options) {
   // Layout section.
   const uint64_t layout_fixed = kind == 0 ? 76 : uint64_t(n) * 48;
   if (uint64_t(layout_size) < layout_fixed + 8)
-    throw FormatError(44, "layout section of " + std::to_string(layout_size) + " bytes is too small for " + std::to_string(n) + " cells");
+    throw FormatError(44, "layout section of " + std::to_string(layout_size) +
+                              " bytes is too small for " + std::to_string(n) + " cells");
   if (kHeaderSize + uint64_t(layout_size) > size)
-    throw FormatError(44, "layout section of " + std::to_string(layout_size) + " bytes runs past the end of the file");
+    throw FormatError(44, "layout section of " + std::to_string(layout_size) +
+                              " bytes runs past the end of the file");
   std::string layout = source_->read(kHeaderSize, layout_size);
   {
-    Cursor t(std::string_view(layout).substr(layout_size - 4), kHeaderSize + layout_size - 4, "layout section");
+    Cursor t(std::string_view(layout).substr(layout_size - 4), kHeaderSize + layout_size - 4,
+             "layout section");
     uint32_t stored = t.u32();
     uint32_t computed = crc32c(layout.data(), layout_size - 4);
-    if (verify_checksums_ && stored != computed) throw FormatError(kHeaderSize + layout_size - 4, "layout section checksum mismatch");
+    if (verify_checksums_ && stored != computed)
+      throw FormatError(kHeaderSize + layout_size - 4, "layout section checksum mismatch");
   }
   Cursor l(std::string_view(layout).substr(0, layout_size - 4), kHeaderSize, "layout section");
   auto read_box = [&](Box& b) {
@@ -672,7 +793,9 @@ void Reader::open(const ReadOptions& options) {
     L.nz = l.u32();
     if (L.nx == 0 || L.ny == 0 || L.nz == 0) throw FormatError(at, "grid dimension 0");
     if (uint64_t(L.nx) * L.ny * L.nz != n)
-      throw FormatError(at, "grid " + std::to_string(L.nx) + "x" + std::to_string(L.ny) + "x" + std::to_string(L.nz) + " does not have the header's " + std::to_string(n) + " cells");
+      throw FormatError(at, "grid " + std::to_string(L.nx) + "x" + std::to_string(L.ny) + "x" +
+                                std::to_string(L.nz) + " does not have the header's " +
+                                std::to_string(n) + " cells");
     at = l.offset();
     L.eye_lo = l.f64();
     L.eye_hi = l.f64();
@@ -685,19 +808,24 @@ void Reader::open(const ReadOptions& options) {
   uint64_t md_at = l.offset();
   uint32_t md_size = l.u32();
   if (l.remaining() != md_size)
-    throw FormatError(md_at, "metadata of " + std::to_string(md_size) + " bytes does not fill the layout section (" + std::to_string(l.remaining()) + " bytes left)");
+    throw FormatError(md_at, "metadata of " + std::to_string(md_size) +
+                                 " bytes does not fill the layout section (" +
+                                 std::to_string(l.remaining()) + " bytes left)");
   info_.metadata = std::string(l.bytes(md_size));
 
   // Index.
   index_offset_ = kHeaderSize + uint64_t(layout_size);
   const uint64_t index_size = uint64_t(n) * kIndexEntrySize + 4;
   if (index_size > size - index_offset_)
-    throw FormatError(size, "truncated: the index of " + std::to_string(n) + " cells needs " + std::to_string(index_size) + " bytes, " + std::to_string(size - index_offset_) + " left");
+    throw FormatError(size, "truncated: the index of " + std::to_string(n) + " cells needs " +
+                                std::to_string(index_size) + " bytes, " +
+                                std::to_string(size - index_offset_) + " left");
   std::string index = source_->read(index_offset_, size_t(index_size));
   blocks_offset_ = index_offset_ + index_size;
   {
     Cursor t(std::string_view(index).substr(index.size() - 4), blocks_offset_ - 4, "index");
-    if (t.u32() != crc32c(index.data(), index.size() - 4) && verify_checksums_) throw FormatError(blocks_offset_ - 4, "index checksum mismatch");
+    if (t.u32() != crc32c(index.data(), index.size() - 4) && verify_checksums_)
+      throw FormatError(blocks_offset_ - 4, "index checksum mismatch");
   }
   Cursor x(std::string_view(index).substr(0, index.size() - 4), index_offset_, "index");
   index_.resize(n);
@@ -709,37 +837,57 @@ void Reader::open(const ReadOptions& options) {
     e.size = x.u32();
     e.count = x.u32();
     if (e.offset != expect)
-      throw FormatError(at, "cell " + std::to_string(c) + ": block offset " + std::to_string(e.offset) + ", expected " + std::to_string(expect) + " (blocks are contiguous in cell order)");
-    if (e.size < 5) throw FormatError(at + 8, "cell " + std::to_string(c) + ": block of " + std::to_string(e.size) + " bytes is smaller than 5");
+      throw FormatError(at, "cell " + std::to_string(c) + ": block offset " +
+                                std::to_string(e.offset) + ", expected " + std::to_string(expect) +
+                                " (blocks are contiguous in cell order)");
+    if (e.size < 5)
+      throw FormatError(at + 8, "cell " + std::to_string(c) + ": block of " +
+                                    std::to_string(e.size) + " bytes is smaller than 5");
     if (e.size > size - e.offset)
-      throw FormatError(size, "truncated: cell " + std::to_string(c) + "'s block ends at " + std::to_string(e.offset + e.size) + ", past the end of the file");
+      throw FormatError(size, "truncated: cell " + std::to_string(c) + "'s block ends at " +
+                                  std::to_string(e.offset + e.size) + ", past the end of the file");
     if (e.count > info_.universe)
-      throw FormatError(at + 12, "cell " + std::to_string(c) + ": count " + std::to_string(e.count) + " exceeds the universe " + std::to_string(info_.universe));
+      throw FormatError(at + 12, "cell " + std::to_string(c) + ": count " +
+                                     std::to_string(e.count) + " exceeds the universe " +
+                                     std::to_string(info_.universe));
     expect = e.offset + e.size;
   }
   if (expect != size)
-    throw FormatError(expect, "trailing bytes: the last block ends at " + std::to_string(expect) + ", the file has " + std::to_string(size) + " bytes");
+    throw FormatError(expect, "trailing bytes: the last block ends at " + std::to_string(expect) +
+                                  ", the file has " + std::to_string(size) + " bytes");
 }
 
 std::string Reader::read_block(uint32_t cell) {
-  if (cell >= index_.size()) throw std::out_of_range("pvs::Reader: cell " + std::to_string(cell) + " out of range");
+  if (cell >= index_.size())
+    throw std::out_of_range("pvs::Reader: cell " + std::to_string(cell) + " out of range");
   const IndexEntry& e = index_[cell];
   std::string b = source_->read(e.offset, e.size);
   Cursor t(std::string_view(b).substr(b.size() - 4), e.offset + e.size - 4, "block");
   if (t.u32() != crc32c(b.data(), b.size() - 4) && verify_checksums_)
-    throw FormatError(e.offset + e.size - 4, "cell " + std::to_string(cell) + ": block checksum mismatch");
+    throw FormatError(e.offset + e.size - 4,
+                      "cell " + std::to_string(cell) + ": block checksum mismatch");
   b.resize(b.size() - 4);
   uint8_t enc = uint8_t(b[0]);
-  if (enc > 3) throw FormatError(e.offset, "cell " + std::to_string(cell) + ": unknown encoding " + std::to_string(enc));
+  if (enc > 3)
+    throw FormatError(e.offset,
+                      "cell " + std::to_string(cell) + ": unknown encoding " + std::to_string(enc));
   if (Encoding(enc) == Encoding::Absent) {
-    if (!info_.partial) throw FormatError(e.offset, "cell " + std::to_string(cell) + " is absent in a file not marked partial");
-    if (b.size() != 1) throw FormatError(e.offset + 1, "cell " + std::to_string(cell) + ": absent block with a payload");
-    if (e.count != 0) throw FormatError(e.offset, "cell " + std::to_string(cell) + ": absent block with count " + std::to_string(e.count));
+    if (!info_.partial)
+      throw FormatError(e.offset,
+                        "cell " + std::to_string(cell) + " is absent in a file not marked partial");
+    if (b.size() != 1)
+      throw FormatError(e.offset + 1,
+                        "cell " + std::to_string(cell) + ": absent block with a payload");
+    if (e.count != 0)
+      throw FormatError(e.offset, "cell " + std::to_string(cell) + ": absent block with count " +
+                                      std::to_string(e.count));
   }
   return b;
 }
 
-bool Reader::is_absent(uint32_t cell) { return Encoding(uint8_t(read_block(cell)[0])) == Encoding::Absent; }
+bool Reader::is_absent(uint32_t cell) {
+  return Encoding(uint8_t(read_block(cell)[0])) == Encoding::Absent;
+}
 
 BlockInfo Reader::block_info(uint32_t cell) {
   std::string b = read_block(cell);
@@ -751,10 +899,14 @@ BlockInfo Reader::block_info(uint32_t cell) {
     Cursor c(std::string_view(b).substr(1), e.offset + 1, "block");
     uint64_t at = c.offset();
     uint32_t d = c.varint();
-    if (d == 0 || d > cell) throw FormatError(at, "cell " + std::to_string(cell) + ": delta reference distance " + std::to_string(d) + " is not in [1, " + std::to_string(cell) + "]");
+    if (d == 0 || d > cell)
+      throw FormatError(at, "cell " + std::to_string(cell) + ": delta reference distance " +
+                                std::to_string(d) + " is not in [1, " + std::to_string(cell) + "]");
     bi.reference = cell - d;
     uint8_t inner = c.u8();
-    if (inner > 1) throw FormatError(c.offset() - 1, "cell " + std::to_string(cell) + ": delta with inner encoding " + std::to_string(inner));
+    if (inner > 1)
+      throw FormatError(c.offset() - 1, "cell " + std::to_string(cell) +
+                                            ": delta with inner encoding " + std::to_string(inner));
     bi.inner = Encoding(inner);
   }
   return bi;
@@ -765,17 +917,23 @@ std::vector<uint32_t> Reader::decode_cell(uint32_t cell, int depth) {
   const IndexEntry& e = index_[cell];
   const std::string name = "cell " + std::to_string(cell) + ": ";
   Encoding enc = Encoding(uint8_t(b[0]));
-  if (enc == Encoding::Absent) throw FormatError(e.offset, name + "absent (this is a shard; merge the shards first)");
+  if (enc == Encoding::Absent)
+    throw FormatError(e.offset, name + "absent (this is a shard; merge the shards first)");
   Cursor c(std::string_view(b).substr(1), e.offset + 1, "block");
   std::vector<uint32_t> ids;
   if (enc == Encoding::Delta) {
     uint64_t at = c.offset();
     uint32_t d = c.varint();
-    if (d == 0 || d > cell) throw FormatError(at, name + "delta reference distance " + std::to_string(d) + " is not in [1, " + std::to_string(cell) + "]");
+    if (d == 0 || d > cell)
+      throw FormatError(at, name + "delta reference distance " + std::to_string(d) +
+                                " is not in [1, " + std::to_string(cell) + "]");
     if (depth + 1 > int(info_.max_delta_depth))
-      throw FormatError(at, name + "delta chain longer than the header's limit " + std::to_string(info_.max_delta_depth));
+      throw FormatError(at, name + "delta chain longer than the header's limit " +
+                                std::to_string(info_.max_delta_depth));
     uint8_t inner = c.u8();
-    if (inner > 1) throw FormatError(c.offset() - 1, name + "delta with inner encoding " + std::to_string(inner));
+    if (inner > 1)
+      throw FormatError(c.offset() - 1,
+                        name + "delta with inner encoding " + std::to_string(inner));
     std::vector<uint32_t> diff = decode_set(c, Encoding(inner), info_.universe, info_.universe);
     std::vector<uint32_t> ref = decode_cell(cell - d, depth + 1);
     ids = symmetric_difference(ref, diff);
@@ -784,11 +942,14 @@ std::vector<uint32_t> Reader::decode_cell(uint32_t cell, int depth) {
   }
   if (!c.done()) c.fail(name + std::to_string(c.remaining()) + " bytes after the set");
   if (ids.size() != e.count)
-    throw FormatError(e.offset, name + "decodes to " + std::to_string(ids.size()) + " ids, the index says " + std::to_string(e.count));
+    throw FormatError(e.offset, name + "decodes to " + std::to_string(ids.size()) +
+                                    " ids, the index says " + std::to_string(e.count));
   return ids;
 }
 
-std::vector<uint32_t> Reader::read_cell(uint32_t cell) { return decode_cell(cell, 0); }
+std::vector<uint32_t> Reader::read_cell(uint32_t cell) {
+  return decode_cell(cell, 0);
+}
 
 void Reader::verify() {
   for (uint32_t c = 0; c < cell_count(); ++c)
@@ -803,7 +964,8 @@ std::string merge_pvs(std::vector<Reader>& shards) {
   for (size_t s = 1; s < shards.size(); ++s) {
     const FileInfo& o = shards[s].info();
     auto bad = [&](const char* what) {
-      throw FormatError(0, "shard " + std::to_string(s + 1) + " differs from shard 1 in its " + what + ": not shards of the same bake");
+      throw FormatError(0, "shard " + std::to_string(s + 1) + " differs from shard 1 in its " +
+                               what + ": not shards of the same bake");
     };
     if (o.scene_fingerprint != first.scene_fingerprint) bad("scene fingerprint");
     if (o.universe != first.universe) bad("universe");
@@ -819,12 +981,16 @@ std::string merge_pvs(std::vector<Reader>& shards) {
       if (shards[s].is_absent(c)) continue;
       std::vector<uint32_t> ids = shards[s].read_cell(c);
       if (cells[c] && *cells[c] != ids)
-        throw FormatError(shards[s].entry(c).offset, "shard " + std::to_string(s + 1) + ": cell " + std::to_string(c) + " differs from the same cell in an earlier shard");
+        throw FormatError(shards[s].entry(c).offset,
+                          "shard " + std::to_string(s + 1) + ": cell " + std::to_string(c) +
+                              " differs from the same cell in an earlier shard");
       cells[c] = std::move(ids);
     }
   }
   for (uint32_t c = 0; c < n; ++c)
-    if (!cells[c]) throw FormatError(0, "cell " + std::to_string(c) + " is absent from every shard (a shard is missing)");
+    if (!cells[c])
+      throw FormatError(
+          0, "cell " + std::to_string(c) + " is absent from every shard (a shard is missing)");
   FileInfo info = first;
   info.partial = false;
   return write_pvs(info, cells);

@@ -4,7 +4,8 @@
 // This library depends on the C++ standard library only (house style, "Which way the arrows
 // point"): an engine embeds it to load a PVS without vislib or its dependencies. It knows nothing
 // of scenes: it stores a 64-bit scene fingerprint computed by the caller (vislib's is
-// scene_fingerprint() in vislib/scene/scene_fingerprint.h, its byte stream is in the format document).
+// scene_fingerprint() in vislib/scene/scene_fingerprint.h, its byte stream is in the format
+// document).
 //
 // Errors: a malformed, truncated, corrupted or too new file throws pvs::FormatError carrying the
 // byte offset where the problem was found and what is wrong. The reader never crashes or reads
@@ -14,6 +15,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -91,13 +93,13 @@ bool operator==(const CellLayout& a, const CellLayout& b);
 // Everything of a file except the visible sets.
 struct FileInfo {
   uint32_t version = kFormatVersion;
-  bool partial = false;         // some cells are Absent (a shard of a bake)
+  bool partial = false;  // some cells are Absent (a shard of a bake)
   uint64_t scene_fingerprint = 0;
-  uint32_t universe = 0;        // number of ids at this granularity (scene triangles or objects)
+  uint32_t universe = 0;  // number of ids at this granularity (scene triangles or objects)
   Granularity granularity = Granularity::Triangle;
   uint8_t max_delta_depth = 8;  // longest chain of Delta references a cell may need
   CellLayout layout;
-  std::string metadata;         // free text, by convention JSON with the bake settings
+  std::string metadata;  // free text, by convention JSON with the bake settings
 };
 
 // ---- Writing --------------------------------------------------------------------------------
@@ -120,6 +122,32 @@ struct WriteStats {
 // grid nx, ny, nz >= 1; eye_lo <= eye_hi. Violations throw std::invalid_argument.
 std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells,
                       WriteStats* stats = nullptr);
+
+// write_pvs one cell at a time, in cell order, for files larger than memory (pvs bake streams its
+// output): the same bytes as write_pvs(info, all cells). `sink(offset, bytes)` stores bytes at a
+// file offset: the header and layout at construction, each block as it is added (appended in
+// order), the index and the header (which hold the sizes and offsets) again at finish(). Holds
+// O(cell count) small state (16 index bytes, a depth byte and a bit per cell) plus the sets a
+// later cell may reference as a Delta (grid: the previous nx*ny cells; box list: the previous
+// 4096), kept sorted-delta encoded. Throws std::invalid_argument on the preconditions of
+// write_pvs (a bad layout at construction, a bad set in add(), a missing cell in finish()).
+// Not thread-safe.
+class StreamWriter {
+ public:
+  using Sink = std::function<void(uint64_t offset, std::string_view bytes)>;
+  StreamWriter(FileInfo info, Sink sink);
+  ~StreamWriter();
+  StreamWriter(StreamWriter&&) noexcept;
+  // Adds the next cell (next_cell()): its set, or nullopt for an absent cell (info.partial only).
+  void add(const CellSet& set);
+  uint32_t next_cell() const;
+  // Writes the index and the header once every cell was added. Returns the sizes.
+  WriteStats finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 // ---- Reading --------------------------------------------------------------------------------
 

@@ -12,15 +12,28 @@ namespace pvs_runtime {
 
 namespace {
 
-Point3 operator+(const Point3& a, const Point3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-Point3 operator-(const Point3& a, const Point3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-Point3 operator*(const Point3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
-double dot(const Point3& a, const Point3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-double length(const Point3& a) { return std::sqrt(dot(a, a)); }
-Point3 normalize(const Point3& a) { return a * (1.0 / length(a)); }
+Point3 operator+(const Point3& a, const Point3& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+Point3 operator-(const Point3& a, const Point3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+Point3 operator*(const Point3& a, double s) {
+  return {a.x * s, a.y * s, a.z * s};
+}
+double dot(const Point3& a, const Point3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+double length(const Point3& a) {
+  return std::sqrt(dot(a, a));
+}
+Point3 normalize(const Point3& a) {
+  return a * (1.0 / length(a));
+}
 
 Point3 vertex(const float* positions, uint32_t i) {
-  return {double(positions[3 * size_t(i)]), double(positions[3 * size_t(i) + 1]), double(positions[3 * size_t(i) + 2])};
+  return {double(positions[3 * size_t(i)]), double(positions[3 * size_t(i) + 1]),
+          double(positions[3 * size_t(i) + 2])};
 }
 
 // The t > 0 where u + t d leaves the vertical cylinder of radius r around o; u strictly inside.
@@ -37,7 +50,9 @@ double leave_cylinder(const Point3& u, const Point3& d, const Point3& o, double 
 
 }  // namespace
 
-double axis_distance(const Point3& p, const Point3& o) { return std::hypot(p.x - o.x, p.z - o.z); }
+double axis_distance(const Point3& p, const Point3& o) {
+  return std::hypot(p.x - o.x, p.z - o.z);
+}
 
 Region vertex_region(double r, double r1, double r2) {
   assert(r1 >= 0 && r1 < r2);
@@ -52,21 +67,30 @@ double morph_user_weight(double r, double r1, double r2, MorphCurve curve) {
   if (r >= r2) return 0.0;
   const double x = (r2 - r) / (r2 - r1);  // a / (r2 - r1), a = r2 - r
   switch (curve) {
-    case MorphCurve::Linear: return x;
-    case MorphCurve::Quadratic: return x * x;
-    case MorphCurve::SCurve: return x < 0.5 ? 2.0 * x * x : 1.0 - 2.0 * (x - 1.0) * (x - 1.0);
+    case MorphCurve::Linear:
+      return x;
+    case MorphCurve::Quadratic:
+      return x * x;
+    case MorphCurve::SCurve:
+      return x < 0.5 ? 2.0 * x * x : 1.0 - 2.0 * (x - 1.0) * (x - 1.0);
   }
   return x;
 }
 
-Point3 displace_far(const Point3& p, const Point3& u, const Point3& o) { return u + (p - o); }
+Point3 displace_far(const Point3& p, const Point3& u, const Point3& o) {
+  return u + (p - o);
+}
 
-Point3 morph_vertex(const Point3& p, const Point3& u, const Point3& o, double r1, double r2, MorphCurve curve) {
+Point3 morph_vertex(const Point3& p, const Point3& u, const Point3& o, double r1, double r2,
+                    MorphCurve curve) {
   const double r = axis_distance(p, o);
   switch (vertex_region(r, r1, r2)) {
-    case Region::Near: return p;
-    case Region::Far: return displace_far(p, u, o);
-    case Region::Intermediate: break;
+    case Region::Near:
+      return p;
+    case Region::Far:
+      return displace_far(p, u, o);
+    case Region::Intermediate:
+      break;
   }
   assert(axis_distance(u, o) < r1);
   const double wu = morph_user_weight(r, r1, r2, curve), wo = 1.0 - wu;
@@ -77,9 +101,10 @@ Point3 morph_vertex(const Point3& p, const Point3& u, const Point3& o, double r1
   return u + d * t;
 }
 
-NearFarPartition partition_near_far(const float* positions, size_t vertex_count, const uint32_t* indices,
-                                    size_t triangle_count, const uint8_t* dynamic, const uint32_t* ids,
-                                    size_t id_count, const Point3& o, double r1, double r2) {
+NearFarPartition partition_near_far(const float* positions, size_t vertex_count,
+                                    const uint32_t* indices, size_t triangle_count,
+                                    const uint8_t* dynamic, const uint32_t* ids, size_t id_count,
+                                    const Point3& o, double r1, double r2) {
   assert(r1 >= 0 && r1 < r2);
   NearFarPartition out;
   for (size_t k = 0; k < id_count; ++k) {
@@ -133,20 +158,26 @@ CubePixel cube_pixel(const Point3& d, int size) {
   assert(size > 0 && dot(d, d) > 0);
   const double ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
   int face;
-  if (ax >= ay && ax >= az) face = d.x >= 0 ? 0 : 1;
-  else if (ay >= az) face = d.y >= 0 ? 2 : 3;
-  else face = d.z >= 0 ? 4 : 5;
+  if (ax >= ay && ax >= az)
+    face = d.x >= 0 ? 0 : 1;
+  else if (ay >= az)
+    face = d.y >= 0 ? 2 : 3;
+  else
+    face = d.z >= 0 ? 4 : 5;
   const Axes& a = kFaces[face];
   const double m = dot(d, a.f);  // > 0
   const double sc = dot(d, a.s) / m, tc = dot(d, a.t) / m;
-  auto pix = [size](double u) { return std::clamp(int(std::floor((u + 1.0) * 0.5 * size)), 0, size - 1); };
+  auto pix = [size](double u) {
+    return std::clamp(int(std::floor((u + 1.0) * 0.5 * size)), 0, size - 1);
+  };
   return {face, pix(sc), pix(tc)};
 }
 
 Point3 cube_pixel_direction(int face, int x, int y, int size) {
   assert(face >= 0 && face < 6 && size > 0);
   const Axes& a = kFaces[face];
-  const double sc = double(2 * x + 1) / double(size) - 1.0, tc = double(2 * y + 1) / double(size) - 1.0;
+  const double sc = double(2 * x + 1) / double(size) - 1.0,
+               tc = double(2 * y + 1) / double(size) - 1.0;
   return a.f + a.s * sc + a.t * tc;
 }
 
@@ -178,7 +209,8 @@ std::vector<double> equal_area_ring_radii(double ring_area, double final_radius)
   return radii;
 }
 
-std::vector<double> ring_contributions(const std::vector<double>& radii, const std::vector<double>& item_radius,
+std::vector<double> ring_contributions(const std::vector<double>& radii,
+                                       const std::vector<double>& item_radius,
                                        const std::vector<double>& item_weight) {
   assert(item_radius.size() == item_weight.size());
   std::vector<double> sum(radii.size(), 0.0);
@@ -189,8 +221,8 @@ std::vector<double> ring_contributions(const std::vector<double>& radii, const s
   return sum;
 }
 
-std::vector<double> merge_rings(const std::vector<double>& radii, const std::vector<double>& contribution,
-                                double min_contribution) {
+std::vector<double> merge_rings(const std::vector<double>& radii,
+                                const std::vector<double>& contribution, double min_contribution) {
   assert(radii.size() == contribution.size());
   std::vector<double> merged;
   double acc = 0;
@@ -202,8 +234,10 @@ std::vector<double> merge_rings(const std::vector<double>& radii, const std::vec
     }
   }
   if (!radii.empty() && (merged.empty() || merged.back() != radii.back())) {
-    if (!merged.empty()) merged.back() = radii.back();  // the short last group joins the one before
-    else merged.push_back(radii.back());
+    if (!merged.empty())
+      merged.back() = radii.back();  // the short last group joins the one before
+    else
+      merged.push_back(radii.back());
   }
   return merged;
 }
@@ -224,10 +258,11 @@ Point3 inject_vertex(const Point3& p, const Point3& u, const Point3& o, double b
   return u + d * leave_cylinder(u, d, o, r);
 }
 
-ProgressivePartition partition_progressive(const float* positions, size_t vertex_count, const uint32_t* indices,
-                                           size_t triangle_count, const uint32_t* triangle_object,
-                                           size_t object_count, const uint32_t* ids, size_t id_count,
-                                           const Point3& o, double big_r) {
+ProgressivePartition partition_progressive(const float* positions, size_t vertex_count,
+                                           const uint32_t* indices, size_t triangle_count,
+                                           const uint32_t* triangle_object, size_t object_count,
+                                           const uint32_t* ids, size_t id_count, const Point3& o,
+                                           double big_r) {
   std::vector<uint8_t> near_object(object_count, 0);
   for (size_t t = 0; t < triangle_count; ++t) {
     assert(triangle_object[t] < object_count);
@@ -240,7 +275,8 @@ ProgressivePartition partition_progressive(const float* positions, size_t vertex
   ProgressivePartition out;
   for (size_t k = 0; k < id_count; ++k) {
     assert(ids[k] < triangle_count);
-    (near_object[triangle_object[ids[k]]] ? out.near_ids : out.environment_map_ids).push_back(ids[k]);
+    (near_object[triangle_object[ids[k]]] ? out.near_ids : out.environment_map_ids)
+        .push_back(ids[k]);
   }
   std::sort(out.near_ids.begin(), out.near_ids.end());
   std::sort(out.environment_map_ids.begin(), out.environment_map_ids.end());

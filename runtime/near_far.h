@@ -93,15 +93,16 @@ struct NearFarPartition {
 // triangle, triangle_count triangles; dynamic: one byte per triangle, nonzero = the triangle moves
 // (it is then never put in the environment map), or null if the whole scene is static.
 // Preconditions: every id < triangle_count, every index < vertex_count, 0 <= r1 < r2.
-NearFarPartition partition_near_far(const float* positions, size_t vertex_count, const uint32_t* indices,
-                                    size_t triangle_count, const uint8_t* dynamic, const uint32_t* ids,
-                                    size_t id_count, const Point3& o, double r1, double r2);
+NearFarPartition partition_near_far(const float* positions, size_t vertex_count,
+                                    const uint32_t* indices, size_t triangle_count,
+                                    const uint8_t* dynamic, const uint32_t* ids, size_t id_count,
+                                    const Point3& o, double r1, double r2);
 
 // ---- The range cube map and Eq. 3 -----------------------------------------------------------
 
 // A per-pixel range map from O: 6 square faces of size x size pixels, in vislib's binding cubemap
-// convention (vislib/base/cubemap.h, identity orientation): faces 0..5 = +X, -X, +Y, -Y, +Z, -Z with
-// forward/S/T axes
+// convention (vislib/base/cubemap.h, identity orientation): faces 0..5 = +X, -X, +Y, -Y, +Z, -Z
+// with forward/S/T axes
 //   +X: F=(1,0,0)  S=(0,0,-1) T=(0,-1,0)     -X: F=(-1,0,0) S=(0,0,1)  T=(0,-1,0)
 //   +Y: F=(0,1,0)  S=(1,0,0)  T=(0,0,1)      -Y: F=(0,-1,0) S=(1,0,0)  T=(0,0,-1)
 //   +Z: F=(0,0,1)  S=(1,0,0)  T=(0,-1,0)     -Z: F=(0,0,-1) S=(-1,0,0) T=(0,-1,0)
@@ -144,7 +145,8 @@ std::vector<double> equal_area_ring_radii(double ring_area, double final_radius)
 // enters the near region with its first vertex), its weight what the ring costs or brings:
 // e.g. its visible triangle count (a PVS-visible set accounts for "visibility"), divided by its
 // distance to the user (perspective foreshortening).
-std::vector<double> ring_contributions(const std::vector<double>& radii, const std::vector<double>& item_radius,
+std::vector<double> ring_contributions(const std::vector<double>& radii,
+                                       const std::vector<double>& item_radius,
                                        const std::vector<double>& item_weight);
 
 // Merges consecutive rings, inside out, until each merged ring contributes at least
@@ -153,8 +155,8 @@ std::vector<double> ring_contributions(const std::vector<double>& radii, const s
 // (merge "based on visibility and distance from user", giving 10, 14, 17, 22, 32, 63 m for its
 // City from 10 m equal-area rings) but no rule; this greedy rule is ours. Requires
 // contribution.size() == radii.size().
-std::vector<double> merge_rings(const std::vector<double>& radii, const std::vector<double>& contribution,
-                                double min_contribution);
+std::vector<double> merge_rings(const std::vector<double>& radii,
+                                const std::vector<double>& contribution, double min_contribution);
 
 // Alg. 1's weight of the user view for a vertex at axis distance r while the near region has
 // radius R and the near subregion R_n: 1 for r <= R_n, w = (R - r)/(R - R_n) in between, 0 for
@@ -176,9 +178,10 @@ struct ProgressivePartition {
 };
 // triangle_object: object id of each triangle (< object_count). Other arguments as
 // partition_near_far.
-ProgressivePartition partition_progressive(const float* positions, size_t vertex_count, const uint32_t* indices,
-                                           size_t triangle_count, const uint32_t* triangle_object,
-                                           size_t object_count, const uint32_t* ids, size_t id_count,
-                                           const Point3& o, double big_r);
+ProgressivePartition partition_progressive(const float* positions, size_t vertex_count,
+                                           const uint32_t* indices, size_t triangle_count,
+                                           const uint32_t* triangle_object, size_t object_count,
+                                           const uint32_t* ids, size_t id_count, const Point3& o,
+                                           double big_r);
 
 }  // namespace pvs_runtime

@@ -90,8 +90,16 @@ struct BucketGrid {
   int nx = 1, nz = 1;
   std::vector<std::vector<uint32_t>> buckets;
 
-  int bx(double x) const { return std::clamp(int(std::floor((x - min_x) / cell_x)), 0, nx - 1); }
-  int bz(double z) const { return std::clamp(int(std::floor((z - min_z) / cell_z)), 0, nz - 1); }
+  // The bucket of a coordinate, clamped in double before the conversion to int (a far, infinite
+  // or NaN coordinate must not overflow the conversion: undefined behaviour). NaN maps to 0.
+  static int bucket(double x, double min, double width, int n) {
+    double f = std::floor((x - min) / width);
+    if (!(f > 0)) return 0;
+    if (f >= double(n - 1)) return n - 1;
+    return int(f);
+  }
+  int bx(double x) const { return bucket(x, min_x, cell_x, nx); }
+  int bz(double z) const { return bucket(z, min_z, cell_z, nz); }
 
   void build(const std::vector<pvs::Box>& boxes) {
     if (boxes.empty()) return;
@@ -109,8 +117,14 @@ struct BucketGrid {
     nx = nz = side;
     cell_x = (max_x - min_x) / nx;
     cell_z = (max_z - min_z) / nz;
-    if (!(cell_x > 0)) { cell_x = 1; nx = 1; }
-    if (!(cell_z > 0)) { cell_z = 1; nz = 1; }
+    if (!(cell_x > 0)) {
+      cell_x = 1;
+      nx = 1;
+    }
+    if (!(cell_z > 0)) {
+      cell_z = 1;
+      nz = 1;
+    }
     buckets.assign(size_t(nx) * size_t(nz), {});
     for (uint32_t c = 0; c < boxes.size(); ++c) {
       const pvs::Box& b = boxes[c];
@@ -169,15 +183,25 @@ Pvs Pvs::open(const std::string& path, const OpenOptions& options) {
   return Pvs(std::move(impl));
 }
 
-const pvs::FileInfo& Pvs::info() const { return impl_->reader->info(); }
-uint32_t Pvs::cell_count() const { return impl_->reader->cell_count(); }
-uint64_t Pvs::file_size() const { return impl_->reader->file_size(); }
+const pvs::FileInfo& Pvs::info() const {
+  return impl_->reader->info();
+}
+uint32_t Pvs::cell_count() const {
+  return impl_->reader->cell_count();
+}
+uint64_t Pvs::file_size() const {
+  return impl_->reader->file_size();
+}
 
 std::optional<uint32_t> Pvs::find_cell(const double position[3]) const {
+  // NaN or infinite coordinates lie in no (finite) cell; checked before any arithmetic on them.
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(position[k])) return std::nullopt;
   const pvs::CellLayout& layout = info().layout;
   if (layout.kind == pvs::LayoutKind::Grid) return layout.find_cell(position);
   for (uint32_t c : impl_->buckets.candidates(position[0], position[0], position[2], position[2]))
-    if (box_contains(layout.boxes[c], position)) return c;  // candidates are sorted: lowest id first
+    if (box_contains(layout.boxes[c], position))
+      return c;  // candidates are sorted: lowest id first
   return std::nullopt;
 }
 
@@ -189,11 +213,14 @@ std::vector<uint32_t> Pvs::neighbours(uint32_t cell, double margin) const {
   std::vector<uint32_t> out;
   if (layout.kind == pvs::LayoutKind::Grid) {
     const uint32_t n[3] = {layout.nx, layout.ny, layout.nz};
-    uint32_t idx[3] = {cell % layout.nx, (cell / layout.nx) % layout.ny, cell / (layout.nx * layout.ny)};
+    uint32_t idx[3] = {cell % layout.nx, (cell / layout.nx) % layout.ny,
+                       cell / (layout.nx * layout.ny)};
     int64_t lo[3], hi[3];
     for (int k = 0; k < 3; ++k) {
       double w = (layout.grid_box.max[k] - layout.grid_box.min[k]) / n[k];
-      int64_t reach = w > 0 ? int64_t(std::ceil(margin / w)) + 1 : int64_t(n[k]);
+      // In double first: an infinite or huge margin reaches every cell (no overflowing cast).
+      double r = w > 0 ? std::ceil(margin / w) + 1 : double(n[k]);
+      int64_t reach = r >= double(n[k]) ? int64_t(n[k]) : int64_t(r);
       lo[k] = std::max<int64_t>(0, int64_t(idx[k]) - reach);
       hi[k] = std::min<int64_t>(int64_t(n[k]) - 1, int64_t(idx[k]) + reach);
     }
@@ -206,8 +233,8 @@ std::vector<uint32_t> Pvs::neighbours(uint32_t cell, double margin) const {
     std::sort(out.begin(), out.end());
     return out;
   }
-  for (uint32_t c : impl_->buckets.candidates(me.min[0] - margin, me.max[0] + margin, me.min[2] - margin,
-                                               me.max[2] + margin))
+  for (uint32_t c : impl_->buckets.candidates(me.min[0] - margin, me.max[0] + margin,
+                                              me.min[2] - margin, me.max[2] + margin))
     if (c != cell && boxes_overlap(me, layout.boxes[c], margin)) out.push_back(c);
   return out;
 }
@@ -235,7 +262,8 @@ void Pvs::prefetch(uint32_t cell) {
   uintptr_t begin = reinterpret_cast<uintptr_t>(impl_->mapping.data) + uintptr_t(e.offset);
   uintptr_t end = begin + e.size;
   begin &= ~(page - 1);
-  madvise(reinterpret_cast<void*>(begin), end - begin, MADV_WILLNEED);  // advice only: errors ignored
+  madvise(reinterpret_cast<void*>(begin), end - begin,
+          MADV_WILLNEED);  // advice only: errors ignored
 }
 
 }  // namespace pvs_runtime

@@ -1,34 +1,74 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer target of the PVS reader with clang (ASan + UBSan) and runs it for a
-# bounded time on the committed seed corpus. Exit status non-zero on a finding; the crashing
-# input is saved as build-fuzz/crash-* (reproduce: build-fuzz/pvs_reader_fuzz build-fuzz/crash-...).
+# Builds the libFuzzer targets with clang (ASan + UBSan) and runs each for a bounded time on its
+# committed seed corpus: the PVS reader and the scene loaders of every format (glb gltf obj ply off
+# stl spheres). Exit status non-zero on a finding; the crashing input is saved as
+# build-fuzz/<target>/crash-* (reproduce: build-fuzz/<target> build-fuzz/<target>/crash-...).
 #
-#   bash scripts/fuzz.sh              # 60 s (FUZZ_SECONDS overrides), new inputs in build-fuzz/corpus
-#   bash scripts/fuzz.sh merge        # minimise seeds + build-fuzz/corpus into fuzz/corpus/pvs_reader
+#   bash scripts/fuzz.sh                  # every target, FUZZ_SECONDS (default 240) split evenly
+#   FUZZ_SECONDS_PER_TARGET=600 bash scripts/fuzz.sh ply_loader_fuzz   # one target, 10 minutes
+#   bash scripts/fuzz.sh merge [TARGET]   # minimise seeds + new inputs into fuzz/corpus/<name>
 #
-# Needs clang++ and the libFuzzer runtime (Debian: clang, libclang-rt-14-dev). Uses neither vislib
-# nor its dependencies: the target compiles pvs_format/ alone.
+# Before fuzzing, every seed (the issue-18 repros among them) is run once through its target, and
+# when ../shared/repros and build/cli/pvs exist, `pvs info` must exit 2 on each repro.
+# Needs clang++ and the libFuzzer runtime (Debian: clang, libclang-rt-14-dev), and for the scene
+# loaders the Debian packages of tinygltf, meshoptimizer and nlohmann-json (as vislib itself).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${FUZZ_BUILD_DIR:-build-fuzz}
-SECONDS_TO_RUN=${FUZZ_SECONDS:-60}
-SEEDS=fuzz/corpus/pvs_reader
-mkdir -p "$BUILD_DIR/corpus"
+ALL_TARGETS="pvs_reader_fuzz glb_loader_fuzz gltf_loader_fuzz obj_loader_fuzz ply_loader_fuzz off_loader_fuzz stl_loader_fuzz spheres_loader_fuzz"
+mode=run
+if [[ "${1:-}" == "merge" ]]; then mode=merge; shift; fi
+TARGETS=${*:-$ALL_TARGETS}
+ntargets=$(wc -w <<< "$TARGETS")
+TOTAL=${FUZZ_SECONDS:-240}
+PER_TARGET=${FUZZ_SECONDS_PER_TARGET:-$(( TOTAL / ntargets ))}
+(( PER_TARGET >= 1 )) || PER_TARGET=1
+mkdir -p "$BUILD_DIR"
 cmake -S fuzz -B "$BUILD_DIR" -G Ninja -DCMAKE_CXX_COMPILER="${CXX_FUZZ:-clang++}" > "$BUILD_DIR/configure.log" 2>&1 \
   || { cat "$BUILD_DIR/configure.log"; exit 1; }
-cmake --build "$BUILD_DIR"
-FUZZER="$BUILD_DIR/pvs_reader_fuzz"
+cmake --build "$BUILD_DIR" --target $TARGETS
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
-if [[ "${1:-}" == "merge" ]]; then
-  # Keep only inputs that add coverage; replaces the committed seeds by the minimised set.
-  rm -rf "$SEEDS.new" && mkdir -p "$SEEDS.new"
-  "$FUZZER" -merge=1 "$SEEDS.new" "$SEEDS" "$BUILD_DIR/corpus"
-  rm -rf "$SEEDS" && mv "$SEEDS.new" "$SEEDS"
-  echo "fuzz: $(ls "$SEEDS" | wc -l) inputs, $(du -sh "$SEEDS" | cut -f1) in $SEEDS"
+seeds_of() { local t=${1%_fuzz}; echo "fuzz/corpus/${t%_loader}"; }
+
+if [[ $mode == merge ]]; then
+  for t in $TARGETS; do
+    seeds=$(seeds_of "$t")
+    # Keep only inputs that add coverage; replaces the committed seeds by the minimised set.
+    rm -rf "$seeds.new" && mkdir -p "$seeds.new" "$BUILD_DIR/corpus/$t"
+    "$BUILD_DIR/$t" -merge=1 "$seeds.new" "$seeds" "$BUILD_DIR/corpus/$t"
+    rm -rf "$seeds" && mv "$seeds.new" "$seeds"
+    echo "fuzz: $t: $(ls "$seeds" | wc -l) inputs, $(du -sh "$seeds" | cut -f1) in $seeds"
+  done
   exit 0
 fi
-# New inputs go to the first folder (not committed); the seeds are read only.
-"$FUZZER" -max_total_time="$SECONDS_TO_RUN" -max_len=4096 -rss_limit_mb=2048 -timeout=10 \
-  -print_final_stats=1 -artifact_prefix="$BUILD_DIR/" "$BUILD_DIR/corpus" "$SEEDS"
-echo "fuzz: ${SECONDS_TO_RUN} s without a finding"
+
+# The repros of issue 18 through the CLI: exit 2 with a message, quickly.
+if [[ -d ../shared/repros && -x build/cli/pvs ]]; then
+  for f in ../shared/repros/ply-*.ply ../shared/repros/off-oom.off; do
+    [[ -e $f ]] || continue
+    t0=$(date +%s%N)
+    rc=0; msg=$(timeout 10 build/cli/pvs info "$f" 2>&1 >/dev/null) || rc=$?
+    ms=$(( ($(date +%s%N) - t0) / 1000000 ))
+    [[ $rc == 2 ]] || { echo "fuzz: repro $f: exit $rc (expected 2) after $ms ms: $msg"; exit 1; }
+    echo "fuzz: repro $(basename "$f"): exit 2 in $ms ms: $msg"
+  done
+fi
+
+echo "fuzz: $ntargets target(s), ${PER_TARGET} s each"
+for t in $TARGETS; do
+  seeds=$(seeds_of "$t")
+  mkdir -p "$BUILD_DIR/corpus/$t" "$BUILD_DIR/$t.artifacts"
+  # New inputs go to the first folder (not committed); the seeds are read only.
+  status=0
+  "$BUILD_DIR/$t" -max_total_time="$PER_TARGET" -max_len=4096 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
+    -timeout=10 -print_final_stats=1 -artifact_prefix="$BUILD_DIR/$t.artifacts/" \
+    "$BUILD_DIR/corpus/$t" "$seeds" > "$BUILD_DIR/$t.log" 2>&1 || status=$?
+  grep -E "^#[0-9]+ +(INITED|DONE)|^stat::number_of_executed_units" "$BUILD_DIR/$t.log" || true
+  if [[ $status != 0 ]]; then
+    tail -40 "$BUILD_DIR/$t.log"
+    echo "fuzz: $t: FINDING (exit $status), input in $BUILD_DIR/$t.artifacts/"
+    exit 1
+  fi
+  echo "fuzz: $t: ${PER_TARGET} s without a finding"
+done

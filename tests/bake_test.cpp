@@ -1,19 +1,21 @@
 // Tests of the bake (library): byte-identical output for any thread count, shards merged into
 // the same bytes, resume from a checkpoint (including one torn at any byte), refusal of another
 // bake's checkpoint, and the scene fingerprint and subset the PVS relies on.
+#include "vislib/bake/bake.h"
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <filesystem>
+#include <memory>
 
 #include "tests/test_support.h"
-#include "vislib/bake/bake.h"
 #include "vislib/bake/checkpoint.h"
+#include "vislib/bake/scene_subset.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/generate.h"
 #include "vislib/scene/scene_fingerprint.h"
-#include "vislib/bake/scene_subset.h"
 
 using namespace vislib;
 using vislib_test::temp_dir;
@@ -41,12 +43,15 @@ BakeSettings settings() {
   return s;
 }
 
-std::string bake_bytes(const Scene& scene, const ViewCells& cells, const BakeSettings& s, const std::string& path,
-                       Shard shard = {}, int threads = 0) {
+std::string bake_bytes(const Scene& scene, const ViewCells& cells, const BakeSettings& s,
+                       const std::string& path, Shard shard = {}, int threads = 0) {
   std::unique_ptr<tbb::global_control> limit;
-  if (threads) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+  if (threads)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                  threads);
   bake(scene, cells, s, shard, {path, path + ".ckpt", false});
-  EXPECT_FALSE(std::filesystem::exists(path + ".ckpt")) << "the checkpoint must be gone after success";
+  EXPECT_FALSE(std::filesystem::exists(path + ".ckpt"))
+      << "the checkpoint must be gone after success";
   return read_file(path);
 }
 
@@ -63,7 +68,8 @@ TEST(Bake, OutputIsByteIdenticalForOneAndTwoThreads) {
   EXPECT_EQ(r.info().universe, scene.triangle_count());
   EXPECT_EQ(r.info().scene_fingerprint, scene_fingerprint(scene));
   // Each cell holds what bake_cell computes.
-  for (uint32_t c = 0; c < 9; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, r.info().layout, c, settings()));
+  for (uint32_t c = 0; c < 9; ++c)
+    EXPECT_EQ(r.read_cell(c), bake_cell(scene, r.info().layout, c, settings()));
 }
 
 TEST(Bake, ShardsMergeIntoTheSingleBakeByteForByte) {
@@ -72,7 +78,8 @@ TEST(Bake, ShardsMergeIntoTheSingleBakeByteForByte) {
   std::string whole = bake_bytes(scene, small_grid(), settings(), dir + "/whole.pvs");
   std::vector<pvs::Reader> shards;
   for (uint32_t i = 0; i < 4; ++i) {
-    std::string bytes = bake_bytes(scene, small_grid(), settings(), dir + "/s" + std::to_string(i) + ".pvs", {i, 4});
+    std::string bytes = bake_bytes(scene, small_grid(), settings(),
+                                   dir + "/s" + std::to_string(i) + ".pvs", {i, 4});
     shards.push_back(pvs::Reader::from_memory(bytes));
     EXPECT_TRUE(shards.back().info().partial);
   }
@@ -146,14 +153,15 @@ TEST(Checkpoint, TornAtAnyByteKeepsEveryCompleteRecord) {
   for (size_t n = 0; n <= full.size(); ++n) {
     write_file_atomic(path, full.substr(0, n));
     std::vector<std::optional<std::vector<uint32_t>>> got;
-    Checkpoint cp(path, 99, 10, true, &got, 5000);
+    auto cp = std::make_unique<Checkpoint>(path, 99, 10, true, &got, 5000);
     size_t complete = 0;
     while (complete + 1 < ends.size() && ends[complete + 1] <= n) ++complete;
     if (n < ends[0]) complete = 0;
-    EXPECT_EQ(cp.recovered_records(), complete) << "cut at " << n;
+    EXPECT_EQ(cp->recovered_records(), complete) << "cut at " << n;
     for (size_t i = 0; i < complete; ++i) EXPECT_EQ(got[2 * i], sets[i]) << "cut at " << n;
     // Appending after the cut continues a valid file.
-    cp.append(9, {42});
+    cp->append(9, {42});
+    cp.reset();  // release the checkpoint (and its lock) before reopening it
     std::vector<std::optional<std::vector<uint32_t>>> again;
     Checkpoint reread(path, 99, 10, true, &again, 5000);
     EXPECT_EQ(reread.recovered_records(), complete + 1) << "cut at " << n;
@@ -161,7 +169,7 @@ TEST(Checkpoint, TornAtAnyByteKeepsEveryCompleteRecord) {
   }
 }
 
-TEST(Checkpoint, DamagedRecordEndsTheValidPart) {
+TEST(Checkpoint, DamagedLastRecordIsDropped) {
   std::string dir = temp_dir("checkpoint_damaged");
   std::string path = dir + "/c.ckpt";
   {
@@ -178,6 +186,122 @@ TEST(Checkpoint, DamagedRecordEndsTheValidPart) {
   EXPECT_TRUE(got[0]);
   EXPECT_FALSE(got[1]);
   EXPECT_GT(cp.discarded_bytes(), 0u);
+  EXPECT_EQ(cp.dropped_records(), 1u);
+}
+
+namespace {
+
+// A checkpoint of 38 records (cells 0..37 of 40, sets of varying size), as bytes; `ends[i]` is
+// the file size after record i.
+std::string checkpoint_of_38(const std::string& path, std::vector<size_t>& ends,
+                             std::vector<std::vector<uint32_t>>& sets) {
+  sets.clear();
+  ends.clear();
+  {
+    Checkpoint cp(path, 77, 40, false);
+    for (uint32_t c = 0; c < 38; ++c) {
+      std::vector<uint32_t> ids;
+      for (uint32_t i = 0; i < 3 + (c * 7) % 20; ++i) ids.push_back(c + 10 * i);
+      cp.append(c, ids);
+      sets.push_back(ids);
+      ends.push_back(std::filesystem::file_size(path));
+    }
+  }
+  return read_file(path);
+}
+
+}  // namespace
+
+// Issue 18: one flipped byte at a quarter of a 38-record checkpoint used to drop the valid records
+// after it. Now only the damaged record is dropped (skipped by its size field), whatever byte of
+// it is hit, and appending continues after the last record.
+TEST(Checkpoint, FlippedByteAtAQuarterKeepsEveryOtherRecord) {
+  std::string dir = temp_dir("checkpoint_flip");
+  std::string path = dir + "/c.ckpt";
+  std::vector<size_t> ends;
+  std::vector<std::vector<uint32_t>> sets;
+  const std::string full = checkpoint_of_38(path, ends, sets);
+  const size_t quarter = full.size() / 4;
+  size_t hit = 0;  // the record holding byte `quarter`
+  while (ends[hit] <= quarter) ++hit;
+  const size_t rec_start = hit == 0 ? 24 : ends[hit - 1];
+  // The byte at a quarter, then every byte of that record (size field, cell id, payload, CRC).
+  std::vector<size_t> where = {quarter};
+  for (size_t b = rec_start; b < ends[hit]; ++b) where.push_back(b);
+  for (size_t at : where) {
+    std::string f = full;
+    f[at] ^= 0x5a;
+    write_file_atomic(path, f);
+    std::vector<std::optional<std::vector<uint32_t>>> got;
+    auto cp = std::make_unique<Checkpoint>(path, 77, 40, true, &got, 1000);
+    EXPECT_EQ(cp->recovered_records(), 37u) << "byte " << at;
+    EXPECT_EQ(cp->dropped_records(), 1u) << "byte " << at;
+    EXPECT_EQ(cp->discarded_bytes(), ends[hit] - rec_start) << "byte " << at;
+    for (uint32_t c = 0; c < 38; ++c) {
+      if (c == hit) {
+        EXPECT_FALSE(got[c]) << "byte " << at;
+      } else {
+        ASSERT_TRUE(got[c]) << "byte " << at << " cell " << c;
+        EXPECT_EQ(*got[c], sets[c]);
+      }
+    }
+    // The damaged cell is baked again and appended; a second reopen finds all 38.
+    cp->append(uint32_t(hit), sets[hit]);
+    cp.reset();  // release the checkpoint (and its lock) before reopening it
+    std::vector<std::optional<std::vector<uint32_t>>> again;
+    Checkpoint reread(path, 77, 40, true, &again, 1000);
+    EXPECT_EQ(reread.recovered_records(), 38u) << "byte " << at;
+    EXPECT_EQ(again[hit], sets[hit]);
+  }
+}
+
+TEST(Checkpoint, SecondOpenOfTheSameCheckpointIsRefused) {
+  std::string dir = temp_dir("checkpoint_lock");
+  std::string path = dir + "/c.ckpt";
+  Checkpoint first(path, 1, 4, false);
+  first.append(0, {1});
+  EXPECT_THROW(Checkpoint(path, 1, 4, true), InputError);
+  EXPECT_THROW(Checkpoint(path, 1, 4, false), InputError);
+  // The refused opens did not truncate or cut the holder's file: both records are there.
+  first.append(1, {2});
+  std::string bytes = read_file(path);
+  EXPECT_EQ(bytes.size(), std::filesystem::file_size(path));
+  EXPECT_GT(bytes.size(), 24u + 2 * 12);
+  first.remove();
+  EXPECT_FALSE(std::filesystem::exists(path));
+}
+
+// The streamed output (blocks written as cells finish, index patched at the end) holds exactly the
+// bytes pvs::write_pvs gives for every cell's set, for the whole bake and for a shard.
+TEST(Bake, StreamedFileEqualsWritePvsOfEveryCellsSet) {
+  Scene scene = small_city();
+  ViewCells cells = small_grid();
+  std::string dir = temp_dir("bake_stream");
+  pvs::FileInfo info = bake_file_info(scene, cells, settings());
+  std::vector<pvs::CellSet> sets(cells.layout.cell_count());
+  for (uint32_t c = 0; c < sets.size(); ++c)
+    sets[c] = bake_cell(scene, cells.layout, c, settings());
+  EXPECT_EQ(bake_bytes(scene, cells, settings(), dir + "/all.pvs", {}, 2),
+            pvs::write_pvs(info, sets));
+  info.partial = true;
+  for (uint32_t c = 0; c < sets.size(); ++c)
+    if (!in_shard(c, {1, 3})) sets[c].reset();
+  EXPECT_EQ(bake_bytes(scene, cells, settings(), dir + "/s1.pvs", {1, 3}, 2),
+            pvs::write_pvs(info, sets));
+}
+
+TEST(Bake, RefusedWhileAnotherBakeHoldsTheOutputLock) {
+  Scene scene = small_city();
+  std::string dir = temp_dir("bake_lock");
+  std::string out = dir + "/x.pvs";
+  {
+    FileLock other(out + ".lock", "the output");
+    EXPECT_THROW(bake(scene, small_grid(), settings(), {}, {out, out + ".ckpt", false}),
+                 InputError);
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  bake(scene, small_grid(), settings(), {}, {out, out + ".ckpt", false});
+  EXPECT_TRUE(std::filesystem::exists(out));
 }
 
 TEST(SceneFingerprint, ChangesWithAnyVertexIndexOrObjectButNotWithNames) {
@@ -208,7 +332,8 @@ TEST(SceneSubset, KeepsExactlyTheSetAtEachGranularity) {
   Scene o = scene_subset(s, objs, Granularity::Object);
   EXPECT_EQ(o.objects.size(), objs.size());
   size_t expect = 0;
-  for (uint32_t obj : s.triangle_object) expect += std::binary_search(objs.begin(), objs.end(), obj);
+  for (uint32_t obj : s.triangle_object)
+    expect += std::binary_search(objs.begin(), objs.end(), obj);
   EXPECT_EQ(o.triangle_count(), expect);
   EXPECT_EQ(o.objects[0].name, s.objects[objs[0]].name);
 }

@@ -131,7 +131,7 @@ TEST(BenchmarkCompare, SmallRunIsConsistent) {
     EXPECT_EQ(m->growth.back().found, m->set.size());
     // Checkpoint sets are the growth curve's sets; frame quality does not get worse with more runs.
     for (size_t i = 0; i < m->checkpoints.size(); ++i) {
-      const Checkpoint& c = m->checkpoints[i];
+      const QualityCheckpoint& c = m->checkpoints[i];
       EXPECT_EQ(c.set_size, c.runs ? m->growth[size_t(c.runs) - 1].found : 0u);
       EXPECT_EQ(c.views.size(), 3u);
       if (i) {

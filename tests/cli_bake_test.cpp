@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -39,7 +40,8 @@ const std::string& city() {
 
 // 16 grid cells over the middle of the city, at a small resolution.
 std::string grid_bake(const std::string& out) {
-  return "bake " + city() + " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 -o " + out;
+  return "bake " + city() +
+         " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 -o " + out;
 }
 
 // Complete records in a checkpoint file (24-byte header, then size/cell/payload/CRC records).
@@ -68,8 +70,10 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
 
   // Start the same bake as a child process and kill -9 it once a few cells are checkpointed.
   std::string target = dir + "/killed.pvs";
-  std::vector<std::string> args = {"pvs", "bake", city(), "--box", "-60,0,-60,60,3,60", "--grid", "4,1,4",
-                                   "--eye-height", "1.5,1.8", "--res", "24", "--threads", "1", "-o", target};
+  std::vector<std::string> args = {
+      "pvs",          "bake",    city(),  "--box", "-60,0,-60,60,3,60", "--grid", "4,1,4",
+      "--eye-height", "1.5,1.8", "--res", "24",    "--threads",         "1",      "-o",
+      target};
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -88,7 +92,8 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
       finished_early = true;
       break;
     }
-    ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60)) << "no checkpoint records";
+    ASSERT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60))
+        << "no checkpoint records";
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   ASSERT_FALSE(finished_early) << "the bake finished before it could be killed";
@@ -128,7 +133,10 @@ TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {
   ASSERT_EQ(run_pvs("merge " + shards + "-o " + dir + "/merged.pvs", &out), 0) << out;
   EXPECT_EQ(vislib::read_file(dir + "/merged.pvs"), vislib::read_file(dir + "/one.pvs"));
   // A missing shard is an error naming the cell.
-  ASSERT_EQ(run_pvs("merge " + dir + "/shard0.pvs " + dir + "/shard1.pvs -o " + dir + "/bad.pvs", &out), 2) << out;
+  ASSERT_EQ(
+      run_pvs("merge " + dir + "/shard0.pvs " + dir + "/shard1.pvs -o " + dir + "/bad.pvs", &out),
+      2)
+      << out;
   EXPECT_NE(out.find("absent from every shard"), std::string::npos) << out;
   EXPECT_EQ(run_pvs(grid_bake(dir + "/x.pvs") + " --shard 3/3", &out), 2) << out;
 }
@@ -136,7 +144,11 @@ TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {
 TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
   std::string dir = temp_dir("cli_inspect");
   std::string pvs = dir + "/city.pvs", out;
-  ASSERT_EQ(run_pvs("bake " + city() + " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 -o " + pvs, &out), 0) << out;
+  ASSERT_EQ(run_pvs("bake " + city() +
+                        " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 -o " + pvs,
+                    &out),
+            0)
+      << out;
   ASSERT_EQ(run_pvs("inspect --json " + pvs, &out), 0) << out;
   json s = json::parse(out);
   const unsigned cells = s["cells"];
@@ -156,7 +168,11 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
 
   // One cell, by point, with the scene: export the visible triangles and read them back.
   std::string glb = dir + "/cell.glb";
-  ASSERT_EQ(run_pvs("inspect " + pvs + " --at 0,1.6,0 --json --scene " + city() + " --export-gltf " + glb, &out), 0) << out;
+  ASSERT_EQ(
+      run_pvs("inspect " + pvs + " --at 0,1.6,0 --json --scene " + city() + " --export-gltf " + glb,
+              &out),
+      0)
+      << out;
   json c = json::parse(out);
   EXPECT_EQ(c["boundary_segments"].size(), 8u);
   EXPECT_GT(c["visible_count"].get<int>(), 0);
@@ -176,8 +192,18 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
 
   // Object granularity: whole objects are exported.
   std::string opvs = dir + "/objects.pvs";
-  ASSERT_EQ(run_pvs("bake " + city() + " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 --granularity object -o " + opvs, &out), 0) << out;
-  ASSERT_EQ(run_pvs("inspect " + opvs + " --at 0,1.6,0 --json --scene " + city() + " --export-gltf " + glb, &out), 0) << out;
+  ASSERT_EQ(run_pvs("bake " + city() +
+                        " --walkable --cell-size 20 --box -40,-1,-40,40,2,40 --res 24 "
+                        "--granularity object -o " +
+                        opvs,
+                    &out),
+            0)
+      << out;
+  ASSERT_EQ(run_pvs("inspect " + opvs + " --at 0,1.6,0 --json --scene " + city() +
+                        " --export-gltf " + glb,
+                    &out),
+            0)
+      << out;
   c = json::parse(out);
   EXPECT_EQ(c["granularity"], "object");
   EXPECT_EQ(vislib::load_scene(glb).objects.size(), c["visible_count"].get<size_t>());
@@ -199,3 +225,140 @@ TEST(CliBake, InspectRejectsAnotherScenesPvsAndDamagedFiles) {
   EXPECT_NE(out.find("checksum mismatch"), std::string::npos) << out;
   EXPECT_NE(out.find("damaged.pvs"), std::string::npos) << out;
 }
+
+// Two bakes of one output cannot run together: while another process holds OUTPUT.lock (as a
+// running bake does), `pvs bake` exits 2 saying so, and touches neither output nor checkpoint.
+TEST(CliBake, SecondConcurrentBakeOfTheSameOutputIsRefused) {
+  std::string dir = temp_dir("cli_bake_lock");
+  std::string out = dir + "/busy.pvs", text;
+  {
+    vislib::FileLock running(out + ".lock",
+                             "the output " + out);  // this process plays the first bake
+    EXPECT_EQ(run_pvs(grid_bake(out), &text), 2) << text;
+    EXPECT_NE(text.find("locked by another process"), std::string::npos) << text;
+    EXPECT_FALSE(std::filesystem::exists(out));
+    EXPECT_FALSE(std::filesystem::exists(out + ".ckpt"));
+    EXPECT_EQ(run_pvs(grid_bake(out) + " --resume", &text), 2) << text;
+  }
+  // Once released (and the lock file removed), the bake runs.
+  EXPECT_FALSE(std::filesystem::exists(out + ".lock"));
+  EXPECT_EQ(run_pvs(grid_bake(out), &text), 0) << text;
+  EXPECT_FALSE(std::filesystem::exists(out + ".lock"));
+}
+
+// Two resumes cannot append to one checkpoint: the checkpoint is locked too, even when the two
+// runs write different outputs.
+TEST(CliBake, SecondResumeOfALockedCheckpointIsRefused) {
+  std::string dir = temp_dir("cli_bake_ckpt_lock");
+  std::string ckpt = dir + "/shared.ckpt", text;
+  int fd = ::open(ckpt.c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);  // as a running bake holds it
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/other.pvs") + " --resume --checkpoint " + ckpt, &text), 2)
+      << text;
+  EXPECT_NE(text.find("checkpoint is locked"), std::string::npos) << text;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/other.pvs"));
+  ::close(fd);
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/other.pvs") + " --resume --checkpoint " + ckpt, &text), 0)
+      << text;
+  namespace {
+
+  // A sphere scene with `states` key states, plus (if `ground`) a `mesh` line naming a ground
+  // quad in an OBJ beside it: the paper's bouncing spheres over a ground, from the command line.
+  std::string sphere_scene(const std::string& dir, bool ground) {
+    std::string path = dir + "/balls.spheres", out;
+    EXPECT_EQ(run_pvs("generate spheres --count 40 --radius 1 --area 30 --states 3 --max-height 4 "
+                      "--speed 3 -o " +
+                          path,
+                      &out),
+              0)
+        << out;
+    if (!ground) return path;
+    {
+      std::FILE* f = std::fopen((dir + "/ground.obj").c_str(), "w");
+      std::fputs("o ground\nv -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\nf 1 3 2\nf 1 4 3\n", f);
+      std::fclose(f);
+    }
+    std::string text = vislib::read_file(path);
+    size_t at = text.find("states 3\n");
+    EXPECT_NE(at, std::string::npos);
+    text.insert(at + 9, "mesh ground.obj\n");
+    std::string mixed = dir + "/mixed.spheres";
+    std::FILE* f = std::fopen(mixed.c_str(), "w");
+    std::fputs(text.c_str(), f);
+    std::fclose(f);
+    return mixed;
+  }
+
+  }  // namespace
+
+  // Issue 12 items 5 and 6: one id rule for bake, inspect and view, on a sphere scene and on a
+  // scene of a mesh plus spheres given from the command line (a `mesh` line in the sphere file).
+  TEST(CliBake, SphereAndMixedScenesBakeInspectAndViewWithOneIdUniverse) {
+    std::string dir = temp_dir("cli_spheres");
+    for (bool ground : {false, true}) {
+      std::string scene = sphere_scene(dir, ground),
+                  pvs = dir + (ground ? "/mixed.pvs" : "/balls.pvs"), out;
+      const unsigned tris = ground ? 2 : 0;
+      ASSERT_EQ(
+          run_pvs("bake " + scene +
+                      " --box -8,0,-8,8,2,8 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 -o " + pvs,
+                  &out),
+          0)
+          << out;
+      EXPECT_EQ(out.find("ignored"), std::string::npos) << out;  // spheres are baked, not "ignored"
+      ASSERT_EQ(run_pvs("inspect --json " + pvs, &out), 0) << out;
+      EXPECT_EQ(json::parse(out)["universe"], tris + 40);
+      ASSERT_EQ(run_pvs("inspect " + pvs + " --scene " + scene + " --cell 0 --json", &out), 0)
+          << out;
+      json c = json::parse(out);
+      ASSERT_GT(c["visible_count"].get<int>(), 0) << out;
+      bool sphere_id = false;
+      for (unsigned id : c["visible"]) sphere_id = sphere_id || id >= tris;
+      EXPECT_TRUE(sphere_id) << "a cell sees some sphere";
+      // The segment command sees the same scene: triangles first, then spheres.
+      ASSERT_EQ(run_pvs("segment " + scene + " --from -2,1.6,0 --to 2,1.6,0 --res 16 --json " +
+                            dir + "/s.json",
+                        &out),
+                0)
+          << out;
+      json sj = json::parse(vislib::read_file(dir + "/s.json"));
+      if (ground) {
+        EXPECT_EQ(sj["counts"]["scene_triangles"], 2);
+      }
+      EXPECT_GT(sj["visible_spheres"].size(), 0u);
+      std::string png = dir + "/view.png";
+      ASSERT_EQ(run_pvs("view " + pvs + " --scene " + scene +
+                            " --at -3,1.6,-3 --look 3,1.6,3 --near-far 3,8 --frame 32x24 -o " +
+                            png + " --json -",
+                        &out),
+                0)
+          << out;
+      size_t brace = out.find('{');
+      ASSERT_NE(brace, std::string::npos) << out;
+      json v = json::parse(out.substr(brace));
+      EXPECT_EQ(v["triangles"]["scene"], tris);
+    }
+  }
+
+  // Issue 12 item 8: an animated glTF without --states warns and names the option; a scene far from
+  // the origin warns; `pvs info` makes no units claim.
+  TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
+    VISLIB_REQUIRE_SHARED(shared);
+    std::string out, box = shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf";
+    ASSERT_EQ(run_pvs("info " + box, &out), 0) << out;
+    EXPECT_NE(out.find("animation(s) ignored"), std::string::npos) << out;
+    EXPECT_NE(out.find("--states"), std::string::npos) << out;
+    EXPECT_EQ(out.find("(likely)"), std::string::npos) << out;
+    ASSERT_EQ(run_pvs("info " + box + " --states 5", &out), 0) << out;
+    EXPECT_EQ(out.find("animation(s) ignored"), std::string::npos) << out;
+    std::string dir = temp_dir("cli_far");
+    std::FILE* f = std::fopen((dir + "/far.obj").c_str(), "w");
+    std::fputs("v 100000 0 0\nv 100001 0 0\nv 100000 1 0\nf 1 2 3\n", f);
+    std::fclose(f);
+    ASSERT_EQ(run_pvs("info " + dir + "/far.obj --json", &out), 0) << out;
+    EXPECT_NE(out.find("far from the origin"), std::string::npos) << out;
+    size_t brace = out.find('{');
+    ASSERT_NE(brace, std::string::npos);
+    EXPECT_TRUE(json::parse(out.substr(brace))["far_from_origin"].get<bool>());
+  }

@@ -367,3 +367,254 @@ TEST(DynamicVisibility, GeneratedBouncingSpheresOverAGroundMatchTheReference) {
   expect_clean(check_diagonal(s, {-3, 1.7, -2}, {4, 1.7, 3}, random_orientation(8), 40, 0.01, 5, 9),
                "bouncing spheres");
 }
+
+namespace {
+
+// View depth of primitive `id` (triangle id, or triangle_count + sphere) along eye + lambda d at
+// animation time tau, lambda > near, in double; inf when the ray misses it.
+double depth_of(const Scene& s, uint32_t id, double tau, Vec3 eye, Vec3 d, double near) {
+  if (id < s.triangle_count()) {
+    const auto& ix = s.triangles[id];
+    Vec3 a = s.position_at(ix[0], tau) - eye, b = s.position_at(ix[1], tau) - eye,
+         c = s.position_at(ix[2], tau) - eye;
+    Vec3 e1 = b - a, e2 = c - a, pv = cross(d, e2);
+    double det = dot(e1, pv);
+    if (det == 0) return INFINITY;
+    double u = dot(-a, pv) / det;
+    Vec3 qv = cross(-a, e1);
+    double v = dot(d, qv) / det, lam = dot(e2, qv) / det;
+    if (u < 0 || v < 0 || u + v > 1 || !(lam > near)) return INFINITY;
+    return lam;
+  }
+  uint32_t k = uint32_t(id - s.triangle_count());
+  Vec3 w = eye - s.sphere_center_at(k, tau);
+  double rr = s.sphere_radius[k], dd = dot(d, d), h = dot(d, w), m = dot(w, w) - rr * rr;
+  Vec3 c = cross(d, w);
+  double g = rr * rr * dd - dot(c, c);
+  if (g <= 0) return INFINITY;
+  double sq = std::sqrt(g);
+  double l1 = h < 0 ? m / (-h + sq) : (-h - sq) / dd, l2 = (-h + sq) / dd;
+  return l1 > near ? l1 : (l2 > near ? l2 : INFINITY);
+}
+
+struct WitnessCounts {
+  size_t witnesses = 0, ambiguous = 0, failures = 0;
+  std::string first;
+};
+
+// Re-casts every witness of `r` (both kinds of primitive) with the double-precision reference at
+// the witness's eye position v0 + t (v1 - v0) and animation time tau. A witness holds when the
+// reference's first hit is its primitive, or when its primitive lies within eps_z of the first
+// hit's depth (a coplanar tie, CoplanarRule::Both); ambiguous references are skipped.
+WitnessCounts recast_witnesses(const Scene& s, const SegmentResult& r, Vec3 v0, Vec3 v1,
+                               const SegmentOptions& o) {
+  WitnessCounts c;
+  for (const Witness& w : r.witnesses) {
+    ++c.witnesses;
+    uint32_t id = w.is_sphere ? uint32_t(s.triangle_count() + w.tri) : w.tri;
+    Vec3 eye = lerp(v0, v1, w.t),
+         d = pixel_direction(face_axes(w.face, o.orientation), w.x, w.y, o.resolution);
+    RefHit ref = reference(s, w.tau, eye, d, o.near);
+    if (ref.id == id) continue;
+    if (ref.ambiguous) {
+      ++c.ambiguous;
+      continue;
+    }
+    if (o.coplanar == CoplanarRule::Both && ref.id != kNoHit) {
+      double mine = depth_of(s, id, w.tau, eye, d, o.near),
+             front = depth_of(s, ref.id, w.tau, eye, d, o.near);
+      if (std::fabs(mine - front) <= 2 * o.eps_z * front) continue;
+    }
+    ++c.failures;
+    if (c.first.empty())
+      c.first = std::string(w.is_sphere ? "sphere " : "triangle ") + std::to_string(w.tri) +
+                " face " + std::to_string(w.face) + " x " + std::to_string(w.x) + " y " +
+                std::to_string(w.y) + " t " + std::to_string(w.t) + " tau " +
+                std::to_string(w.tau) + ": reference " + std::to_string(int(ref.id));
+  }
+  return c;
+}
+
+// Dense overlapping moving spheres around a segment that passes through several of them.
+Scene dense_spheres(int count, double extent, uint64_t seed) {
+  Rng rng(seed);
+  Scene s;
+  const int K = 4;
+  s.sphere_centers.resize(K);
+  for (int i = 0; i < count; ++i) {
+    double r = rng.uniform(0.6, 1.8);
+    Vec3 c{rng.uniform(-extent, extent), rng.uniform(-2, 2), rng.uniform(-extent, extent)};
+    Vec3 v{rng.uniform(-1.5, 1.5), rng.uniform(-0.5, 0.5), rng.uniform(-1.5, 1.5)};
+    for (int k = 0; k < K; ++k) s.sphere_centers[k].push_back(c + v * double(k));
+    s.sphere_radius.push_back(r);
+    s.sphere_object.push_back(uint32_t(i));
+    s.objects.push_back({"sphere" + std::to_string(i)});
+  }
+  return s;
+}
+
+}  // namespace
+
+// Issue 12 item 1. With the eye inside overlapping spheres, a sphere's pixel list holds touching
+// pieces of the same sphere on its entry root and then on its exit root; joining them by id alone
+// kept the entry depth over both, so a sphere behind another's exit surface won (witness of sphere
+// 0 in the repro at t = 0.7162, face 1, pixel (15, 31), where sphere 1's exit lies in front).
+TEST(DynamicVisibility, WitnessesOfOverlappingSpheresAroundTheEyeRecastToTheirSphere) {
+  Scene s = dense_spheres(220, 7, 21);
+  const Vec3 v0{-6, 0.3, -5}, v1{6, -0.2, 5.5};
+  // The segment must run inside several spheres at once somewhere, or the test means nothing.
+  int most_inside = 0;
+  for (int k = 0; k <= 100; ++k) {
+    double t = k / 100.0;
+    int inside = 0;
+    for (size_t i = 0; i < s.sphere_count(); ++i)
+      inside += length(lerp(v0, v1, t) - s.sphere_center_at(uint32_t(i), t)) < s.sphere_radius[i];
+    most_inside = std::max(most_inside, inside);
+  }
+  EXPECT_GE(most_inside, 3);
+  for (DynamicMode mode : {DynamicMode::Diagonal, DynamicMode::Decoupled}) {
+    SegmentOptions o;
+    o.resolution = 40;
+    o.orientation = random_orientation(12);
+    o.want_witnesses = true;
+    o.mode = mode;
+    SegmentResult r = dynamic_segment_visibility(s, v0, v1, o);
+    WitnessCounts c = recast_witnesses(s, r, v0, v1, o);
+    const char* name = mode == DynamicMode::Diagonal ? "diagonal" : "decoupled";
+    EXPECT_GT(c.witnesses, 50u) << name;
+    EXPECT_EQ(c.failures, 0u) << name << ": " << c.first;
+    EXPECT_LE(c.ambiguous, c.witnesses / 100 + 2) << name;
+    std::printf(
+        "[sphere witnesses] %s: %zu witnesses, %zu ambiguous, %zu failures (eye inside up to %d "
+        "spheres)\n",
+        name, c.witnesses, c.ambiguous, c.failures, most_inside);
+  }
+}
+
+TEST(DynamicVisibility, EyeInsideOverlappingSpheresReproHasOnlyTrueWitnesses) {
+  VISLIB_REQUIRE_SHARED(shared);
+  Scene s = load_scene(shared + "/repros/eye-inside-overlapping-spheres.spheres");
+  const Vec3 v0{7.6, 4.6, 2.8}, v1{-5, 1.7, -3};
+  for (DynamicMode mode : {DynamicMode::Diagonal, DynamicMode::Decoupled}) {
+    SegmentOptions o;
+    o.resolution = 32;
+    o.want_witnesses = true;
+    o.mode = mode;
+    SegmentResult r = dynamic_segment_visibility(s, v0, v1, o);
+    WitnessCounts c = recast_witnesses(s, r, v0, v1, o);
+    EXPECT_EQ(c.failures, 0u) << c.first;
+    EXPECT_GT(c.witnesses, 0u);
+  }
+}
+
+// The 300-sphere scene of the issue (generate spheres --count 300 --radius 1.5 --area 40 --states 6
+// --max-height 6 --speed 4, the repro's segment): 5 of 136 (diagonal) and 5 of 295 (decoupled)
+// witnesses failed before the fix.
+TEST(DynamicVisibility, GeneratedThreeHundredSpheresHaveOnlyTrueWitnesses) {
+  SphereOptions so;
+  so.count = 300;
+  so.radius = 1.5;
+  so.area = 40;
+  so.states = 6;
+  so.max_height = 6;
+  so.speed = 4;
+  Scene s = generate_spheres(so);
+  const Vec3 v0{7.6, 4.6, 2.8}, v1{-5, 1.7, -3};
+  for (DynamicMode mode : {DynamicMode::Diagonal, DynamicMode::Decoupled}) {
+    SegmentOptions o;
+    o.resolution = 32;
+    o.want_witnesses = true;
+    o.mode = mode;
+    SegmentResult r = dynamic_segment_visibility(s, v0, v1, o);
+    WitnessCounts c = recast_witnesses(s, r, v0, v1, o);
+    EXPECT_EQ(c.failures, 0u) << c.first;
+    std::printf("[300 spheres] %s: %zu witnesses, %zu ambiguous, %zu failures\n",
+                mode == DynamicMode::Diagonal ? "diagonal" : "decoupled", c.witnesses, c.ambiguous,
+                c.failures);
+  }
+}
+
+// Issue 12 item 3: the decoupled mode checked like the diagonal one, at random (eye position s,
+// animation time tau) pairs on moving triangles and spheres. Pairs on what the mode computes (the
+// diagonal s = tau, the eye fixed at either end while the scene animates, the scene frozen at a
+// key state while the eye moves): every unambiguous first hit of every pixel is in the set.
+// Witnesses re-cast to their primitive. Pairs inside the (s, tau) square, which the mode
+// approximates by its boundary (docs/visibility.md), are measured: a first hit outside the set is
+// allowed there, at most 2% of the rays.
+TEST(DynamicVisibility, DecoupledModeHoldsEveryFirstHitOnItsRunsAndOnlyTrueWitnesses) {
+  Scene s = moving_soup(160, 3, 31, 6, 1.2, 1.5);
+  Scene balls = dense_spheres(40, 6, 32);
+  balls.sphere_centers.resize(3);  // three key states, as the soup
+  append_scene(s, balls);
+  const Vec3 v0{-1.5, 0.2, -1}, v1{1.5, -0.3, 1.2};
+  SegmentOptions o;
+  o.resolution = 32;
+  o.orientation = random_orientation(14);
+  o.want_witnesses = true;
+  o.mode = DynamicMode::Decoupled;
+  SegmentResult r = dynamic_segment_visibility(s, v0, v1, o);
+  std::vector<uint8_t> in_set(s.triangle_count() + s.sphere_count(), 0);
+  for (uint32_t t : r.visible) in_set[t] = 1;
+  for (uint32_t k : r.visible_spheres) in_set[s.triangle_count() + k] = 1;
+  const int K = int(s.state_count()), n = o.resolution;
+  Rng rng(15);
+  struct Pair {
+    double s, tau;
+    bool on_runs;
+  };
+  std::vector<Pair> pairs;
+  for (int k = 0; k < 6; ++k) {
+    double u = rng.uniform();
+    pairs.push_back({u, u, true});                // diagonal
+    pairs.push_back({0.0, rng.uniform(), true});  // eye at v0
+    pairs.push_back({1.0, rng.uniform(), true});  // eye at v1
+    pairs.push_back(
+        {rng.uniform(), std::min(K - 1, int(rng.uniform() * K)) / double(K - 1), true});  // frozen
+    pairs.push_back({rng.uniform(), rng.uniform(), false});  // inside the square
+    pairs.push_back({rng.uniform(), rng.uniform(), false});
+  }
+  std::atomic<uint64_t> rays{0}, ambiguous{0}, misses{0}, inner_rays{0}, inner_out{0};
+  std::string first;
+  std::mutex mu;
+  for (const Pair& pr : pairs) {
+    const Vec3 eye = lerp(v0, v1, pr.s);
+    tbb::parallel_for(size_t(0), size_t(6) * n * n, [&](size_t p) {
+      int face = int(p / (size_t(n) * n)), y = int(p / n % n), x = int(p % n);
+      RefHit ref = reference(s, pr.tau, eye,
+                             pixel_direction(face_axes(face, o.orientation), x, y, n), o.near);
+      if (ref.id == kNoHit) return;
+      if (!pr.on_runs) {
+        ++inner_rays;
+        if (!ref.ambiguous && !in_set[ref.id]) ++inner_out;
+        return;
+      }
+      ++rays;
+      if (in_set[ref.id]) return;
+      if (ref.ambiguous) {
+        ++ambiguous;
+        return;
+      }
+      ++misses;
+      std::lock_guard<std::mutex> g(mu);
+      if (first.empty())
+        first = "miss at s " + std::to_string(pr.s) + " tau " + std::to_string(pr.tau) + " face " +
+                std::to_string(face) + " x " + std::to_string(x) + " y " + std::to_string(y) +
+                ": reference " + std::to_string(int(ref.id));
+    });
+  }
+  EXPECT_GT(rays.load(), 10000u);
+  EXPECT_EQ(misses.load(), 0u) << first;
+  EXPECT_LT(double(ambiguous.load()), 0.01 * double(rays.load()));
+  EXPECT_LT(double(inner_out.load()), 0.02 * double(inner_rays.load()));
+  WitnessCounts c = recast_witnesses(s, r, v0, v1, o);
+  EXPECT_EQ(c.failures, 0u) << c.first;
+  EXPECT_GT(c.witnesses, 50u);
+  std::printf(
+      "[decoupled oracle] %zu ids; on its runs: %llu rays, %llu ambiguous, %llu misses; inside the "
+      "square: %llu "
+      "rays, %llu first hits outside the set; witnesses %zu (%zu ambiguous, %zu failures)\n",
+      r.visible.size() + r.visible_spheres.size(), (unsigned long long)rays.load(),
+      (unsigned long long)ambiguous.load(), (unsigned long long)misses.load(),
+      (unsigned long long)inner_rays.load(), (unsigned long long)inner_out.load(), c.witnesses,
+      c.ambiguous, c.failures);
+}

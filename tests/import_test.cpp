@@ -1,5 +1,7 @@
 // Tests of vislib::load_scene (import.h) and scene_info (scene_info.h) on tiny files made on the
 // fly, and on the shared real scenes (skipped when ../shared is absent).
+#include "vislib/scene/import.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 #include "tests/import_test_files.h"
 #include "tests/test_support.h"
 #include "vislib/base/error.h"
-#include "vislib/scene/import.h"
 #include "vislib/scene/scene_info.h"
 
 using namespace vislib;
@@ -187,10 +188,12 @@ TEST(ImportGltf, NodeHierarchyComposesTransformsInOrder) {
   // root: translate (10,0,0); child: rotate 90 deg about z, scale 2; grandchild has the mesh and
   // a matrix translating by (0,0,5).
   double h = std::sqrt(0.5);
-  g.nodes = json::array({{{"name", "root"}, {"translation", {10, 0, 0}}, {"children", {1}}},
-                         {{"name", "mid"}, {"rotation", {0, 0, h, h}}, {"scale", {2, 2, 2}}, {"children", {2}}},
-                         {{"name", "leaf"}, {"mesh", 0},
-                          {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1}}}});
+  g.nodes = json::array(
+      {{{"name", "root"}, {"translation", {10, 0, 0}}, {"children", {1}}},
+       {{"name", "mid"}, {"rotation", {0, 0, h, h}}, {"scale", {2, 2, 2}}, {"children", {2}}},
+       {{"name", "leaf"},
+        {"mesh", 0},
+        {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1}}}});
   g.scene_nodes = {0};
   Scene s = load(write_gltf(dir + "/h.gltf", g));
   ASSERT_EQ(s.objects.size(), 1u);
@@ -247,7 +250,8 @@ TEST(ImportGltf, BadInputsThrowInputErrorNamingTheProblem) {
   } cases[] = {
       {"bad_accessor", [](GltfSpec& g) { g.position_accessor = 7; }, "accessor 7"},
       {"bad_view", [](GltfSpec& g) { g.view_length_extra = 400; }, "bufferView 0"},
-      {"index_range", [](GltfSpec& g) { g.indices = {0, 1, 9, 0, 1, 12}; }, "2 indices out of range"},
+      {"index_range", [](GltfSpec& g) { g.indices = {0, 1, 9, 0, 1, 12}; },
+       "2 indices out of range"},
       {"nan", [](GltfSpec& g) { g.positions[4] = NAN; }, "vertex 1 is not finite"},
       {"bad_component", [](GltfSpec& g) { g.position_component_type = 5124; }, "accessor 0"},
       {"count_overflow", [](GltfSpec& g) { g.position_count_override = 1000; }, "accessor 0"},
@@ -262,7 +266,8 @@ TEST(ImportGltf, BadInputsThrowInputErrorNamingTheProblem) {
       load(path);
       ADD_FAILURE() << c.name << ": no error";
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos) << c.name << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.expect), std::string::npos)
+          << c.name << ": " << e.what();
       EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
     }
   }
@@ -304,12 +309,42 @@ TEST(ImportSpheres, ReadsStatesAndNamesSpheres) {
 
 TEST(ImportSpheres, MalformedLineNamesTheLineNumber) {
   std::string dir = temp_dir("spheres_bad");
-  std::string path = write_text(dir + "/s.spheres", "vislib-spheres 1\nstates 2\n0.5 0 0 0 0 1 0\n1 2 3\n");
+  std::string path =
+      write_text(dir + "/s.spheres", "vislib-spheres 1\nstates 2\n0.5 0 0 0 0 1 0\n1 2 3\n");
   try {
     load(path);
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("line 4"), std::string::npos) << e.what();
+  }
+}
+
+// Issue 12 item 6: a `mesh` line adds a static mesh before the spheres (triangles first, then
+// spheres); a bad mesh line names the sphere file and its line.
+TEST(ImportSpheres, MeshLineAddsAGroundBeforeTheSpheres) {
+  std::string dir = temp_dir("spheres_mesh");
+  write_text(dir + "/ground.obj",
+             "o ground\nv -9 0 -9\nv 9 0 -9\nv 9 0 9\nv -9 0 9\nf 1 3 2\nf 1 4 3\n");
+  std::string path = write_text(dir + "/s.spheres",
+                                "vislib-spheres 1\nstates 2\nmesh ground.obj\n0.5 0 1 0 0 2 0\n");
+  Scene s = load(path);
+  EXPECT_EQ(s.triangle_count(), 2u);
+  ASSERT_EQ(s.sphere_count(), 1u);
+  EXPECT_EQ(s.state_count(), 2u);
+  EXPECT_EQ(s.objects.size(), 2u);
+  EXPECT_EQ(s.objects[s.sphere_object[0]].name, "sphere0");
+  EXPECT_EQ(s.sphere_center_at(0, 1.0), (Vec3{0, 2, 0}));
+  EXPECT_EQ(s.position_at(s.triangles[0][0], 1.0), (Vec3{-9, 0, -9}));
+  for (const char* bad : {"mesh missing.obj", "mesh a b", "mesh s.spheres"}) {
+    std::string p2 =
+        write_text(dir + "/bad.spheres", std::string("vislib-spheres 1\nstates 2\n") + bad + "\n");
+    try {
+      load(p2);
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.spheres"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+    }
   }
 }
 
@@ -333,16 +368,16 @@ TEST(SceneInfo, CountsDuplicatesNonFiniteAndOutOfRange) {
   EXPECT_EQ(info.out_of_range_indices, 1u);
   EXPECT_EQ(info.degenerate_triangles, 1u);  // (0,1,3): zero area
   json j = json::parse(to_json(info));
-  for (const char* key : {"triangles", "objects", "states", "spheres", "bbox", "degenerate_triangles",
-                          "nonfinite_vertices", "duplicate_vertices", "out_of_range_indices",
-                          "units_guess"})
+  for (const char* key : {"triangles", "objects", "states", "spheres", "bbox",
+                          "degenerate_triangles", "nonfinite_vertices", "duplicate_vertices",
+                          "out_of_range_indices", "origin_offset", "far_from_origin"})
     EXPECT_TRUE(j.contains(key)) << key;
 }
 
-TEST(ImportMesh, OffThroughOpenMeshKeepsFaceOrder) {
+TEST(ImportMesh, OffKeepsFaceOrder) {
   std::string dir = temp_dir("off_ok");
-  std::string path = write_text(dir + "/q.off",
-                                "OFF\n5 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n3 0 1 2\n4 1 3 4 2\n");
+  std::string path = write_text(
+      dir + "/q.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n2 2 0\n3 0 1 2\n4 1 3 4 2\n");
   Scene s = load(path);
   ASSERT_EQ(s.triangle_count(), 3u);  // the quad is fan-triangulated
   EXPECT_EQ(s.objects.size(), 1u);

@@ -135,3 +135,25 @@ TEST(Metrics, CompareSetsCountsMissedAndExtraTriangles) {
   EXPECT_EQ(c.extra, 2u);   // 1 9
   EXPECT_EQ(compare_sets({}, reference).missed, 6u);
 }
+
+// Whole-image SSIM (CloVR's visual continuity): one window over all pixels. Two half-black,
+// half-white images whose halves are swapped: means equal (127.5), variances equal (127.5^2),
+// covariance -127.5^2: the luminance term is 1 and the structure term
+// is (2 cov + C2) / (2 var + C2) (negative).
+TEST(Metrics, WholeImageSsimUsesTheStatisticsOfAllPixels) {
+  const int w = 24, h = 12;
+  std::vector<uint8_t> a(3 * w * h), b(3 * w * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        a[3 * (y * w + x) + c] = x < w / 2 ? 0 : 255;
+        b[3 * (y * w + x) + c] = x < w / 2 ? 255 : 0;
+      }
+  const double c1 = (0.01 * 255) * (0.01 * 255), c2 = (0.03 * 255) * (0.03 * 255);
+  // Y = (0.299 + 0.587 + 0.114) * 255 up to the rounding of the weights.
+  const double m = 127.5, v = 127.5 * 127.5;
+  const double expected = ((2 * m * m + c1) * (-2 * v + c2)) / ((2 * m * m + c1) * (2 * v + c2));
+  EXPECT_NEAR(ssim_whole_image(w, h, a, b), expected, 1e-9);
+  EXPECT_EQ(ssim_whole_image(w, h, a, a), 1.0);
+  EXPECT_DOUBLE_EQ(ssim_whole_image(w, h, a, b), ssim_whole_image(w, h, b, a));
+}

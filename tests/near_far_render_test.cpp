@@ -257,3 +257,32 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
 }
 
 }  // namespace
+
+// CloVR's Eq. 2 counts footprints (pixels of an object anywhere), capped at the truth's, weighted
+// by footprint; the per-object mean of per-pixel agreement (ofc) does not. A 4 x 1 frame: truth
+// shows object 0 on 3 pixels and object 1 on 1 pixel; the test shows object 0 shifted by one
+// pixel (3 pixels, 2 in place) and object 1 not at all; then object 0 over all 4 pixels.
+TEST(NearFarRender, ObjectFootprintCompletionFollowsClovrEquation2) {
+  vislib::Scene s;
+  vislib_test::add_quad(s, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});  // triangles 0, 1: object 0
+  vislib_test::add_quad(s, {2, 0, 0}, {3, 0, 0}, {3, 1, 0}, {2, 1, 0});  // triangles 2, 3: object 1
+  auto frame = [](std::vector<uint32_t> tri) {
+    vislib::Frame f;
+    f.width = int(tri.size());
+    f.height = 1;
+    f.tri = tri;
+    f.rgb.assign(3 * tri.size(), 0);
+    f.depth.assign(tri.size(), 1.0f);
+    return f;
+  };
+  const uint32_t none = vislib::kNoHit;
+  const vislib::Frame truth = frame({0, 1, 0, 2});
+  // Object 0 drawn on pixels 1..3 (2 of its 3 truth pixels), object 1 missing.
+  vislib::ObjectCompletion c = vislib::object_completion(s, truth, frame({none, 0, 1, 0}));
+  EXPECT_DOUBLE_EQ(c.ofc, (2.0 / 3.0 + 0.0) / 2.0);
+  EXPECT_DOUBLE_EQ(c.ofc_eq2, (3.0 + 0.0) / 4.0);  // min(3, 3) + min(0, 1) over 3 + 1
+  // Object 0 grown over object 1's pixel: capped at its truth footprint.
+  c = vislib::object_completion(s, truth, frame({0, 0, 0, 1}));
+  EXPECT_DOUBLE_EQ(c.ofc_eq2, 3.0 / 4.0);
+  EXPECT_DOUBLE_EQ(c.ofc, (1.0 + 0.0) / 2.0);
+}

@@ -4,10 +4,12 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -24,7 +26,8 @@ namespace {
 constexpr uint64_t kScene = 0x1234abcd5678ef00ull;
 
 std::string temp_dir(const std::string& name) {
-  fs::path d = fs::temp_directory_path() / ("vislib_runtime_test_" + std::to_string(getpid())) / name;
+  fs::path d =
+      fs::temp_directory_path() / ("vislib_runtime_test_" + std::to_string(getpid())) / name;
   fs::remove_all(d);
   fs::create_directories(d);
   return d.string();
@@ -68,7 +71,8 @@ std::vector<uint32_t> brute_neighbours(const pvs::CellLayout& l, uint32_t cell, 
     if (c == cell) continue;
     pvs::Box b = l.cell_box(c);
     bool touch = true;
-    for (int k = 0; k < 3; ++k) touch = touch && b.min[k] <= me.max[k] + margin && me.min[k] - margin <= b.max[k];
+    for (int k = 0; k < 3; ++k)
+      touch = touch && b.min[k] <= me.max[k] + margin && me.min[k] - margin <= b.max[k];
     if (touch) out.push_back(c);
   }
   return out;
@@ -106,7 +110,8 @@ TEST(Runtime, GridNeighboursAreTheCellsThatTouchOrComeWithinTheMargin) {
   // Corner cell 0: 3 neighbours along x/y/z, 3 across edges, 1 across the corner.
   EXPECT_EQ(p.neighbours(0), (std::vector<uint32_t>{1, 4, 5, 8, 9, 12, 13}));
   for (double margin : {0.0, 1.0, 2.5})
-    for (uint32_t c = 0; c < 24; ++c) EXPECT_EQ(p.neighbours(c, margin), brute_neighbours(g.info.layout, c, margin)) << c;
+    for (uint32_t c = 0; c < 24; ++c)
+      EXPECT_EQ(p.neighbours(c, margin), brute_neighbours(g.info.layout, c, margin)) << c;
 }
 
 TEST(Runtime, BoxListLookupAndNeighboursMatchALinearScan) {
@@ -137,7 +142,8 @@ TEST(Runtime, BoxListLookupAndNeighboursMatchALinearScan) {
     found += bool(expect);
   }
   EXPECT_GT(found, 100);  // the sample does land in cells
-  for (uint32_t c = 0; c < 500; ++c) ASSERT_EQ(p.neighbours(c, 1.0), brute_neighbours(info.layout, c, 1.0)) << c;
+  for (uint32_t c = 0; c < 500; ++c)
+    ASSERT_EQ(p.neighbours(c, 1.0), brute_neighbours(info.layout, c, 1.0)) << c;
 }
 
 TEST(Runtime, RejectsAPvsOfAnotherScene) {
@@ -178,7 +184,8 @@ TEST(Runtime, RejectsCorruptAndTruncatedFilesWithTheByteOffset) {
   hdr[33] = char(hdr[33] ^ 1);
   write_file(dir + "/header.pvs", hdr);
   write_file(dir + "/truncated.pvs", g.bytes.substr(0, g.bytes.size() - 3));
-  write_file(dir + "/text.pvs", "hello, this is not a PVS file at all, just some text bytes for the test");
+  write_file(dir + "/text.pvs",
+             "hello, this is not a PVS file at all, just some text bytes for the test");
   write_file(dir + "/empty.pvs", "");
   struct Case {
     const char* file;
@@ -190,7 +197,8 @@ TEST(Runtime, RejectsCorruptAndTruncatedFilesWithTheByteOffset) {
       Pvs::open(dir + "/" + c.file);
       FAIL() << c.file << " opened";
     } catch (const pvs::FormatError& e) {
-      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos) << c.file << ": " << e.what();
+      EXPECT_NE(std::string(e.what()).find(c.message), std::string::npos)
+          << c.file << ": " << e.what();
     }
   }
 }
@@ -212,13 +220,15 @@ TEST(RuntimeC, FingerprintMismatchAndCorruptFileReturnCodesAndMessages) {
   pvs_rt* h = reinterpret_cast<pvs_rt*>(1);
   EXPECT_EQ(pvs_rt_open((dir + "/ok.pvs").c_str(), 1, kScene ^ 0xff, &h), PVS_RT_FINGERPRINT);
   EXPECT_EQ(h, nullptr);
-  EXPECT_NE(std::string(pvs_rt_last_error()).find("baked for another scene"), std::string::npos) << pvs_rt_last_error();
+  EXPECT_NE(std::string(pvs_rt_last_error()).find("baked for another scene"), std::string::npos)
+      << pvs_rt_last_error();
 
   std::string bad = g.bytes;
   bad[70] = char(bad[70] ^ 0x10);  // inside the layout section
   write_file(dir + "/bad.pvs", bad);
   EXPECT_EQ(pvs_rt_open((dir + "/bad.pvs").c_str(), 1, kScene, &h), PVS_RT_FORMAT);
-  EXPECT_NE(std::string(pvs_rt_last_error()).find("layout section checksum mismatch"), std::string::npos)
+  EXPECT_NE(std::string(pvs_rt_last_error()).find("layout section checksum mismatch"),
+            std::string::npos)
       << pvs_rt_last_error();
 
   EXPECT_EQ(pvs_rt_open((dir + "/missing.pvs").c_str(), 0, 0, &h), PVS_RT_IO);
@@ -231,7 +241,8 @@ TEST(RuntimeC, EngineCallsReturnIdsNeighboursAndReportShortBuffers) {
   const GridFile g = make_grid_file();
   write_file(dir + "/ok.pvs", g.bytes);
   pvs_rt* h = nullptr;
-  ASSERT_EQ(pvs_rt_open((dir + "/ok.pvs").c_str(), 1, kScene, &h), PVS_RT_OK) << pvs_rt_last_error();
+  ASSERT_EQ(pvs_rt_open((dir + "/ok.pvs").c_str(), 1, kScene, &h), PVS_RT_OK)
+      << pvs_rt_last_error();
   pvs_rt_info info;
   ASSERT_EQ(pvs_rt_get_info(h, &info), PVS_RT_OK);
   EXPECT_EQ(info.cell_count, 24u);
@@ -269,9 +280,12 @@ TEST(RuntimeC, EngineCallsReturnIdsNeighboursAndReportShortBuffers) {
 TEST(Runtime, LooksUpCellsOfABakedCity) {
   const std::string dir = temp_dir("city");
   const std::string pvs_exe = VISLIB_PVS_EXE;
-  auto run = [](const std::string& cmd) { return std::system((cmd + " > /dev/null 2>&1").c_str()); };
+  auto run = [](const std::string& cmd) {
+    return std::system((cmd + " > /dev/null 2>&1").c_str());
+  };
   ASSERT_EQ(run(pvs_exe + " generate city --blocks 2,2 -o " + dir + "/city.glb"), 0);
-  ASSERT_EQ(run(pvs_exe + " bake " + dir + "/city.glb --box 0,0,0,40,3,40 --grid 3,1,3 --eye-height 1.5,1.8" +
+  ASSERT_EQ(run(pvs_exe + " bake " + dir +
+                "/city.glb --box 0,0,0,40,3,40 --grid 3,1,3 --eye-height 1.5,1.8" +
                 " --res 32 --threads 1 -o " + dir + "/city.pvs"),
             0);
   pvs::Reader reader = pvs::Reader::from_file(dir + "/city.pvs");
@@ -284,7 +298,8 @@ TEST(Runtime, LooksUpCellsOfABakedCity) {
   size_t total = 0;
   for (uint32_t c = 0; c < 9; ++c) {
     pvs::Box b = p.info().layout.cell_box(c);
-    double centre[3] = {(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2, (b.min[2] + b.max[2]) / 2};
+    double centre[3] = {(b.min[0] + b.max[0]) / 2, (b.min[1] + b.max[1]) / 2,
+                        (b.min[2] + b.max[2]) / 2};
     EXPECT_EQ(p.find_cell(centre), std::optional<uint32_t>(c));
     EXPECT_EQ(p.visible_ids(c), reader.read_cell(c));
     EXPECT_EQ(p.neighbours(c), brute_neighbours(p.info().layout, c, 0.0));
@@ -296,6 +311,96 @@ TEST(Runtime, LooksUpCellsOfABakedCity) {
 
   char fp_hex[17];
   std::snprintf(fp_hex, sizeof fp_hex, "%016llx", static_cast<unsigned long long>(fp));
-  EXPECT_EQ(run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs " + fp_hex + " --frames 50"), 0);
+  EXPECT_EQ(
+      run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs " + fp_hex + " --frames 50"),
+      0);
   EXPECT_NE(run(std::string(VISLIB_ENGINE_LOOP_EXE) + " " + dir + "/city.pvs 0123 --frames 50"), 0);
+}
+
+namespace {
+
+// A small box-list file: 40 random boxes (the layout whose lookup converts coordinates to bucket
+// indices).
+std::string box_list_file(const std::string& dir) {
+  pvs::FileInfo info;
+  info.scene_fingerprint = kScene;
+  info.universe = 10;
+  info.layout.kind = pvs::LayoutKind::Boxes;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> pos(-20, 20), side(0.5, 4);
+  for (int i = 0; i < 40; ++i) {
+    pvs::Box b;
+    for (int k = 0; k < 3; ++k) {
+      b.min[k] = pos(rng);
+      b.max[k] = b.min[k] + side(rng);
+    }
+    info.layout.boxes.push_back(b);
+  }
+  std::string path = dir + "/boxes.pvs";
+  write_file(path, pvs::write_pvs(info, std::vector<pvs::CellSet>(40, std::vector<uint32_t>{2})));
+  return path;
+}
+
+}  // namespace
+
+// NaN and infinite positions are rejected before any conversion (UBSan flagged the cast of NaN to
+// int in the box-list bucket lookup); huge finite ones are simply outside every cell.
+TEST(RuntimeC, FindCellRejectsNonFinitePositionsOnBothLayouts) {
+  std::string dir = temp_dir("c_nonfinite");
+  write_file(dir + "/grid.pvs", make_grid_file().bytes);
+  for (std::string path : {dir + "/grid.pvs", box_list_file(dir)}) {
+    pvs_rt* h = nullptr;
+    ASSERT_EQ(pvs_rt_open(path.c_str(), 0, 0, &h), PVS_RT_OK) << pvs_rt_last_error();
+    const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
+    uint32_t cell = 77;
+    for (double bad : {nan, inf, -inf}) {
+      for (int k = 0; k < 3; ++k) {
+        double p[3] = {1, 1, 1};
+        p[k] = bad;
+        EXPECT_EQ(pvs_rt_find_cell(h, p, &cell), PVS_RT_INVALID_ARGUMENT) << path << " axis " << k;
+        EXPECT_NE(std::string(pvs_rt_last_error()).find("not finite"), std::string::npos);
+      }
+    }
+    for (double far : {1e300, -1e300, 3e9}) {
+      double p[3] = {far, far, far};
+      EXPECT_EQ(pvs_rt_find_cell(h, p, &cell), PVS_RT_NOT_FOUND) << path;
+    }
+    EXPECT_EQ(cell, 77u);
+    pvs_rt_close(h);
+  }
+}
+
+TEST(RuntimeC, InfiniteMarginMakesEveryOtherCellANeighbour) {
+  std::string dir = temp_dir("c_inf_margin");
+  write_file(dir + "/grid.pvs", make_grid_file().bytes);
+  for (std::string path : {dir + "/grid.pvs", box_list_file(dir)}) {
+    pvs_rt* h = nullptr;
+    ASSERT_EQ(pvs_rt_open(path.c_str(), 0, 0, &h), PVS_RT_OK) << pvs_rt_last_error();
+    pvs_rt_info info;
+    ASSERT_EQ(pvs_rt_get_info(h, &info), PVS_RT_OK);
+    std::vector<uint32_t> out(info.cell_count);
+    for (uint32_t c : {0u, 5u, info.cell_count - 1}) {
+      size_t count = 0;
+      ASSERT_EQ(pvs_rt_neighbours(h, c, std::numeric_limits<double>::infinity(), out.data(),
+                                  out.size(), &count),
+                PVS_RT_OK)
+          << pvs_rt_last_error();
+      ASSERT_EQ(count, size_t(info.cell_count - 1)) << path << " cell " << c;
+      for (uint32_t i = 0, k = 0; i < info.cell_count; ++i)
+        if (i != c) EXPECT_EQ(out[k++], i);
+      // A huge finite margin reaches every cell too; NaN is an invalid argument.
+      ASSERT_EQ(pvs_rt_neighbours(h, c, 1e308, out.data(), out.size(), &count), PVS_RT_OK);
+      EXPECT_EQ(count, size_t(info.cell_count - 1));
+      EXPECT_EQ(pvs_rt_neighbours(h, c, std::nan(""), out.data(), out.size(), &count),
+                PVS_RT_INVALID_ARGUMENT);
+    }
+    pvs_rt_close(h);
+  }
+}
+
+TEST(RuntimeC, StatusNameOfAnUnknownValueIsUnknown) {
+  EXPECT_STREQ(pvs_rt_status_name(PVS_RT_OK), "ok");
+  EXPECT_STREQ(pvs_rt_status_name(PVS_RT_INTERNAL), "internal");
+  for (int v : {-1, 10, 16, 1000, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()})
+    EXPECT_STREQ(pvs_rt_status_name(v), "unknown") << v;
 }

@@ -214,6 +214,68 @@ TEST(SegmentHardCases, H9_CoplanarDuplicatesGoToTheLowerIdAndACloserOffsetWins) 
   }
 }
 
+// H9 with the tie rule (issue 12 item 2): the list is the same as under the old rule, and the tie
+// records make both ids visible, for exact duplicates and for a 1e-12 offset; a 1e-3 offset is no
+// tie (eps_z = 1e-6 of the depth 5).
+TEST(SegmentHardCases, H9_CoplanarTiesWithinEpsZMakeBothTrianglesVisibleInEitherOrder) {
+  std::array<Vec3, 3> t{Vec3{-50, -50, 5}, {50, -50, 5}, {0, 50, 5}};
+  Vec3 v0{-1, 0, 0}, v1{1, 0, 0}, d{0, 0, 1};
+  Cov c = coverage(t, v0, v1, d);
+  for (double offset : {0.0, 1e-12, 1e-3}) {
+    std::array<Vec3, 3> moved = t;
+    for (auto& p : moved) p.z -= offset;
+    Cov c7 = coverage(moved, v0, v1, d);
+    for (int order = 0; order < 2; ++order) {
+      PieceList l;
+      std::vector<TieRecord> ties;
+      TieRule rule{kDefaultEpsZ, &ties};
+      if (order) {
+        insert_piece(l, Piece{c7.lo, c7.hi, 7, c7.depth}, rule);
+        insert_piece(l, Piece{c.lo, c.hi, 3, c.depth}, rule);
+      } else {
+        insert_piece(l, Piece{c.lo, c.hi, 3, c.depth}, rule);
+        insert_piece(l, Piece{c7.lo, c7.hi, 7, c7.depth}, rule);
+      }
+      ASSERT_EQ(l.size(), 1u);
+      EXPECT_EQ(l[0].id, offset == 0.0 ? 3u : 7u);
+      std::vector<uint32_t> seen;
+      for_each_visible(l, ties, [&](uint32_t id, double t0, double t1) {
+        EXPECT_EQ(t0, 0.0);
+        EXPECT_EQ(t1, 1.0);
+        seen.push_back(id);
+      });
+      std::sort(seen.begin(), seen.end());
+      if (offset < 1e-6)
+        EXPECT_EQ(seen, (std::vector<uint32_t>{3, 7})) << offset << " order " << order;
+      else
+        EXPECT_EQ(seen, (std::vector<uint32_t>{7})) << offset << " order " << order;
+    }
+  }
+}
+
+// Three exact coplanar copies inserted front copy first or last: each is visible (ties are
+// followed transitively), and a triangle in front of all three hides every one of them.
+TEST(SegmentHardCases, H9_ThreeCoplanarCopiesAreAllVisibleAndAllHiddenTogether) {
+  std::array<Vec3, 3> t{Vec3{-50, -50, 5}, {50, -50, 5}, {0, 50, 5}};
+  std::array<Vec3, 3> front{Vec3{-50, -50, 4}, {50, -50, 4}, {0, 50, 4}};
+  Vec3 v0{-1, 0, 0}, v1{1, 0, 0}, d{0, 0, 1};
+  Cov c = coverage(t, v0, v1, d), f = coverage(front, v0, v1, d);
+  for (auto ids : {std::vector<uint32_t>{2, 1, 0}, std::vector<uint32_t>{0, 1, 2},
+                   std::vector<uint32_t>{1, 2, 0}}) {
+    for (bool with_front : {false, true}) {
+      PieceList l;
+      std::vector<TieRecord> ties;
+      TieRule rule{kDefaultEpsZ, &ties};
+      if (with_front) insert_piece(l, Piece{f.lo, f.hi, 9, f.depth}, rule);
+      for (uint32_t id : ids) insert_piece(l, Piece{c.lo, c.hi, id, c.depth}, rule);
+      std::vector<uint32_t> seen;
+      for_each_visible(l, ties, [&](uint32_t id, double, double) { seen.push_back(id); });
+      std::sort(seen.begin(), seen.end());
+      EXPECT_EQ(seen, with_front ? std::vector<uint32_t>{9} : (std::vector<uint32_t>{0, 1, 2}));
+    }
+  }
+}
+
 namespace {
 using Q = CGAL::Gmpq;
 struct QV {

@@ -1,9 +1,8 @@
 // bake.cpp: parallel bake over view cells with checkpoint and shards (bake.h, docs/bake.md).
 #include "vislib/bake/bake.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_pipeline.h>
 
 #include <atomic>
 #include <cassert>
@@ -13,34 +12,38 @@
 #include <nlohmann/json.hpp>
 
 #include "vislib/bake/checkpoint.h"
+#include "vislib/bake/id_universe.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 namespace vislib {
 
-pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const BakeSettings& settings) {
+pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
+                             const BakeSettings& settings) {
   assert(scene.triangle_count() < 0xFFFFFFFFull && scene.objects.size() < 0xFFFFFFFFull);
   pvs::FileInfo info;
   info.scene_fingerprint = scene_fingerprint(scene);
-  info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object : pvs::Granularity::Triangle;
-  // Triangle granularity: triangle ids, then sphere s as triangle_count + s.
-  info.universe = uint32_t(settings.granularity == Granularity::Object ? scene.objects.size()
-                                                                        : scene.triangle_count() + scene.sphere_count());
+  info.granularity = settings.granularity == Granularity::Object ? pvs::Granularity::Object
+                                                                 : pvs::Granularity::Triangle;
+  info.universe = id_universe(scene, settings.granularity);  // the one id rule (bake/id_universe.h)
   info.layout = cells.layout;
   const SegmentOptions& s = settings.region.segment;
-  nlohmann::json m = {{"generator", "vislib pvs bake"},
-                      {"cells", nlohmann::json::parse(cells.description)},
-                      {"granularity", settings.granularity == Granularity::Object ? "object" : "triangle"},
-                      {"resolution", s.resolution},
-                      {"near", s.near},
-                      {"eps_len", s.eps_len},
-                      {"runs", settings.region.runs},
-                      {"seed", settings.region.seed},
-                      {"state", s.state},
-                      {"states", scene.state_count()},
-                      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
-                      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
+  nlohmann::json m = {
+      {"generator", "vislib pvs bake"},
+      {"cells", nlohmann::json::parse(cells.description)},
+      {"granularity", settings.granularity == Granularity::Object ? "object" : "triangle"},
+      {"resolution", s.resolution},
+      {"near", s.near},
+      {"eps_len", s.eps_len},
+      {"runs", settings.region.runs},
+      {"seed", settings.region.seed},
+      {"state", s.state},
+      {"states", scene.state_count()},
+      {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
+      {"coplanar", s.coplanar == CoplanarRule::First ? "first" : "both"},
+      {"eps_z", s.eps_z},
+      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
   info.metadata = m.dump();
   return info;
 }
@@ -60,15 +63,15 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
                                 const std::function<void(double)>& progress) {
   CellVisibility v = cell_visibility(scene, layout, cell, settings.region, progress);
   if (seconds) *seconds = v.seconds;
-  if (settings.granularity == Granularity::Object) return objects_of(scene, v.triangles, v.spheres);
-  std::vector<uint32_t> ids = std::move(v.triangles);
-  for (uint32_t s : v.spheres) ids.push_back(uint32_t(scene.triangle_count() + s));
-  return ids;
+  return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
-BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,
-                const BakeFiles& files, const BakeProgressFn& progress) {
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
+                Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
   assert(shard.count >= 1 && shard.index < shard.count);
+  std::unique_ptr<FileLock> lock;
+  if (files.lock)
+    lock = std::make_unique<FileLock>(files.output + ".lock", "the output " + files.output);
   pvs::FileInfo info = bake_file_info(scene, cells, settings);
   info.partial = shard.count > 1;
   const uint32_t n = info.layout.cell_count();
@@ -76,77 +79,105 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   report.cells = n;
   report.cell_seconds.assign(n, 0.0);
 
-  std::vector<pvs::CellSet> sets(n);
+  // Cells recovered from the checkpoint (resume); each is released once written.
+  std::vector<std::optional<std::vector<uint32_t>>> recovered;
   std::unique_ptr<Checkpoint> checkpoint;
   if (!files.checkpoint.empty()) {
-    std::vector<std::optional<std::vector<uint32_t>>> recovered;
-    checkpoint = std::make_unique<Checkpoint>(files.checkpoint, bake_key(info, shard), n, files.resume,
-                                              &recovered, info.universe);
+    checkpoint = std::make_unique<Checkpoint>(files.checkpoint, bake_key(info, shard), n,
+                                              files.resume, &recovered, info.universe);
+    report.checkpoint_dropped_records = checkpoint->dropped_records();
+    report.checkpoint_dropped_bytes = checkpoint->discarded_bytes();
     for (uint32_t c = 0; c < n; ++c)
-      if (recovered[c]) {
-        if (!in_shard(c, shard))
-          throw InputError(files.checkpoint, "holds cell " + std::to_string(c) + ", which is not in this shard");
-        sets[c] = std::move(recovered[c]);
-      }
+      if (recovered[c] && !in_shard(c, shard))
+        throw InputError(files.checkpoint,
+                         "holds cell " + std::to_string(c) + ", which is not in this shard");
   }
-  std::vector<uint32_t> pending;
+  if (recovered.empty()) recovered.resize(n);
   for (uint32_t c = 0; c < n; ++c) {
     if (!in_shard(c, shard)) continue;
     ++report.shard_cells;
-    if (sets[c])
-      ++report.resumed;
-    else
-      pending.push_back(c);
+    if (recovered[c]) ++report.resumed;
   }
 
+  // Streaming: cells are baked in parallel and written in cell order as soon as every earlier
+  // cell is written (a TBB pipeline whose last stage is serial and in order), so the memory held
+  // is the cells in flight (a bounded number of tokens) plus what pvs::StreamWriter keeps for
+  // delta references, whatever the cell count. The bytes are those of pvs::write_pvs.
+  AtomicFile out(files.output);
+  pvs::StreamWriter writer(
+      info, [&out](uint64_t offset, std::string_view bytes) { out.write_at(offset, bytes); });
   const auto start = std::chrono::steady_clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
   std::mutex progress_mutex;
   uint32_t done = report.resumed;
   std::vector<double> partial(n, 0.0);  // fraction of each running cell's runs done
   double running = 0;                   // their sum
   if (progress) progress({done, report.shard_cells, report.resumed, 0.0, 0.0});
+  const size_t threads =
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
+  const size_t tokens = 4 * std::max<size_t>(1, threads);
+  uint32_t next = 0;
   try {
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, pending.size(), 1),
-        [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t i = r.begin(); i != r.end(); ++i) {
-            uint32_t c = pending[i];
-            double seconds = 0;
-            std::function<void(double)> in_cell;
-            if (progress)
-              in_cell = [&, c](double fraction) {
-                std::lock_guard<std::mutex> lock(progress_mutex);
-                running += fraction - partial[c];
-                partial[c] = fraction;
-                progress(
-                    {done, report.shard_cells, report.resumed, elapsed(), std::max(0.0, running)});
-              };
-            std::vector<uint32_t> ids =
-                bake_cell(scene, info.layout, c, settings, &seconds, in_cell);
-            if (checkpoint) checkpoint->append(c, ids);
-            sets[c] = std::move(ids);
-            report.cell_seconds[c] = seconds;
-            std::lock_guard<std::mutex> lock(progress_mutex);
-            ++done;
-            running -= partial[c];
-            partial[c] = 0;
-            if (progress)
-              progress(
-                  {done, report.shard_cells, report.resumed, elapsed(), std::max(0.0, running)});
-          }
-        },
-        tbb::simple_partitioner());
+  tbb::parallel_pipeline(
+      tokens,
+      tbb::make_filter<void, uint32_t>(tbb::filter_mode::serial_in_order,
+                                       [&](tbb::flow_control& fc) -> uint32_t {
+                                         if (next >= n) {
+                                           fc.stop();
+                                           return 0;
+                                         }
+                                         return next++;
+                                       }) &
+          tbb::make_filter<uint32_t, std::shared_ptr<pvs::CellSet>>(
+              tbb::filter_mode::parallel,
+              [&](uint32_t c) {
+                auto set = std::make_shared<pvs::CellSet>();
+                if (!in_shard(c, shard)) return set;  // absent from this shard's file
+                if (recovered[c]) {
+                  *set = std::move(recovered[c]);
+                  recovered[c].reset();
+                  return set;
+                }
+                double seconds = 0;
+                std::function<void(double)> in_cell;  // progress inside the cell
+                if (progress)
+                  in_cell = [&, c](double fraction) {
+                    std::lock_guard<std::mutex> lock(progress_mutex);
+                    running += fraction - partial[c];
+                    partial[c] = fraction;
+                    progress({done, report.shard_cells, report.resumed, elapsed(),
+                              std::max(0.0, running)});
+                  };
+                std::vector<uint32_t> ids = with_memory_stage(
+                    "baking cell " + std::to_string(c) + " of " + std::to_string(n),
+                    [&] { return bake_cell(scene, info.layout, c, settings, &seconds, in_cell); });
+                if (checkpoint) checkpoint->append(c, ids);
+                *set = std::move(ids);
+                report.cell_seconds[c] = seconds;
+                std::lock_guard<std::mutex> guard(progress_mutex);
+                ++done;
+                ++report.baked;
+                running -= partial[c];
+                partial[c] = 0;
+                if (progress)
+                  progress({done, report.shard_cells, report.resumed, elapsed(),
+                            std::max(0.0, running)});
+                return set;
+              }) &
+          tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
+              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
+                with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
+              }));
   } catch (...) {
     // A bake that recorded nothing leaves no checkpoint behind (issue 17 item 1).
     if (checkpoint && done == 0) checkpoint->remove();
     throw;
   }
-  report.baked = uint32_t(pending.size());
   report.seconds = elapsed();
-
-  std::string bytes = pvs::write_pvs(info, sets, &report.stats);
-  write_file_atomic(files.output, bytes);
+  report.stats = writer.finish();
+  out.commit();
   if (checkpoint) checkpoint->remove();
   return report;
 }

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/view_cells.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/scene.h"
-#include "vislib/bake/view_cells.h"
 
 namespace vislib {
 
@@ -29,13 +29,16 @@ struct BakeSettings {
 struct Shard {
   uint32_t index = 0, count = 1;
 };
-inline bool in_shard(uint32_t cell, Shard shard) { return cell % shard.count == shard.index; }
+inline bool in_shard(uint32_t cell, Shard shard) {
+  return cell % shard.count == shard.index;
+}
 
 // What the file will hold besides the sets: scene_fingerprint(scene), the universe (triangle or
 // object count), granularity, the cells' layout, and metadata: a JSON object with the cells'
 // description and every setting the sets depend on (not the thread count, not the shard).
 // Precondition: the scene has fewer than 2^32 triangles.
-pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells, const BakeSettings& settings);
+pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
+                             const BakeSettings& settings);
 
 // Identifies a bake for its checkpoint: a digest of the file info and the shard.
 uint64_t bake_key(const pvs::FileInfo& info, Shard shard);
@@ -64,23 +67,34 @@ struct BakeFiles {
   std::string output;      // the PVS file (a partial file when sharded); written atomically
   std::string checkpoint;  // checkpoint file, "" for none; deleted once `output` is in place
   bool resume = false;     // continue from `checkpoint` if it exists
+  // Hold an exclusive lock on `output`.lock (FileLock, file_util.h) for the whole bake, so that a
+  // second bake of the same output is refused. false if the caller holds that lock already.
+  bool lock = true;
 };
 
 struct BakeReport {
-  uint32_t cells = 0;        // in the layout
-  uint32_t shard_cells = 0;  // in this shard
-  uint32_t resumed = 0;      // taken from the checkpoint
-  uint32_t baked = 0;        // computed in this run
+  uint32_t cells = 0;                // in the layout
+  uint32_t shard_cells = 0;          // in this shard
+  uint32_t resumed = 0;              // taken from the checkpoint
+  uint32_t baked = 0;                // computed in this run
   std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
-  double seconds = 0;        // wall time of this run's baking
-  pvs::WriteStats stats;     // sizes of the written file
+  double seconds = 0;                // wall time of this run's baking
+  pvs::WriteStats stats;             // sizes of the written file
+  // Damaged records skipped (and a torn tail) when the checkpoint was reopened, and their bytes.
+  size_t checkpoint_dropped_records = 0;
+  uint64_t checkpoint_dropped_bytes = 0;
 };
 
-// Bakes the cells of `shard` in parallel (TBB over cells; the kernel is parallel inside too),
-// records each finished cell in the checkpoint before counting it done, writes `files.output`
-// through a temporary file renamed into place, then deletes the checkpoint. Throws InputError for
-// a checkpoint of another bake, std::runtime_error on I/O failure (the checkpoint is kept).
-BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings, Shard shard,
-                const BakeFiles& files, const BakeProgressFn& progress = {});
+// Bakes the cells of `shard` in parallel (a TBB pipeline over cells; the kernel is parallel inside
+// too), records each finished cell in the checkpoint before counting it done, and streams the
+// blocks to a temporary file in cell order as cells finish (index and header patched at the end;
+// pvs::StreamWriter), renamed over `files.output` once complete; then deletes the checkpoint.
+// Memory: the cells in flight (4 per thread at most) and the delta references of StreamWriter,
+// plus O(cells) bytes of index and timings; not the sets of all cells (on resume, the recovered
+// cells are held until written). Throws InputError for a checkpoint of another bake or a bake
+// already running on the output or checkpoint (locks), std::runtime_error on I/O failure (the
+// checkpoint is kept).
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
+                Shard shard, const BakeFiles& files, const BakeProgressFn& progress = {});
 
 }  // namespace vislib

@@ -1,6 +1,8 @@
 // cell_set.cpp: a cell's visible set read back for its scene.
 #include "vislib/bake/cell_set.h"
 
+#include "vislib/bake/id_universe.h"
+
 namespace vislib {
 
 Granularity granularity_of(const pvs::FileInfo& info) {
@@ -8,8 +10,7 @@ Granularity granularity_of(const pvs::FileInfo& info) {
 }
 
 void check_universe(const std::string& path, const pvs::FileInfo& info, const Scene& scene) {
-  const size_t expect =
-      granularity_of(info) == Granularity::Object ? scene.objects.size() : scene.triangle_count();
+  const uint32_t expect = id_universe(scene, granularity_of(info));  // the bake's one id rule
   if (expect != info.universe)
     throw InputError(path, "universe " + std::to_string(info.universe) +
                                " differs from the scene's " + std::to_string(expect));
@@ -17,13 +18,7 @@ void check_universe(const std::string& path, const pvs::FileInfo& info, const Sc
 
 std::vector<uint32_t> visible_triangles(const Scene& scene, const std::vector<uint32_t>& ids,
                                         Granularity granularity) {
-  if (granularity == Granularity::Triangle) return ids;
-  std::vector<uint8_t> keep(scene.objects.size(), 0);
-  for (uint32_t o : ids) keep[o] = 1;
-  std::vector<uint32_t> tris;
-  for (uint32_t t = 0; t < scene.triangle_count(); ++t)
-    if (keep[scene.triangle_object[t]]) tris.push_back(t);
-  return tris;
+  return primitives_of(scene, granularity, ids).triangles;
 }
 
 Vec3 view_region_centre(const pvs::CellLayout& layout, uint32_t cell) {

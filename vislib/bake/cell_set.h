@@ -19,12 +19,13 @@ namespace vislib {
 // The granularity of a PVS file's ids.
 Granularity granularity_of(const pvs::FileInfo& info);
 
-// Throws InputError(path, ...) when the file's universe (objects or triangles, by its granularity)
-// is not the scene's count.
+// Throws InputError(path, ...) when the file's universe is not the scene's id_universe at the
+// file's granularity (bake/id_universe.h: triangles then spheres, or objects).
 void check_universe(const std::string& path, const pvs::FileInfo& info, const Scene& scene);
 
-// The triangles of a visible set: Triangle granularity: `ids` itself; Object: every triangle of
-// those objects, ascending. Ids must be < objects.size() (Object) or < triangle_count() (Triangle).
+// The triangles of a visible set (primitives_of(...).triangles, bake/id_universe.h): Triangle
+// granularity: the triangle ids among `ids` (sphere ids are left out); Object: every triangle of
+// those objects, ascending. Ids must be < id_universe(scene, granularity).
 std::vector<uint32_t> visible_triangles(const Scene& scene, const std::vector<uint32_t>& ids,
                                         Granularity granularity);
 

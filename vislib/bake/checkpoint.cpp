@@ -2,6 +2,7 @@
 #include "vislib/bake/checkpoint.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -60,61 +61,120 @@ void write_all(int fd, const std::string& bytes, const std::string& path) {
 }  // namespace
 
 Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_count, bool resume,
-                       std::vector<std::optional<std::vector<uint32_t>>>* recovered, uint32_t universe)
+                       std::vector<std::optional<std::vector<uint32_t>>>* recovered,
+                       uint32_t universe)
     : path_(path) {
   if (recovered) recovered->assign(cell_count, std::nullopt);
+  // Open without truncating and lock before reading or cutting anything: a second bake or resume
+  // on the same checkpoint must not touch the records of the one that holds it.
+  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd_ < 0) io_error(path, "cannot open the checkpoint");
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    int err = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (err == EWOULDBLOCK)
+      throw InputError(path,
+                       "the checkpoint is locked by another process (another pvs bake or resume of "
+                       "this bake is running); wait for it to finish or stop it");
+    errno = err;
+    io_error(path, "cannot lock the checkpoint");
+  }
   size_t keep = 0;  // bytes of the existing file to keep
   struct stat st;
-  if (resume && ::stat(path.c_str(), &st) == 0) {
-    std::string bytes = read_file(path);
+  if (resume) {
+    if (::fstat(fd_, &st) != 0) io_error(path, "cannot stat the checkpoint");
+    std::string bytes(size_t(st.st_size), '\0');
+    size_t got = 0;
+    while (got < bytes.size()) {
+      ssize_t n = ::pread(fd_, &bytes[got], bytes.size() - got, off_t(got));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) io_error(path, "cannot read the checkpoint");
+      got += size_t(n);
+    }
     if (bytes.size() >= 8 && std::memcmp(bytes.data(), kCheckpointMagic, 8) != 0)
       throw InputError(path, "not a bake checkpoint (bad magic bytes)");
     if (bytes.size() >= kCheckpointHeader) {
       if (get_u32(bytes, 20) != pvs::crc32c(bytes.data(), 20))
         throw InputError(path, "byte 20: checkpoint header checksum mismatch");
       if (get_u32(bytes, 8) != 1)
-        throw InputError(path, "byte 8: checkpoint version " + std::to_string(get_u32(bytes, 8)) + " (this bake reads 1)");
+        throw InputError(path, "byte 8: checkpoint version " + std::to_string(get_u32(bytes, 8)) +
+                                   " (this bake reads 1)");
       if (get_u64(bytes, 12) != key)
-        throw InputError(path, "the checkpoint belongs to another bake (other scene, cells or settings); delete it or bake without --resume");
-      keep = kCheckpointHeader;
-      while (bytes.size() - keep >= 12) {
-        uint32_t size = get_u32(bytes, keep);
-        if (uint64_t(size) + 12 > bytes.size() - keep) break;  // torn record
-        uint32_t crc = get_u32(bytes, keep + 8 + size);
-        if (crc != pvs::crc32c(bytes.data() + keep, 8 + size)) break;  // torn or damaged
-        uint32_t cell = get_u32(bytes, keep + 4);
+        throw InputError(path,
+                         "the checkpoint belongs to another bake (other scene, cells or settings); "
+                         "delete it or bake without --resume");
+      // A record at `at` is whole and intact if its size fits in the file and its CRC matches.
+      auto intact = [&](size_t at) {
+        if (bytes.size() - at < 12) return false;
+        uint32_t size = get_u32(bytes, at);
+        if (uint64_t(size) + 12 > bytes.size() - at) return false;
+        return get_u32(bytes, at + 8 + size) == pvs::crc32c(bytes.data() + at, 8 + size);
+      };
+      size_t at = kCheckpointHeader;
+      keep = at;
+      while (bytes.size() - at >= 12) {
+        if (!intact(at)) {
+          // A damaged record (a flipped bit on disk) or a torn tail (a write cut by a kill). The
+          // next record starts at the first offset after `at` where an intact record lies: where
+          // the size field points when only the payload or CRC is damaged, elsewhere when the size
+          // field itself is hit (searched byte by byte; an intact record has a matching CRC-32C,
+          // so a false start has probability 2^-32 per offset). With none, the rest is a torn
+          // tail and is cut off.
+          size_t next = 0;
+          for (size_t q = at + 1; q + 12 <= bytes.size(); ++q)
+            if (intact(q)) {
+              next = q;
+              break;
+            }
+          if (next == 0) break;  // torn or damaged tail
+          ++dropped_records_;
+          discarded_bytes_ += next - at;
+          at = next;
+          continue;
+        }
+        uint32_t size = get_u32(bytes, at);
+        uint32_t cell = get_u32(bytes, at + 4);
         if (cell >= cell_count)
-          throw InputError(path, "byte " + std::to_string(keep + 4) + ": record of cell " + std::to_string(cell) + ", the bake has " + std::to_string(cell_count));
+          throw InputError(path, "byte " + std::to_string(at + 4) + ": record of cell " +
+                                     std::to_string(cell) + ", the bake has " +
+                                     std::to_string(cell_count));
         std::vector<uint32_t> ids;
         try {
-          ids = pvs::decode_sorted_delta(std::string_view(bytes).substr(keep + 8, size), universe, keep + 8);
+          ids = pvs::decode_sorted_delta(std::string_view(bytes).substr(at + 8, size), universe,
+                                         at + 8);
         } catch (const pvs::FormatError& e) {
-          throw InputError(path, std::string("record of cell ") + std::to_string(cell) + ": " + e.what());
+          throw InputError(path,
+                           std::string("record of cell ") + std::to_string(cell) + ": " + e.what());
         }
         if (recovered) (*recovered)[cell] = std::move(ids);
         ++recovered_records_;
-        keep += 12 + size;
+        at += 12 + size;
+        keep = at;
       }
-      discarded_bytes_ = bytes.size() - keep;
+      if (at < bytes.size()) {  // a torn (or damaged) tail: cut off below, counted as one record
+        ++dropped_records_;
+        discarded_bytes_ += bytes.size() - at;
+      }
     }
   }
-  int flags = O_WRONLY | O_CREAT | O_CLOEXEC | (keep == 0 ? O_TRUNC : 0);
-  fd_ = ::open(path.c_str(), flags, 0644);
-  if (fd_ < 0) io_error(path, "cannot open the checkpoint");
   if (keep == 0) {
+    if (::ftruncate(fd_, 0) != 0) io_error(path, "cannot empty the checkpoint");
     write_all(fd_, header_bytes(key), path);
     // Make the new file's directory entry durable too (a power cut, not only a killed process).
-    std::string dir = path.find('/') == std::string::npos ? "." : path.substr(0, path.rfind('/') + 1);
+    std::string dir =
+        path.find('/') == std::string::npos ? "." : path.substr(0, path.rfind('/') + 1);
     int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) {
       ::fsync(dfd);
       ::close(dfd);
     }
   } else {
-    if (::ftruncate(fd_, off_t(keep)) != 0) io_error(path, "cannot cut the torn tail of the checkpoint");
-    if (::lseek(fd_, 0, SEEK_END) < 0) io_error(path, "seek failed");
+    if (::ftruncate(fd_, off_t(keep)) != 0)
+      io_error(path, "cannot cut the torn tail of the checkpoint");
     if (::fdatasync(fd_) != 0) io_error(path, "fsync failed");
   }
+  if (::lseek(fd_, 0, SEEK_END) < 0) io_error(path, "seek failed");
 }
 
 Checkpoint::~Checkpoint() {

@@ -5,9 +5,12 @@
 // 20 bytes before it; then one record per finished cell, in the order cells finished:
 // u32 payload size, u32 cell id, payload (the cell's ids as a pvs SortedDelta payload), u32
 // CRC32C of the record's bytes before it. All little-endian. A record is written with a single
-// write() and fsync'd before the cell counts as done. On reopening, records are read up to the
-// first one that is incomplete or fails its CRC (a write torn by the kill); the file is cut there
-// and appending continues.
+// write() and fsync'd before the cell counts as done. On reopening, every intact record is kept: a
+// record that fails its CRC (a damaged byte) is skipped up to the next intact record (where its
+// size field points, or, if the size field itself is damaged, the first offset after it where a
+// record with a matching CRC starts, searched byte by byte); its cell is baked again. A
+// tail with no intact record (a write torn by the kill) is cut off and appending continues. The
+// open checkpoint is locked (flock): a second bake or resume of the same file is refused.
 #pragma once
 
 #include <cstdint>
@@ -27,7 +30,8 @@ class Checkpoint {
   //    `recovered` (indexed by cell id); throws InputError if the file is not a checkpoint or
   //    belongs to another bake (other key), or if a record with a valid CRC names a cell out of
   //    range or holds a malformed set. A missing file or a torn header starts empty.
-  // Throws std::runtime_error on I/O failure.
+  // Throws InputError if another process holds the checkpoint's lock (a bake running on it),
+  // std::runtime_error on I/O failure. A symbolic link at `path` is not followed.
   Checkpoint(const std::string& path, uint64_t key, uint32_t cell_count, bool resume,
              std::vector<std::optional<std::vector<uint32_t>>>* recovered = nullptr,
              uint32_t universe = 0xFFFFFFFFu);
@@ -40,8 +44,10 @@ class Checkpoint {
   // Closes and deletes the file (after the PVS file is safely in place).
   void remove();
   const std::string& path() const { return path_; }
-  // Records kept from the previous run (resume) and the bytes cut off after them.
+  // Records kept from the previous run (resume); damaged records skipped plus a torn tail (each
+  // counts one) and the bytes they spanned.
   size_t recovered_records() const { return recovered_records_; }
+  size_t dropped_records() const { return dropped_records_; }
   uint64_t discarded_bytes() const { return discarded_bytes_; }
 
  private:
@@ -49,6 +55,7 @@ class Checkpoint {
   int fd_ = -1;
   std::mutex mutex_;
   size_t recovered_records_ = 0;
+  size_t dropped_records_ = 0;
   uint64_t discarded_bytes_ = 0;
 };
 

@@ -11,12 +11,13 @@
 
 namespace vislib {
 
-// The scene reduced to `ids` (sorted or not; each < triangle_count() for Triangle granularity,
-// < objects.size() for Object): Triangle keeps exactly those triangles, Object keeps every
-// triangle of those objects. Objects left without triangles are dropped; the others keep their
-// names and their order, and triangles keep their relative order. Every state's positions are kept
-// (unused vertices too: writers such as scene_to_glb write only the vertices an object uses).
-// Spheres are dropped.
+// The scene reduced to `ids`, read with the one id rule of bake/id_universe.h (sorted or not;
+// each < id_universe(scene, granularity): triangle ids, then sphere s as triangle_count() + s, or
+// object ids): Triangle keeps exactly those triangles and spheres, Object keeps every triangle and
+// sphere of those objects. Objects left without primitives are dropped; the others keep their
+// names and their order, and triangles and spheres keep their relative order. Every state's
+// positions are kept (unused vertices too: writers such as scene_to_glb write only the vertices an
+// object uses).
 Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granularity granularity);
 
 // The appearance of scene_subset(scene, ids, granularity): `appearance` (aligned with `scene`)

@@ -9,6 +9,13 @@ namespace vislib {
 // Errs towards hidden for pieces that short; 0 = exact mode.
 constexpr double kDefaultEpsLen = 1e-12;
 
+// Depth tie tolerance eps_z (math note H9), relative (unitless): where two surfaces covering a
+// pixel have view depths within eps_z * lambda of each other (lambda = the front depth; 1e-6 is
+// 1 micrometre at 1 m, 0.1 mm at 100 m), both count as visible, as a headset's z-buffer may show
+// either (z-fighting). Makes coplanar overlaps (decals, doubled walls) independent of placement,
+// rotation and units. Errs towards visible; 0 = exactly equal depths only.
+constexpr double kDefaultEpsZ = 1e-6;
+
 // Margin added around a footprint in face coordinates (u, w) in [-1,1] (one pixel = 2/N). Errs
 // towards scanning more pixels (safe: coverage is decided exactly afterwards).
 constexpr double kFootprintMargin = 1e-6;

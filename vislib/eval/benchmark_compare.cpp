@@ -51,10 +51,10 @@ struct Evaluator {
   const std::vector<Frame>& truth;
   const std::vector<uint32_t>& frame_triangles;
 
-  Checkpoint evaluate(const std::vector<uint32_t>& first_run, int runs, double seconds,
-                      std::vector<Frame>* frames = nullptr,
-                      std::vector<std::vector<uint8_t>>* missed = nullptr) const {
-    Checkpoint c;
+  QualityCheckpoint evaluate(const std::vector<uint32_t>& first_run, int runs, double seconds,
+                             std::vector<Frame>* frames = nullptr,
+                             std::vector<std::vector<uint8_t>>* missed = nullptr) const {
+    QualityCheckpoint c;
     c.runs = runs;
     c.seconds = seconds;
     const std::vector<uint32_t> ids = set_after(first_run, runs);
@@ -390,9 +390,9 @@ BenchResult run_bench(const Scene& scene, const BenchOptions& options,
   et.share = et.segment_found ? double(et.point_found) / double(et.segment_found) : 0.0;
   et.overlap_share =
       et.segment_found ? double(et.point_found_of_segment) / double(et.segment_found) : 0.0;
-  for (const Checkpoint& c : r.segment.checkpoints)
+  for (const QualityCheckpoint& c : r.segment.checkpoints)
     if (c.runs == int(S * K)) et.segment = c;
-  for (const Checkpoint& c : r.point.checkpoints)
+  for (const QualityCheckpoint& c : r.point.checkpoints)
     if (c.runs == et.point_runs) et.point = c;
   if (options.keep_frames) {
     r.truth_frames = truth;

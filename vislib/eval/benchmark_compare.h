@@ -84,7 +84,10 @@ struct QualitySummary {
 };
 QualitySummary summarize(const std::vector<FrameQuality>& views);
 
-struct Checkpoint {
+// A measured point of a growth curve with the frame quality of its set (named apart from the
+// bake's vislib::Checkpoint file class, checkpoint.h: two classes of one name broke the
+// one-definition rule).
+struct QualityCheckpoint {
   int runs = 0;
   double seconds = 0;
   size_t set_size = 0;
@@ -95,7 +98,7 @@ struct Checkpoint {
 
 struct MethodRun {
   std::vector<GrowthPoint> growth;      // after every run
-  std::vector<Checkpoint> checkpoints;  // in increasing runs
+  std::vector<QualityCheckpoint> checkpoints;  // in increasing runs
   std::vector<uint32_t> set;            // final union, sorted
   // Per triangle: the run index (0-based, in growth order) that first found it, or kNever.
   std::vector<uint32_t> first_run;
@@ -113,7 +116,7 @@ struct EqualTime {
   double overlap_share = 0;           // |P ∩ S| / |S|
   // False when from-point stopped before `seconds` (then P is its final set: a lower bound).
   bool within_measured = true;
-  Checkpoint segment, point;  // frame quality of S and P
+  QualityCheckpoint segment, point;  // frame quality of S and P
 };
 
 struct EqualQuality {

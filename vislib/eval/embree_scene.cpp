@@ -195,4 +195,19 @@ void EmbreeScene::first_hits_among(Vec3 eye_world, const Vec3* dirs, size_t coun
   impl_->check();
 }
 
+void EmbreeScene::first_hits_from(const Vec3* eyes_world, const Vec3* dirs, size_t count,
+                                  double tnear, const uint8_t* allowed, Hit* out) const {
+  AllowContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  ctx.base.filter = allowed ? &allow_filter : nullptr;
+  ctx.allowed = allowed;
+  std::vector<RTCRayHit> rays(count);
+  for (size_t i = 0; i < count; ++i)
+    rays[i] = make_ray(eyes_world[i] - impl_->origin, dirs[i], tnear);
+  rtcIntersect1M(impl_->scene, &ctx.base, rays.data(), unsigned(count), sizeof(RTCRayHit));
+  for (size_t i = 0; i < count; ++i) out[i] = to_hit(rays[i]);
+  impl_->check();
+}
+
 }  // namespace vislib

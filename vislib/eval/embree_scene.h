@@ -78,6 +78,13 @@ class EmbreeScene {
   void first_hits_among(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear,
                         const uint8_t* allowed, Hit* out) const;
 
+  // As first_hits_among, but ray i starts at eyes_world[i] (e.g. the eyes of an ODS row, one per
+  // column, vislib/render/ods_render.h). Each origin is made relative to origin() in double
+  // before rounding to float. `eyes_world`, `dirs` and `out` must hold `count` elements.
+  // Thread-safe; deterministic.
+  void first_hits_from(const Vec3* eyes_world, const Vec3* dirs, size_t count, double tnear,
+                       const uint8_t* allowed, Hit* out) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -75,6 +75,27 @@ std::array<double, kSsimWindow> gaussian_1d() {
 
 }  // namespace
 
+double ssim_whole_image(int width, int height, const std::vector<uint8_t>& a_rgb,
+                        const std::vector<uint8_t>& b_rgb) {
+  assert(width >= 1 && height >= 1);
+  const size_t n = size_t(width) * size_t(height);
+  assert(a_rgb.size() == 3 * n && b_rgb.size() == 3 * n);
+  if (a_rgb == b_rgb) return 1.0;
+  const std::vector<double> x = luminance(a_rgb, n), y = luminance(b_rgb, n);
+  double mx = 0, my = 0;
+  for (size_t i = 0; i < n; ++i) mx += x[i], my += y[i];
+  mx /= double(n), my /= double(n);
+  double vx = 0, vy = 0, cxy = 0;  // two-pass: no cancellation
+  for (size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - mx, dy = y[i] - my;
+    vx += dx * dx, vy += dy * dy, cxy += dx * dy;
+  }
+  vx /= double(n), vy /= double(n), cxy /= double(n);
+  const double c1 = (kSsimK1 * 255.0) * (kSsimK1 * 255.0);
+  const double c2 = (kSsimK2 * 255.0) * (kSsimK2 * 255.0);
+  return ((2.0 * mx * my + c1) * (2.0 * cxy + c2)) / ((mx * mx + my * my + c1) * (vx + vy + c2));
+}
+
 double ssim_luminance(int width, int height, const std::vector<uint8_t>& a_rgb,
                       const std::vector<uint8_t>& b_rgb) {
   assert(width >= kSsimWindow && height >= kSsimWindow);

@@ -49,6 +49,13 @@ double psnr_rgb(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b);
 double ssim_luminance(int width, int height, const std::vector<uint8_t>& a_rgb,
                       const std::vector<uint8_t>& b_rgb);
 
+// SSIM of the luminance with one window equal to the whole image, uniform weights (as CloVR's
+// visual-continuity metric, "a window size equal to the entire image"): the SSIM formula above
+// with mu, sigma^2 and sigma_xy the population statistics of all W*H pixels. Identical images give
+// exactly 1. width, height >= 1.
+double ssim_whole_image(int width, int height, const std::vector<uint8_t>& a_rgb,
+                        const std::vector<uint8_t>& b_rgb);
+
 struct FrameQuality {
   size_t pixels = 0;         // W*H
   size_t missed_pixels = 0;  // pixels counted by epsilon

@@ -38,8 +38,8 @@ CameraBasis basis(const Camera& c) {
 }
 
 Vec3 ray(const CameraBasis& b, const Camera& c, int x, int y) {
-  const double sx = (double(2 * x + 1) / double(c.width) - 1.0) * b.sx_scale;
-  const double sy = (1.0 - double(2 * y + 1) / double(c.height)) * b.sy_scale;
+  const double sx = (double(2 * x + 1) / double(c.width) - 1.0 + c.shift_x) * b.sx_scale;
+  const double sy = (1.0 - double(2 * y + 1) / double(c.height) + c.shift_y) * b.sy_scale;
   return b.f + b.r * sx + b.u * sy;
 }
 
@@ -94,6 +94,19 @@ std::array<uint8_t, 3> object_colour(uint32_t object) {
   return {to_byte(rgb[0]), to_byte(rgb[1]), to_byte(rgb[2])};
 }
 
+std::array<uint8_t, 3> shade_triangle(const Scene& scene, uint32_t tri, Vec3 dir) {
+  const double len = length(dir);
+  const auto c = scene.corners(tri, 0);
+  const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
+  const double nl = length(normal);
+  const double lambert = nl > 0 ? std::fabs(dot(normal, dir)) / (nl * len) : 0.0;
+  const double shade = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
+  const auto albedo = object_colour(scene.triangle_object[tri]);
+  std::array<uint8_t, 3> out;
+  for (int k = 0; k < 3; ++k) out[size_t(k)] = to_byte(double(albedo[size_t(k)]) / 255.0 * shade);
+  return out;
+}
+
 Frame render_frame(const Scene& scene, const EmbreeScene& rt, const Camera& camera,
                    const uint8_t* allowed) {
   assert(rt.triangle_count() == scene.triangle_count());
@@ -121,16 +134,10 @@ Frame render_frame(const Scene& scene, const EmbreeScene& rt, const Camera& came
               out[2] = kRenderBackground[2];
               continue;
             }
-            const double len = length(dirs[x]);
             frame.tri[p] = h.tri;
-            frame.depth[p] = float(h.lambda * len);
-            const auto c = scene.corners(h.tri, 0);
-            const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
-            const double nl = length(normal);
-            const double lambert = nl > 0 ? std::fabs(dot(normal, dirs[x])) / (nl * len) : 0.0;
-            const double shade = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
-            const auto albedo = object_colour(scene.triangle_object[h.tri]);
-            for (int k = 0; k < 3; ++k) out[k] = to_byte(double(albedo[size_t(k)]) / 255.0 * shade);
+            frame.depth[p] = float(h.lambda * length(dirs[x]));
+            const auto c = shade_triangle(scene, h.tri, dirs[x]);
+            out[0] = c[0], out[1] = c[1], out[2] = c[2];
           }
         }
       });

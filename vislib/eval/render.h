@@ -5,8 +5,8 @@
 // Camera convention. f = forward/|forward|, r = (f x up)/|f x up|, u = r x f. Pixel (x, y) of a
 // W x H frame (x = column from the left, y = row from the top, row-major index y*W + x) looks
 // along the pixel centre
-//   d = f + sx*r + sy*u,  sx = ((2x+1)/W - 1) * tan(vfov/2) * W/H,  sy = (1 - (2y+1)/H) *
-//   tan(vfov/2)
+//   d = f + sx*r + sy*u,  sx = ((2x+1)/W - 1 + shift_x) * tan(vfov/2) * W/H,
+//   sy = (1 - (2y+1)/H + shift_y) * tan(vfov/2)   (shift_x = shift_y = 0 unless off-axis)
 // (not normalised: f.d = 1, so Embree's hit distance along d is the view depth, as in cubemap.h).
 // A hit counts at view depth > z_near (a rasteriser's near plane).
 //
@@ -45,6 +45,10 @@ struct Camera {
   double vfov_degrees = 90;       // vertical field of view, in (0, 180)
   int width = 640, height = 480;  // pixels, each >= 1
   double z_near = kDefaultNear;   // near plane: view depth (scene units), > 0
+  // Off-axis (asymmetric) frustum: the image window is moved by shift_x half-widths to the right
+  // and shift_y half-heights up (sx and sy below gain + shift_x * tan(vfov/2) * W/H and
+  // + shift_y * tan(vfov/2)). 0 = the symmetric frustum. Finite.
+  double shift_x = 0, shift_y = 0;
 };
 
 // One rendered frame. Vectors are row-major from the top-left pixel.
@@ -63,6 +67,11 @@ Vec3 camera_ray(const Camera& camera, int x, int y);
 // The colour of object `object`: hue, saturation in [0.45, 0.8] and value in [0.65, 1] from a
 // SplitMix64 hash of the id. Same id, same colour on every platform.
 std::array<uint8_t, 3> object_colour(uint32_t object);
+
+// render_frame's colour of triangle `tri` (< triangle_count) seen along `dir` (non-zero; the
+// un-normalised pixel direction): object_colour times the headlight Lambert term above, with the
+// normal from key state 0. Thread-safe.
+std::array<uint8_t, 3> shade_triangle(const Scene& scene, uint32_t tri, Vec3 dir);
 
 // Renders `scene` through `rt`, which must have been built from `scene` at tau = 0 (normals are
 // taken from key state 0). `allowed`: null renders every triangle; else it must hold

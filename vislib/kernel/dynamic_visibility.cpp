@@ -44,6 +44,13 @@ double GeneralDepth::at(double t) const {
   return h < 0 ? m / (-h + sq) : (-h - sq) / dd;  // stable form of the near root (§4)
 }
 
+bool same_depth(const GeneralDepth& a, const GeneralDepth& b) {
+  if (a.kind != b.kind) return false;
+  for (int k = 0; k < 16; ++k)
+    if (a.c[k] != b.c[k]) return false;
+  return true;
+}
+
 int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi,
                     double* out) {
   if (i.kind == GeneralDepth::Rational && j.kind == GeneralDepth::Rational) {
@@ -432,11 +439,15 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
   struct Scratch {
     std::vector<std::vector<GeneralPiece>> lists;
     std::vector<double> far;  // per pixel: farthest zmax over its pieces once they cover [0,1]
+    std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
   tbb::enumerable_thread_specific<Scratch> scratch([TS] {
     return Scratch{std::vector<std::vector<GeneralPiece>>(size_t(TS) * TS),
-                   std::vector<double>(size_t(TS) * TS)};
+                   std::vector<double>(size_t(TS) * TS),
+                   std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
   });
+  const bool keep_ties = opt.coplanar == CoplanarRule::Both;
+  const double far_scale = keep_ties ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
 
   for (int face = 0; face < 6; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
@@ -484,6 +495,7 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
             const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
             const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
             for (auto& l : lists) l.clear();
+            for (auto& l : sc.ties) l.clear();
             std::fill(sc.far.begin(), sc.far.end(), INFINITY);
             Binned* tb = bins.data() + bin_start[tile];
             Binned* te = bins.data() + bin_start[tile + 1];
@@ -497,7 +509,7 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
               if (!covers_segment(l)) return;
               double f = -INFINITY;
               for (const GeneralPiece& pc : l) f = std::max(f, zmax[pc.id]);
-              sc.far[k] = f;
+              sc.far[k] = f * far_scale;
             };
             Interval iv[kMaxIntervals];
             double tile_far = INFINITY;
@@ -544,9 +556,10 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
                                             opt.near, iv);
                     if (n) ++stats.covered_pairs;
                     bool changed = false;
+                    const TieRule tie{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
                     for (int i = 0; i < n; ++i)
-                      changed |=
-                          insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                      changed |= insert_piece(
+                          lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth}, tie);
                     if (changed && opt.depth_culling) update_far(k);
                   }
                 }
@@ -565,9 +578,10 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
                     int n = sphere_coverage(sp, pixel_direction(axes, x, y, N), opt.near, iv);
                     if (n) ++stats.covered_pairs;
                     bool changed = false;
+                    const TieRule tie{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
                     for (int i = 0; i < n; ++i)
-                      changed |=
-                          insert_piece(lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth});
+                      changed |= insert_piece(
+                          lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth}, tie);
                     if (changed && opt.depth_culling) update_far(k);
                   }
               }
@@ -582,24 +596,25 @@ void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
                 stats.final_pieces += l.size();
                 stats.max_pieces_per_pixel =
                     std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-                for (const GeneralPiece& pc : l) {
+                const auto& ties = sc.ties[size_t(y - ty0) * TS + (x - tx0)];
+                for_each_visible(l, ties, [&](uint32_t id, double t0, double t1) {
                   // Length in the segment parameter (Diagonal) or in animation time (eye fixed).
                   double span =
                       std::max(std::fabs(run.t1 - run.t0), std::fabs(run.tau1 - run.tau0));
-                  double len = (pc.t1 - pc.t0) * span;
-                  if (!(len > opt.eps_len)) continue;
-                  double sm = 0.5 * (pc.t0 + pc.t1);
-                  bool sph = pc.id >= ntri;
+                  double len = (t1 - t0) * span;
+                  if (!(len > opt.eps_len)) return;
+                  double sm = 0.5 * (t0 + t1);
+                  bool sph = id >= ntri;
                   Witness w;
-                  w.tri = sph ? uint32_t(pc.id - ntri) : pc.id;
+                  w.tri = sph ? uint32_t(id - ntri) : id;
                   w.is_sphere = sph;
                   w.face = face;
                   w.x = x;
                   w.y = y;
                   w.t = run.t0 + sm * (run.t1 - run.t0);
                   w.tau = run.tau0 + sm * (run.tau1 - run.tau0);
-                  found.mark(pc.id, len, w);
-                }
+                  found.mark(id, len, w);
+                });
                 if (pieces && run.diagonal) {
                   auto& dst = (*pieces)[(size_t(face) * N + y) * N + x];
                   for (GeneralPiece pc : l) {

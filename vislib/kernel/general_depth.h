@@ -25,6 +25,8 @@ struct GeneralDepth {
 // sphere-sphere, 6 sphere-triangle). Spheres that stay disjoint over the run have none.
 int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi,
                     double* out);
+// Same kind (rational, sphere near root, sphere far root) and same coefficients.
+bool same_depth(const GeneralDepth& a, const GeneralDepth& b);
 using GeneralPiece = PieceT<GeneralDepth>;
 
 }  // namespace vislib

@@ -11,7 +11,13 @@
 // (view depth lambda at t) and a free function
 //   int depth_crossings(const D& lower_id, const D& higher_id, double lo, double hi, double* out)
 // writing the ascending crossing times strictly inside (lo, hi) (at most kMaxCrossings) computed
-// with the pair in id order, so that the result does not depend on which one is being inserted.
+// with the pair in id order, so that the result does not depend on which one is being inserted,
+// and a free function `bool same_depth(const D&, const D&)`: true when two pieces of one primitive
+// follow the same depth function. Touching pieces are merged only when they have the same id AND
+// the same depth function: one primitive can own touching pieces on different surfaces (a
+// sphere's entry and exit roots when the eye enters it, math note §4), and a merged piece would
+// carry the first one's depth over both, so later insertions would be compared with the wrong
+// surface.
 #pragma once
 
 #include <algorithm>
@@ -34,6 +40,9 @@ struct LinearDepth {
   double at(double t) const { return (n0 - n1 * t) / dn; }
 };
 int depth_crossings(const LinearDepth& i, const LinearDepth& j, double lo, double hi, double* out);
+inline bool same_depth(const LinearDepth& a, const LinearDepth& b) {
+  return a.n0 == b.n0 && a.n1 == b.n1 && a.dn == b.dn;
+}
 
 template <class D>
 struct PieceT {
@@ -45,6 +54,23 @@ struct PieceT {
 using Piece = PieceT<LinearDepth>;
 using PieceList = std::vector<Piece>;
 
+// A depth tie (math note H9, the option "treat |dlambda| <= eps_z lambda as a tie"): over [t0, t1)
+// primitive `hidden` lost the depth test to `front` although their depths differed by at most
+// eps_z times the front depth (checked at both ends and the middle of the stretch). A z-buffer
+// z-fights there and may show either, so `hidden` counts as visible wherever `front` (or anything
+// `front` is tied with) is in the final list over that stretch (see for_each_visible).
+struct TieRecord {
+  double t0 = 0, t1 = 0;
+  uint32_t hidden = 0, front = 0;
+};
+
+// The tie rule of insert_piece. With `sink` null (the default) nothing is recorded: the old rule,
+// ties settled by depth and then by the lower id alone. The list itself never depends on the rule.
+struct TieRule {
+  double eps_z = 0;                        // relative depth tolerance (unitless, >= 0)
+  std::vector<TieRecord>* sink = nullptr;  // where ties are appended (one vector per pixel)
+};
+
 namespace detail {
 
 template <class D>
@@ -55,16 +81,33 @@ const PieceT<D>& front(const PieceT<D>& a, const PieceT<D>& b, double t) {
   return a.id < b.id ? a : b;
 }
 
+// Records a tie when `loser` is within rule.eps_z (relative to the front depth) of `winner` at t0,
+// at the middle and at t1 (for linear depths: over the whole of [t0, t1)).
+template <class D>
+void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& loser, double t0, double t1) {
+  for (double t : {0.5 * (t0 + t1), t0, t1}) {
+    double w = winner.depth.at(t), l = loser.depth.at(t);
+    if (!(std::fabs(l - w) <= rule.eps_z * std::fabs(w))) return;
+  }
+  rule.sink->push_back(TieRecord{t0, t1, loser.id, winner.id});
+}
+
 template <class D>
 int crossings(const PieceT<D>& a, const PieceT<D>& b, double lo, double hi, double* out) {
   return a.id < b.id ? depth_crossings(a.depth, b.depth, lo, hi, out)
                      : depth_crossings(b.depth, a.depth, lo, hi, out);
 }
 
+// True when b continues a: same primitive, same depth function, touching (a before b).
+template <class D>
+bool continues(const PieceT<D>& a, const PieceT<D>& b) {
+  return a.id == b.id && a.t1 == b.t0 && same_depth(a.depth, b.depth);
+}
+
 template <class D>
 void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t1) {
   if (!(t0 < t1)) return;
-  if (!out.empty() && out.back().id == src.id && out.back().t1 == t0) {
+  if (!out.empty() && out.back().id == src.id && out.back().t1 == t0 && same_depth(out.back().depth, src.depth)) {
     out.back().t1 = t1;
     return;
   }
@@ -78,9 +121,11 @@ void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t
 
 // Inserts the coverage interval `p` (p.t0 < p.t1) into `list` (sorted, disjoint, merged).
 // Returns false when the list is unchanged (p is hidden wherever it overlaps the list).
+// With a tie sink in `ties`, appends a TieRecord for every stretch where the loser of a depth
+// comparison lies within ties.eps_z of the winner (the list is the same with or without it).
 // Not thread-safe for the same list; lists are per pixel.
 template <class D>
-bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
+bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p, const TieRule& ties = TieRule{}) {
   assert(p.t0 < p.t1);
   const double s = p.t0, f = p.t1;
   // First piece ending after s (t1 increases along the list).
@@ -90,6 +135,7 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
   double cuts[kMaxCrossings + 2];
   // Read-only pass first: most insertions (front-to-back order) are hidden everywhere and must
   // leave the list untouched; find that out without rebuilding anything.
+  const size_t ties_before = ties.sink ? ties.sink->size() : 0;
   {
     bool changes = false;
     double cur = s;
@@ -102,9 +148,11 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
       double lo = std::max(cur, I.t0), hi = std::min(f, I.t1);
       changes =
           detail::crossings(I, p, lo, hi, cuts) > 0 || &detail::front(I, p, 0.5 * (lo + hi)) == &p;
+      if (!changes && ties.sink) detail::record_tie(ties, I, p, lo, hi);
       cur = hi;
     }
     if (!changes && cur >= f) return false;
+    if (ties.sink) ties.sink->resize(ties_before);  // the full pass below records them again
   }
   size_t count;  // pieces now standing where list[first, i) stood
   if (first == list.size() || list[first].t0 >= f) {
@@ -123,8 +171,11 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
       int n = detail::crossings(I, p, lo, hi, cuts + 1);
       cuts[0] = lo;
       cuts[n + 1] = hi;
-      for (int k = 0; k <= n; ++k)
-        detail::push(out, detail::front(I, p, 0.5 * (cuts[k] + cuts[k + 1])), cuts[k], cuts[k + 1]);
+      for (int k = 0; k <= n; ++k) {
+        const PieceT<D>& w = detail::front(I, p, 0.5 * (cuts[k] + cuts[k + 1]));
+        detail::push(out, w, cuts[k], cuts[k + 1]);
+        if (ties.sink && cuts[k] < cuts[k + 1]) detail::record_tie(ties, w, &w == &p ? I : p, cuts[k], cuts[k + 1]);
+      }
       if (I.t1 > f) detail::push(out, I, f, I.t1);
       cur = hi;
       ++i;
@@ -139,8 +190,8 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p) {
     count = out.size();
   }
   // `push` merged inside the new range; merge across its two ends (higher index first).
-  auto merge_at = [&list](size_t k) {  // list[k] absorbs list[k+1] if same id and touching
-    if (k + 1 < list.size() && list[k].id == list[k + 1].id && list[k].t1 == list[k + 1].t0) {
+  auto merge_at = [&list](size_t k) {  // list[k] absorbs list[k+1] if it continues it
+    if (k + 1 < list.size() && detail::continues(list[k], list[k + 1])) {
       list[k].t1 = list[k + 1].t1;
       list.erase(list.begin() + k + 1);
     }
@@ -159,6 +210,43 @@ std::optional<PieceT<D>> lookup(const std::vector<PieceT<D>>& list, double t) {
   return std::nullopt;
 }
 
+// Calls f(id, t0, t1) for every piece of the final `list`, then for every stretch made visible by
+// the tie records `ties` of that list: a record (hidden, front, [a, b)) makes `hidden` visible
+// over [a, b) intersected with each stretch where `front` is visible, transitively (three coplanar
+// copies: each is visible). Stretches are reported once each (exact duplicates skipped).
+template <class D, class F>
+void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieRecord>& ties, F f) {
+  for (const PieceT<D>& p : list) f(p.id, p.t0, p.t1);
+  if (ties.empty()) return;
+  struct Stretch {
+    uint32_t id;
+    double t0, t1;
+  };
+  std::vector<Stretch> vis;
+  vis.reserve(list.size() + ties.size());
+  for (const PieceT<D>& p : list) vis.push_back({p.id, p.t0, p.t1});
+  std::vector<size_t> scanned(ties.size(), 0);  // per record: stretches already intersected
+  for (bool grew = true; grew;) {
+    grew = false;
+    const size_t n = vis.size();
+    for (size_t r = 0; r < ties.size(); ++r) {
+      const TieRecord& tr = ties[r];
+      for (size_t e = scanned[r]; e < n; ++e) {
+        if (vis[e].id != tr.front) continue;
+        double a = std::max(tr.t0, vis[e].t0), b = std::min(tr.t1, vis[e].t1);
+        if (!(a < b)) continue;
+        bool known = false;
+        for (const Stretch& v : vis) known = known || (v.id == tr.hidden && v.t0 == a && v.t1 == b);
+        if (known) continue;
+        vis.push_back({tr.hidden, a, b});
+        f(tr.hidden, a, b);
+        grew = true;
+      }
+      scanned[r] = n;
+    }
+  }
+}
+
 // True when the pieces cover [0, 1] without gap.
 template <class D>
 bool covers_segment(const std::vector<PieceT<D>>& list) {
@@ -171,8 +259,8 @@ bool covers_segment(const std::vector<PieceT<D>>& list) {
 // Largest depth over all pieces of a list of linear depths (at the piece ends); -inf if empty.
 double farthest_depth(const PieceList& list);
 
-// Checks the invariants of §7 (sorted, disjoint, 0 <= t0 < t1 <= 1, touching same-id pieces
-// merged). For tests and debug builds.
+// Checks the invariants of §7 (sorted, disjoint, 0 <= t0 < t1 <= 1, touching pieces with the same
+// id and the same depth function merged). For tests and debug builds.
 template <class D>
 bool is_valid(const std::vector<PieceT<D>>& list) {
   for (size_t k = 0; k < list.size(); ++k) {
@@ -180,7 +268,7 @@ bool is_valid(const std::vector<PieceT<D>>& list) {
     if (!(0.0 <= p.t0 && p.t0 < p.t1 && p.t1 <= 1.0)) return false;
     if (k > 0) {
       if (list[k - 1].t1 > p.t0) return false;
-      if (list[k - 1].t1 == p.t0 && list[k - 1].id == p.id) return false;
+      if (detail::continues(list[k - 1], p)) return false;
     }
   }
   return true;

@@ -46,18 +46,29 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
   std::vector<uint8_t> in_union(scene.triangle_count(), 0),
       sphere_in_union(scene.sphere_count(), 0);
   size_t union_size = 0;
+  const bool witnesses = options.segment.want_witnesses;
+  std::vector<RegionWitness> tri_witness(witnesses ? scene.triangle_count() : 0),
+      sphere_witness(witnesses ? scene.sphere_count() : 0);
   for (size_t s = 0; s < result.segments.size(); ++s) {
     for (int k = 0; k < options.runs; ++k) {
       SegmentOptions so = options.segment;
       so.orientation = run_orientation(options.seed, s, k);
-      SegmentResult sr =
-          segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
-      for (uint32_t id : sr.visible)
-        if (!in_union[id]) {
-          in_union[id] = 1;
-          ++union_size;
-        }
-      for (uint32_t sphere : sr.visible_spheres) sphere_in_union[sphere] = 1;
+      so.want_pieces = false;
+      SegmentResult sr = segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
+      // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
+      for (size_t i = 0; i < sr.visible.size(); ++i) {
+        uint32_t id = sr.visible[i];
+        if (in_union[id]) continue;
+        in_union[id] = 1;
+        ++union_size;
+        if (witnesses) tri_witness[id] = {s, k, sr.witnesses[i]};
+      }
+      for (size_t i = 0; i < sr.visible_spheres.size(); ++i) {
+        uint32_t sp = sr.visible_spheres[i];
+        if (sphere_in_union[sp]) continue;
+        sphere_in_union[sp] = 1;
+        if (witnesses) sphere_witness[sp] = {s, k, sr.witnesses[sr.visible.size() + i]};
+      }
       result.seconds += sr.stats.seconds;
       RunRecord rec;
       rec.segment = s;
@@ -73,9 +84,15 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
     }
   }
   for (uint32_t id = 0; id < in_union.size(); ++id)
-    if (in_union[id]) result.visible.push_back(id);
+    if (in_union[id]) {
+      result.visible.push_back(id);
+      if (witnesses) result.witnesses.push_back(tri_witness[id]);
+    }
   for (uint32_t s = 0; s < sphere_in_union.size(); ++s)
-    if (sphere_in_union[s]) result.visible_spheres.push_back(s);
+    if (sphere_in_union[s]) {
+      result.visible_spheres.push_back(s);
+      if (witnesses) result.witnesses.push_back(sphere_witness[s]);
+    }
   return result;
 }
 

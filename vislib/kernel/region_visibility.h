@@ -31,7 +31,9 @@ std::vector<Segment> perimeter_segments(const Box3& box);
 Mat3 run_orientation(uint64_t seed, size_t segment, int run);
 
 struct RegionOptions {
-  SegmentOptions segment;  // resolution, near, eps_len, tile size... (orientation is ignored)
+  // resolution, near, eps_len, tile size, want_witnesses... (orientation and want_pieces are
+  // ignored)
+  SegmentOptions segment;
   int runs = 1;            // K orientations per segment, >= 1
   uint64_t seed = 1;
 };
@@ -47,11 +49,24 @@ struct RunRecord {
   double seconds_after = 0;     // cumulative kernel seconds after this run
 };
 
+// A witness of the union: the perimeter segment and run that saw the primitive, and where. The
+// eye is at segments[segment].from + witness.t (to - from), the cube orientation is the run's
+// (run_orientation(seed, segment, run)), so the id can be checked from outside by one ray cast.
+struct RegionWitness {
+  size_t segment = 0;
+  int run = 0;
+  Witness witness;
+};
+
 struct RegionResult {
   std::vector<Segment> segments;
   std::vector<RunRecord> runs;            // segment-major, run-minor
   std::vector<uint32_t> visible;          // union of triangle ids, sorted
   std::vector<uint32_t> visible_spheres;  // union of sphere indices, sorted
+  // If options.segment.want_witnesses: one per id of the union, triangles (in `visible` order)
+  // then spheres (in `visible_spheres` order), each from the first run (segment-major, run-minor)
+  // that saw it.
+  std::vector<RegionWitness> witnesses;
   double seconds = 0;
 };
 

@@ -119,13 +119,17 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     std::vector<PieceList> lists;
     std::vector<uint8_t> full;
     std::vector<double> far;
+    std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
   tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
-    return TileScratch{std::vector<PieceList>(size_t(TS) * TS),
-                       std::vector<uint8_t>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS)};
+    return TileScratch{std::vector<PieceList>(size_t(TS) * TS), std::vector<uint8_t>(size_t(TS) * TS),
+                       std::vector<double>(size_t(TS) * TS), std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
   });
-  tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
-      [&] { return FoundMarks(ntri, opt.want_witnesses); });
+  const bool keep_ties = opt.coplanar == CoplanarRule::Both;
+  // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of it,
+  // so only triangles beyond far * (1 + eps_z) are skipped (2 eps_z covers the rounding).
+  const double far_scale = keep_ties ? 1 + 2 * opt.eps_z : 1.0;
+  tbb::enumerable_thread_specific<FoundMarks> found_by_thread([&] { return FoundMarks(ntri, opt.want_witnesses); });
 
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
@@ -171,6 +175,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
             const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
             const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
             for (auto& l : lists) l.clear();
+            for (auto& l : sc.ties) l.clear();
             std::fill(sc.full.begin(), sc.full.end(), 0);
             std::fill(sc.far.begin(), sc.far.end(), INFINITY);
             FaceTriangle* tb = bins.data() + bin_start[tile];
@@ -227,9 +232,10 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                   if (!static_coverage(st, d, axes.S, axes.T, opt.near, lo, hi, depth)) continue;
                   ++stats.covered_pairs;
                   PieceList& l = lists[k];
-                  if (insert_piece(l, Piece{lo, hi, ft->id, depth}) && opt.depth_culling &&
+                  TieRule rule{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
+                  if (insert_piece(l, Piece{lo, hi, ft->id, depth}, rule) && opt.depth_culling &&
                       covers_segment(l))
-                    sc.far[k] = farthest_depth(l);
+                    sc.far[k] = farthest_depth(l) * far_scale;
                 }
               }
             }
@@ -244,17 +250,18 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
                 stats.final_pieces += l.size();
                 stats.max_pieces_per_pixel =
                     std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-                for (const Piece& p : l) {
-                  double len = p.t1 - p.t0;
-                  if (!(len > opt.eps_len)) continue;
+                const auto& ties = sc.ties[size_t(y - ty0) * TS + (x - tx0)];
+                for_each_visible(l, ties, [&](uint32_t id, double t0, double t1) {
+                  double len = t1 - t0;
+                  if (!(len > opt.eps_len)) return;
                   Witness w;
-                  w.tri = p.id;
+                  w.tri = id;
                   w.face = face;
                   w.x = x;
                   w.y = y;
-                  w.t = 0.5 * (p.t0 + p.t1);
-                  found.mark(p.id, len, w);
-                }
+                  w.t = 0.5 * (t0 + t1);
+                  found.mark(id, len, w);
+                });
                 if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
               }
             stats.peak_tile_bytes = double(bytes);

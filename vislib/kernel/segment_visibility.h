@@ -34,6 +34,13 @@ namespace vislib {
 //    the perimeter is of a view rectangle.
 enum class DynamicMode { Diagonal, Decoupled };
 
+// Depth ties between surfaces (math note H9, docs/visibility.md "Coplanar surfaces"):
+//  Both: where the loser of a depth test lies within eps_z (relative) of the winner over a stretch
+//    of the segment, both are visible there (a z-buffer z-fights); the default.
+//  First: the old rule, the nearer depth wins and exact ties go to the lower id; the set then
+//    depends on rounding, hence on placement and units, for coplanar overlaps.
+enum class CoplanarRule { Both, First };
+
 struct SegmentOptions {
   int resolution = 512;                      // N: each cube face is N x N pixels; must be >= 1
   double near = kDefaultNear;                // z_near > 0, view depth in scene units
@@ -45,6 +52,8 @@ struct SegmentOptions {
   bool depth_culling = true;                 // skip triangles behind a tile's fully covered pixels
   size_t state = 0;                          // static scenes: which key state to use
   DynamicMode mode = DynamicMode::Diagonal;  // dynamic scenes (moving vertices or spheres)
+  CoplanarRule coplanar = CoplanarRule::Both;  // depth ties: both visible, or the first (lower id)
+  double eps_z = kDefaultEpsZ;               // tie tolerance, relative to the front depth; >= 0
 };
 
 struct SegmentStats {

@@ -6,8 +6,9 @@
 
 namespace vislib {
 
-// A pixel and a t at which `tri` is the first hit: the middle of its longest final piece
-// (ties: lowest face, then row, then column).
+// A pixel and a t at which `tri` is the first hit, or (CoplanarRule::Both) lies within eps_z of the
+// first hit's depth: the middle of its longest final or tied stretch (ties: lowest face, then row,
+// then column).
 struct Witness {
   uint32_t tri = 0;  // triangle id, or sphere index when is_sphere
   bool is_sphere = false;

@@ -18,8 +18,12 @@ namespace {
 
 namespace nf = pvs_runtime;
 
-nf::Point3 to_point(Vec3 v) { return {v.x, v.y, v.z}; }
-Vec3 to_vec(nf::Point3 p) { return {p.x, p.y, p.z}; }
+nf::Point3 to_point(Vec3 v) {
+  return {v.x, v.y, v.z};
+}
+Vec3 to_vec(nf::Point3 p) {
+  return {p.x, p.y, p.z};
+}
 
 uint8_t to_byte(double v) {
   double s = std::round(v * 255.0);
@@ -70,47 +74,52 @@ Frame render_displaced(const Scene& scene, const std::vector<uint32_t>& ids, con
 }
 
 // Fills the pixels of `geometry` that hit nothing from `env` (see the header).
-void compose(Frame& geometry, const EnvironmentMap& env, const Camera& camera, EnvironmentLookup lookup,
-             double r2) {
+void compose(Frame& geometry, const EnvironmentMap& env, const Camera& camera,
+             EnvironmentLookup lookup, double r2) {
   const Vec3 o = env.centre, u = camera.eye;
-  tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int y = rows.begin(); y != rows.end(); ++y)
-      for (int x = 0; x < camera.width; ++x) {
-        const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
-        uint8_t* out = &geometry.rgb[3 * p];
-        if (geometry.tri[p] != kNoHit) continue;
-        Vec3 d = camera_ray(camera, x, y);
-        d = d * (1.0 / length(d));
-        Vec3 look = d;
-        if (lookup == EnvironmentLookup::CylinderR2) {
-          // U + t d leaves the cylinder of radius r2 about O's axis (U is inside: one root t > 0).
-          const double ux = u.x - o.x, uz = u.z - o.z;
-          const double a = d.x * d.x + d.z * d.z, b = 2 * (ux * d.x + uz * d.z), c = ux * ux + uz * uz - r2 * r2;
-          if (a > 0) {
-            const double t = (-b + std::sqrt(std::fmax(0.0, b * b - 4 * a * c))) / (2 * a);
-            look = u + d * t - o;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+        for (int y = rows.begin(); y != rows.end(); ++y)
+          for (int x = 0; x < camera.width; ++x) {
+            const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
+            uint8_t* out = &geometry.rgb[3 * p];
+            if (geometry.tri[p] != kNoHit) continue;
+            Vec3 d = camera_ray(camera, x, y);
+            d = d * (1.0 / length(d));
+            Vec3 look = d;
+            if (lookup == EnvironmentLookup::CylinderR2) {
+              // U + t d leaves the cylinder of radius r2 about O's axis (U is inside: one root t >
+              // 0).
+              const double ux = u.x - o.x, uz = u.z - o.z;
+              const double a = d.x * d.x + d.z * d.z, b = 2 * (ux * d.x + uz * d.z),
+                           c = ux * ux + uz * uz - r2 * r2;
+              if (a > 0) {
+                const double t = (-b + std::sqrt(std::fmax(0.0, b * b - 4 * a * c))) / (2 * a);
+                look = u + d * t - o;
+              }
+            }
+            const nf::CubePixel cp = nf::cube_pixel(to_point(look), env.size);
+            const size_t q =
+                (size_t(cp.face) * size_t(env.size) + size_t(cp.y)) * size_t(env.size) +
+                size_t(cp.x);
+            for (int k = 0; k < 3; ++k) out[k] = env.rgb[3 * q + size_t(k)];
+            geometry.tri[p] = env.tri[q];
+            if (env.tri[q] == kNoHit) continue;
+            const double range = env.range[q];
+            if (lookup == EnvironmentLookup::EyeDirection) {
+              geometry.depth[p] = float(range);
+            } else {
+              const double l = length(look);
+              geometry.depth[p] = float(length(o + look * (range / l) - u));
+            }
           }
-        }
-        const nf::CubePixel cp = nf::cube_pixel(to_point(look), env.size);
-        const size_t q = (size_t(cp.face) * size_t(env.size) + size_t(cp.y)) * size_t(env.size) + size_t(cp.x);
-        for (int k = 0; k < 3; ++k) out[k] = env.rgb[3 * q + size_t(k)];
-        geometry.tri[p] = env.tri[q];
-        if (env.tri[q] == kNoHit) continue;
-        const double range = env.range[q];
-        if (lookup == EnvironmentLookup::EyeDirection) {
-          geometry.depth[p] = float(range);
-        } else {
-          const double l = length(look);
-          geometry.depth[p] = float(length(o + look * (range / l) - u));
-        }
-      }
-  });
+      });
 }
 
 }  // namespace
 
-EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt, Vec3 centre, int size,
-                                      const uint8_t* allowed) {
+EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt, Vec3 centre,
+                                      int size, const uint8_t* allowed) {
   assert(size >= 1);
   EnvironmentMap env;
   env.size = size;
@@ -119,28 +128,29 @@ EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt,
   env.rgb.assign(3 * n, 0);
   env.range.assign(n, std::numeric_limits<float>::infinity());
   env.tri.assign(n, kNoHit);
-  tbb::parallel_for(tbb::blocked_range<int>(0, kCubeFaces * size), [&](const tbb::blocked_range<int>& rows) {
-    std::vector<Vec3> dirs(static_cast<size_t>(size));
-    std::vector<Hit> hits(static_cast<size_t>(size));
-    for (int row = rows.begin(); row != rows.end(); ++row) {
-      const int face = row / size, y = row % size;
-      const FaceAxes axes = face_axes_local(face);
-      for (int x = 0; x < size; ++x) dirs[size_t(x)] = pixel_direction(axes, x, y, size);
-      rt.first_hits_among(centre, dirs.data(), size_t(size), 0.0, allowed, hits.data());
-      for (int x = 0; x < size; ++x) {
-        const size_t p = size_t(row) * size_t(size) + size_t(x);
-        const Hit& h = hits[size_t(x)];
-        uint8_t* out = &env.rgb[3 * p];
-        if (h.tri == kNoHit) {
-          for (int k = 0; k < 3; ++k) out[k] = kRenderBackground[size_t(k)];
-          continue;
+  tbb::parallel_for(
+      tbb::blocked_range<int>(0, kCubeFaces * size), [&](const tbb::blocked_range<int>& rows) {
+        std::vector<Vec3> dirs(static_cast<size_t>(size));
+        std::vector<Hit> hits(static_cast<size_t>(size));
+        for (int row = rows.begin(); row != rows.end(); ++row) {
+          const int face = row / size, y = row % size;
+          const FaceAxes axes = face_axes_local(face);
+          for (int x = 0; x < size; ++x) dirs[size_t(x)] = pixel_direction(axes, x, y, size);
+          rt.first_hits_among(centre, dirs.data(), size_t(size), 0.0, allowed, hits.data());
+          for (int x = 0; x < size; ++x) {
+            const size_t p = size_t(row) * size_t(size) + size_t(x);
+            const Hit& h = hits[size_t(x)];
+            uint8_t* out = &env.rgb[3 * p];
+            if (h.tri == kNoHit) {
+              for (int k = 0; k < 3; ++k) out[k] = kRenderBackground[size_t(k)];
+              continue;
+            }
+            env.tri[p] = h.tri;
+            env.range[p] = float(h.lambda * length(dirs[size_t(x)]));
+            shade(scene, h.tri, dirs[size_t(x)], out);
+          }
         }
-        env.tri[p] = h.tri;
-        env.range[p] = float(h.lambda * length(dirs[size_t(x)]));
-        shade(scene, h.tri, dirs[size_t(x)], out);
-      }
-    }
-  });
+      });
   return env;
 }
 
@@ -154,12 +164,14 @@ Scene scene_at(const Scene& scene, double tau) {
   if (!scene.positions.empty()) {
     out.positions.resize(1);
     out.positions[0].resize(scene.vertex_count());
-    for (uint32_t v = 0; v < scene.vertex_count(); ++v) out.positions[0][v] = scene.position_at(v, tau);
+    for (uint32_t v = 0; v < scene.vertex_count(); ++v)
+      out.positions[0][v] = scene.position_at(v, tau);
   }
   if (!scene.sphere_centers.empty()) {
     out.sphere_centers.resize(1);
     out.sphere_centers[0].resize(scene.sphere_count());
-    for (uint32_t k = 0; k < scene.sphere_count(); ++k) out.sphere_centers[0][k] = scene.sphere_center_at(k, tau);
+    for (uint32_t k = 0; k < scene.sphere_count(); ++k)
+      out.sphere_centers[0][k] = scene.sphere_center_at(k, tau);
   }
   return out;
 }
@@ -173,19 +185,21 @@ std::vector<uint8_t> moving_triangles(const Scene& scene) {
   return moves;
 }
 
-Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
-                      const Camera& camera, const NearFarSettings& s, RegionCounts* counts) {
+Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
+                      const std::vector<uint32_t>& visible, const Camera& camera,
+                      const NearFarSettings& s, RegionCounts* counts) {
   assert(s.r1 >= 0 && s.r1 < s.r2 && s.env_size >= 1);
   const nf::Point3 o = to_point(s.centre), u = to_point(camera.eye);
   assert(nf::axis_distance(u, o) < s.r1);
   const auto& pos = scene.positions[0];
   std::vector<float> pos_f(3 * pos.size());
   for (size_t v = 0; v < pos.size(); ++v) {
-    pos_f[3 * v] = float(pos[v].x), pos_f[3 * v + 1] = float(pos[v].y), pos_f[3 * v + 2] = float(pos[v].z);
+    pos_f[3 * v] = float(pos[v].x), pos_f[3 * v + 1] = float(pos[v].y),
+              pos_f[3 * v + 2] = float(pos[v].z);
   }
-  const nf::NearFarPartition part =
-      nf::partition_near_far(pos_f.data(), pos.size(), scene.triangles.empty() ? nullptr : scene.triangles[0].data(),
-                             scene.triangle_count(), s.dynamic, visible.data(), visible.size(), o, s.r1, s.r2);
+  const nf::NearFarPartition part = nf::partition_near_far(
+      pos_f.data(), pos.size(), scene.triangles.empty() ? nullptr : scene.triangles[0].data(),
+      scene.triangle_count(), s.dynamic, visible.data(), visible.size(), o, s.r1, s.r2);
   RegionCounts rc;
   rc.near = part.near_ids.size();
   rc.intermediate = part.intermediate_ids.size();
@@ -195,7 +209,8 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vect
   // Drawn from geometry with the morph: near and intermediate (geometry_ids minus the dynamic far).
   std::vector<uint32_t> geometry_ids;
   {
-    const std::vector<uint8_t> far_dyn = triangle_mask(scene.triangle_count(), part.far_dynamic_ids);
+    const std::vector<uint8_t> far_dyn =
+        triangle_mask(scene.triangle_count(), part.far_dynamic_ids);
     for (uint32_t t : part.geometry_ids)
       if (!far_dyn[t]) geometry_ids.push_back(t);
   }
@@ -204,25 +219,29 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vect
     return to_vec(nf::morph_vertex(to_point(pos[v]), u, o, s.r1, s.r2));
   });
   const EnvironmentMap env = render_environment_map(
-      scene, rt, s.centre, s.env_size, triangle_mask(scene.triangle_count(), part.environment_map_ids).data());
+      scene, rt, s.centre, s.env_size,
+      triangle_mask(scene.triangle_count(), part.environment_map_ids).data());
   if (!part.far_dynamic_ids.empty()) {
     // Eq. 2 displacement, then Eq. 3 against the map's range, then the depth test against geometry.
-    const Frame dyn = render_displaced(scene, part.far_dynamic_ids, camera,
-                                       [&](uint32_t v) { return to_vec(nf::displace_far(to_point(pos[v]), u, o)); });
-    const nf::RangeCubeMap range{env.size, env.range.data()};
-    tbb::parallel_for(tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
-      for (int y = rows.begin(); y != rows.end(); ++y)
-        for (int x = 0; x < camera.width; ++x) {
-          const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
-          if (dyn.tri[p] == kNoHit || !(dyn.depth[p] < f.depth[p])) continue;
-          Vec3 d = camera_ray(camera, x, y);
-          d = d * (1.0 / length(d));
-          if (!nf::passes_range_test(to_point(camera.eye + d * double(dyn.depth[p])), u, range)) continue;
-          f.tri[p] = dyn.tri[p];
-          f.depth[p] = dyn.depth[p];
-          for (int k = 0; k < 3; ++k) f.rgb[3 * p + size_t(k)] = dyn.rgb[3 * p + size_t(k)];
-        }
+    const Frame dyn = render_displaced(scene, part.far_dynamic_ids, camera, [&](uint32_t v) {
+      return to_vec(nf::displace_far(to_point(pos[v]), u, o));
     });
+    const nf::RangeCubeMap range{env.size, env.range.data()};
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+          for (int y = rows.begin(); y != rows.end(); ++y)
+            for (int x = 0; x < camera.width; ++x) {
+              const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
+              if (dyn.tri[p] == kNoHit || !(dyn.depth[p] < f.depth[p])) continue;
+              Vec3 d = camera_ray(camera, x, y);
+              d = d * (1.0 / length(d));
+              if (!nf::passes_range_test(to_point(camera.eye + d * double(dyn.depth[p])), u, range))
+                continue;
+              f.tri[p] = dyn.tri[p];
+              f.depth[p] = dyn.depth[p];
+              for (int k = 0; k < 3; ++k) f.rgb[3 * p + size_t(k)] = dyn.rgb[3 * p + size_t(k)];
+            }
+        });
     std::vector<uint8_t> shown(scene.triangle_count(), 0);
     for (uint32_t t : f.tri)
       if (t != kNoHit) shown[t] = 1;
@@ -233,19 +252,21 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vect
   return f;
 }
 
-Frame render_progressive(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
-                         const Camera& camera, Vec3 centre, double big_r, double near_fraction, int env_size,
-                         double ring_radius) {
+Frame render_progressive(const Scene& scene, const EmbreeScene& rt,
+                         const std::vector<uint32_t>& visible, const Camera& camera, Vec3 centre,
+                         double big_r, double near_fraction, int env_size, double ring_radius) {
   assert(near_fraction > 0 && near_fraction < 1 && big_r > 0 && big_r <= ring_radius);
   const nf::Point3 o = to_point(centre), u = to_point(camera.eye);
   const double r_n = near_fraction * big_r;
   assert(nf::axis_distance(u, o) < r_n);
   const auto& pos = scene.positions[0];
-  // An object is near (received) when one of its visible vertices is within ring_radius of the axis.
+  // An object is near (received) when one of its visible vertices is within ring_radius of the
+  // axis.
   std::vector<uint8_t> near_object(scene.objects.size(), 0);
   for (uint32_t t : visible)
     for (uint32_t v : scene.triangles[t])
-      if (nf::axis_distance(to_point(pos[v]), o) < ring_radius) near_object[scene.triangle_object[t]] = 1;
+      if (nf::axis_distance(to_point(pos[v]), o) < ring_radius)
+        near_object[scene.triangle_object[t]] = 1;
   std::vector<uint32_t> near_ids;
   std::vector<uint8_t> env_mask(scene.triangle_count(), 0);
   for (uint32_t t : visible) {
@@ -262,12 +283,15 @@ Frame render_progressive(const Scene& scene, const EmbreeScene& rt, const std::v
   return f;
 }
 
-std::vector<double> ring_visible_triangle_contribution(const Scene& scene, const std::vector<uint32_t>& visible,
-                                                        Vec3 centre, const std::vector<double>& radii) {
+std::vector<double> ring_visible_triangle_contribution(const Scene& scene,
+                                                       const std::vector<uint32_t>& visible,
+                                                       Vec3 centre,
+                                                       const std::vector<double>& radii) {
   const nf::Point3 o = to_point(centre);
   const auto& pos = scene.positions[0];
   const double inf = std::numeric_limits<double>::infinity();
-  std::vector<double> object_radius(scene.objects.size(), inf), object_tris(scene.objects.size(), 0);
+  std::vector<double> object_radius(scene.objects.size(), inf),
+      object_tris(scene.objects.size(), 0);
   for (uint32_t t : visible) {
     const uint32_t obj = scene.triangle_object[t];
     object_tris[obj] += 1;
@@ -276,19 +300,23 @@ std::vector<double> ring_visible_triangle_contribution(const Scene& scene, const
   }
   std::vector<double> item_radius, item_weight;
   for (size_t obj = 0; obj < scene.objects.size(); ++obj)
-    if (object_tris[obj] > 0) item_radius.push_back(object_radius[obj]), item_weight.push_back(object_tris[obj]);
+    if (object_tris[obj] > 0)
+      item_radius.push_back(object_radius[obj]), item_weight.push_back(object_tris[obj]);
   return nf::ring_contributions(radii, item_radius, item_weight);
 }
 
 ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const Frame& test) {
   assert(truth.pixel_count() == test.pixel_count());
   const size_t n_obj = scene.objects.size();
-  std::vector<size_t> truth_pixels(n_obj, 0), covered(n_obj, 0);
+  std::vector<size_t> truth_pixels(n_obj, 0), covered(n_obj, 0), test_pixels(n_obj, 0);
   std::vector<uint8_t> in_test(n_obj, 0);
   for (size_t p = 0; p < truth.pixel_count(); ++p) {
     const uint32_t a = truth.tri[p] == kNoHit ? kNoHit : scene.triangle_object[truth.tri[p]];
     const uint32_t b = test.tri[p] == kNoHit ? kNoHit : scene.triangle_object[test.tri[p]];
-    if (b != kNoHit) in_test[b] = 1;
+    if (b != kNoHit) {
+      in_test[b] = 1;
+      ++test_pixels[b];
+    }
     if (a == kNoHit) continue;
     ++truth_pixels[a];
     if (a == b) ++covered[a];
@@ -296,15 +324,19 @@ ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const
   ObjectCompletion c;
   size_t seen = 0;
   double ofc_sum = 0;
+  size_t capped = 0, truth_total = 0;
   for (size_t o = 0; o < n_obj; ++o) {
     if (truth_pixels[o] == 0) continue;
     ++c.objects;
     if (in_test[o]) ++seen;
     ofc_sum += double(covered[o]) / double(truth_pixels[o]);
+    capped += std::min(test_pixels[o], truth_pixels[o]);
+    truth_total += truth_pixels[o];
   }
   if (c.objects > 0) {
     c.ovc = double(seen) / double(c.objects);
     c.ofc = ofc_sum / double(c.objects);
+    c.ofc_eq2 = double(capped) / double(truth_total);
   }
   return c;
 }

@@ -15,8 +15,8 @@
 //     exactly as render_frame does (same camera, shading and depth).
 //  2. Environment map: the visible triangles with a vertex at or beyond r2 (far, plus the
 //     intermediate ones crossing r2: the paper's SF bin) are rendered once from O into a cube map
-//     (vislib/base/cubemap.h convention, identity orientation, `env_size` pixels a side): per pixel the
-//     first such triangle along the pixel-centre ray from O, its colour (render_frame's shading
+//     (vislib/base/cubemap.h convention, identity orientation, `env_size` pixels a side): per pixel
+//     the first such triangle along the pixel-centre ray from O, its colour (render_frame's shading
 //     with the ray from O as the headlight) and its range from O.
 //  3. Compose: where the eye ray hits geometry, the pixel is that hit; where it misses, the
 //     environment map is looked up (nearest pixel, pvs_runtime::cube_pixel):
@@ -50,17 +50,17 @@
 #include <cstdint>
 #include <vector>
 
+#include "vislib/base/vec.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/render.h"
 #include "vislib/scene/scene.h"
-#include "vislib/base/vec.h"
 
 namespace vislib {
 
 enum class EnvironmentLookup : uint8_t { EyeDirection = 0, CylinderR2 = 1 };
 
 struct NearFarSettings {
-  Vec3 centre;             // O, on the cylinders' (vertical) axis; the environment map's viewpoint
+  Vec3 centre;              // O, on the cylinders' (vertical) axis; the environment map's viewpoint
   double r1 = 10, r2 = 20;  // scene units; 0 <= r1 < r2
   bool morph = true;        // false: intermediate triangles drawn where they are (no Eq. 1)
   int env_size = 512;       // environment map face side, pixels, >= 1
@@ -93,22 +93,23 @@ std::vector<uint8_t> moving_triangles(const Scene& scene);
 struct EnvironmentMap {
   int size = 0;
   Vec3 centre;
-  std::vector<uint8_t> rgb;    // 3 bytes per pixel; kRenderBackground where nothing is hit
-  std::vector<float> range;    // |hit - O|; +inf where nothing is hit
-  std::vector<uint32_t> tri;   // scene triangle id, or kNoHit
+  std::vector<uint8_t> rgb;   // 3 bytes per pixel; kRenderBackground where nothing is hit
+  std::vector<float> range;   // |hit - O|; +inf where nothing is hit
+  std::vector<uint32_t> tri;  // scene triangle id, or kNoHit
 };
 
 // Renders the triangles t with allowed[t] != 0 (scene.triangle_count() bytes) from `centre` into
 // a cube map of `size` pixels a side. `rt` must be built from `scene` at tau = 0. Thread-safe.
-EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt, Vec3 centre, int size,
-                                      const uint8_t* allowed);
+EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt, Vec3 centre,
+                                      int size, const uint8_t* allowed);
 
 // The near-far frame of the visible triangles `visible` (sorted unique ids < triangle_count())
 // seen by `camera`, as described above. `rt` must be built from `scene` at tau = 0 (it renders the
 // environment map). camera.eye must be strictly inside r1 of O's axis (the user is in the near
 // region). `counts`, if not null, receives the region counts.
-Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
-                      const Camera& camera, const NearFarSettings& settings, RegionCounts* counts = nullptr);
+Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
+                      const std::vector<uint32_t>& visible, const Camera& camera,
+                      const NearFarSettings& settings, RegionCounts* counts = nullptr);
 
 // The CloVR frame while ring `ring_radius` is injected with the near region at radius big_r
 // (object level, CloVR §3, Alg. 1): the triangles (of `visible`) of every object with a visible
@@ -120,27 +121,33 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt, const std::vect
 // injection; big_r = ring_radius is the ring's final frame.
 // camera.eye's axis distance must be < near_fraction * big_r; 0 < near_fraction < 1;
 // 0 < big_r <= ring_radius.
-Frame render_progressive(const Scene& scene, const EmbreeScene& rt, const std::vector<uint32_t>& visible,
-                         const Camera& camera, Vec3 centre, double big_r, double near_fraction, int env_size,
-                         double ring_radius);
+Frame render_progressive(const Scene& scene, const EmbreeScene& rt,
+                         const std::vector<uint32_t>& visible, const Camera& camera, Vec3 centre,
+                         double big_r, double near_fraction, int env_size, double ring_radius);
 
 // The CloVR per-ring contribution for merging (pvs_runtime::merge_rings): for each ring
 // [radii[k-1], radii[k]) of the equal-area sequence `radii`, the number of triangles of `visible`
 // whose objects enter the near region in that ring (an object enters with its first visible vertex,
 // as in render_progressive), i.e. the visible triangles that change from environment map to
 // geometry in that ring. Objects entering at or beyond the last radius are not counted.
-std::vector<double> ring_visible_triangle_contribution(const Scene& scene, const std::vector<uint32_t>& visible,
-                                                        Vec3 centre, const std::vector<double>& radii);
+std::vector<double> ring_visible_triangle_contribution(const Scene& scene,
+                                                       const std::vector<uint32_t>& visible,
+                                                       Vec3 centre,
+                                                       const std::vector<double>& radii);
 
 // CloVR's completion metrics of `test` against `truth` (same size; tri ids of the same scene):
 //  - OVC, object visualization completion: the share of objects with at least one pixel in
 //    `truth` that have at least one pixel anywhere in `test`;
 //  - OFC, object footprint completion: per object of `truth`, the share of its truth pixels at
 //    which `test` shows the same object; averaged uniformly over those objects.
-// Both are 1 when `truth` shows no object.
+//  - ofc_eq2, CloVR's own OFC (its Eq. 2): sum over the objects of truth of min(F*(o), F(o)) over
+//    the sum of F(o), F(o) / F*(o) the object's pixel counts in truth / test, wherever they are
+//    (footprints, not per-pixel agreement; capped so that an object grown by a missing occluder
+//    does not count more than its truth footprint), i.e. weighted by footprint.
+// All are 1 when `truth` shows no object.
 struct ObjectCompletion {
   size_t objects = 0;  // objects with a pixel in truth
-  double ovc = 1, ofc = 1;
+  double ovc = 1, ofc = 1, ofc_eq2 = 1;
 };
 ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const Frame& test);
 

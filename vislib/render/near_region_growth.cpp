@@ -34,7 +34,7 @@ GrowthRun grow_near_region(const Scene& scene, const EmbreeScene& rt,
   const double eye_axis =
       pvs_runtime::axis_distance({camera.eye.x, camera.eye.y, camera.eye.z},
                                  {settings.centre.x, settings.centre.y, settings.centre.z});
-  double min_ssim = 1;
+  double min_ssim = 1, min_whole = 1;
   std::optional<Frame> prev;
   for (size_t i = 0; i < radii.size(); ++i) {
     const int frames = i == 0 ? 1 : settings.frames_per_ring;
@@ -54,12 +54,19 @@ GrowthRun grow_near_region(const Scene& scene, const EmbreeScene& rt,
         const double ss = ssim_luminance(camera.width, camera.height, prev->rgb, f.rgb);
         step.ssim_to_previous = ss;
         min_ssim = std::min(min_ssim, ss);
+        const double whole = ssim_whole_image(camera.width, camera.height, prev->rgb, f.rgb);
+        step.whole_ssim_to_previous = whole;
+        min_whole = std::min(min_whole, whole);
       }
+      if (settings.on_frame) settings.on_frame(run.steps.size(), step, f);
       run.steps.push_back(step);
       prev = std::move(f);
     }
   }
-  if (run.steps.size() >= 2) run.min_consecutive_ssim = min_ssim;
+  if (run.steps.size() >= 2) {
+    run.min_consecutive_ssim = min_ssim;
+    run.min_consecutive_whole_ssim = min_whole;
+  }
   return run;
 }
 

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -35,13 +36,16 @@ struct GrowthStep {
   size_t ring = 0;
   double ring_radius = 0, radius = 0;  // scene units
   double ssim_to_truth = 0;
-  std::optional<double> ssim_to_previous;  // none for the first frame
+  std::optional<double> ssim_to_previous;  // windowed (11 x 11) SSIM; none for the first frame
+  std::optional<double>
+      whole_ssim_to_previous;  // whole-image SSIM (CloVR's VC); none for the first
 };
 
 struct GrowthRun {
   std::vector<double> radii;
   std::vector<GrowthStep> steps;
-  std::optional<double> min_consecutive_ssim;  // none with fewer than two frames
+  std::optional<double> min_consecutive_ssim;        // none with fewer than two frames
+  std::optional<double> min_consecutive_whole_ssim;  // the same with whole-image SSIM
 };
 
 // What the frames of a growth need besides the radii.
@@ -50,6 +54,8 @@ struct GrowthSettings {
   double near_fraction = 0.7;  // R_n / R of Alg. 1, in (0, 1)
   int env_size = 0;            // environment map face side (pixels), >= 1
   int frames_per_ring = 4;     // >= 1
+  // If set, called with each frame of the growth in order (index from 0), e.g. to write it.
+  std::function<void(size_t index, const GrowthStep& step, const Frame& frame)> on_frame;
 };
 
 // Grows the near region through `radii`: ring i is injected over frames_per_ring frames with

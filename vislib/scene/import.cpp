@@ -51,19 +51,22 @@ Scene load_scene(const std::string& path, const LoadOptions& options,
   std::vector<std::string> local;
   std::vector<std::string>& warn = warnings ? *warnings : local;
   std::string ext = file_extension(path);
-  Scene scene;
-  if (ext == ".gltf" || ext == ".glb") {
-    scene = load_gltf(path, options, warn);
-  } else if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl") {
-    scene = load_mesh(path, warn);
-  } else if (ext == ".spheres") {
-    scene = load_spheres(path, warn);
-  } else {
-    throw InputError(path, "unsupported file format '" + (ext.empty() ? std::string("(none)") : ext) +
-                               "' (supported: .gltf .glb .obj .ply .off .stl .spheres)");
-  }
-  check_scene(path, scene);
-  return scene;
+  return with_memory_stage("loading " + path, [&] {
+    Scene scene;
+    if (ext == ".gltf" || ext == ".glb") {
+      scene = load_gltf(path, options, warn);
+    } else if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl") {
+      scene = load_mesh(path, warn);
+    } else if (ext == ".spheres") {
+      scene = load_spheres(path, warn);
+    } else {
+      throw InputError(path, "unsupported file format '" +
+                                 (ext.empty() ? std::string("(none)") : ext) +
+                                 "' (supported: .gltf .glb .obj .ply .off .stl .spheres)");
+    }
+    check_scene(path, scene);
+    return scene;
+  });
 }
 
 }  // namespace vislib

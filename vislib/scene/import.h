@@ -4,7 +4,8 @@
 //
 // Formats, chosen by extension (case-insensitive):
 //   .gltf .glb        glTF 2.0 (import_gltf.cpp)
-//   .obj .ply .off .stl  through OpenMesh (import_mesh.cpp)
+//   .obj .ply .off .stl  our own readers (import_mesh.cpp, scene/import_{ply,off,stl}.cpp); every
+//                     count in a header is checked against the file size before allocating
 //   .spheres          the sphere text format of docs/sphere-format.md (import_spheres.cpp)
 #pragma once
 

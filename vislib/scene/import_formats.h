@@ -15,8 +15,14 @@ struct SceneAppearance;
 // With `appearance`, also fills it (appearance.h).
 Scene load_gltf(const std::string& path, const LoadOptions& options,
                 std::vector<std::string>& warnings, SceneAppearance* appearance = nullptr);
-// OBJ by our own reader (groups become objects); PLY, OFF, STL through OpenMesh (import_mesh.cpp).
+// OBJ (groups become objects), PLY, OFF, STL by extension (import_mesh.cpp).
 Scene load_mesh(const std::string& path, std::vector<std::string>& warnings);
+// PLY ascii / binary little and big endian (vislib/scene/import_ply.cpp).
+Scene load_ply(const std::string& path, std::vector<std::string>& warnings);
+// OFF, ASCII (vislib/scene/import_off.cpp).
+Scene load_off(const std::string& path, std::vector<std::string>& warnings);
+// STL, binary and ASCII (vislib/scene/import_stl.cpp).
+Scene load_stl(const std::string& path, std::vector<std::string>& warnings);
 // The sphere text format of docs/sphere-format.md (import_spheres.cpp).
 Scene load_spheres(const std::string& path, std::vector<std::string>& warnings);
 

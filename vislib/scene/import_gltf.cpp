@@ -88,9 +88,10 @@ Mat4 to_matrix(const Trs& x) {
   double qx = x.r[0], qy = x.r[1], qz = x.r[2], qw = x.r[3];
   double n = std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw);
   if (n > 0) qx /= n, qy /= n, qz /= n, qw /= n;
-  double R[3][3] = {{1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
-                    {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
-                    {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
+  double R[3][3] = {
+      {1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)},
+      {2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)},
+      {2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)}};
   Mat4 m;
   for (int c = 0; c < 3; ++c)
     for (int r = 0; r < 3; ++r) m.m[c * 4 + r] = R[r][c] * x.s[c];
@@ -105,11 +106,12 @@ struct Bytes {
 
 struct Channel {
   int node = -1;
-  int path = 0;  // 0 translation, 1 rotation, 2 scale, 3 morph weights
-  int interp = 0;  // 0 LINEAR, 1 STEP, 2 CUBICSPLINE
+  int path = 0;      // 0 translation, 1 rotation, 2 scale, 3 morph weights
+  int interp = 0;    // 0 LINEAR, 1 STEP, 2 CUBICSPLINE
   size_t ncomp = 3;  // values per key element: 3, 4 (rotation) or the morph target count (weights)
   std::vector<double> times;
-  std::vector<double> values;  // per key: ncomp values (CUBICSPLINE: in-tangent, value, out-tangent)
+  std::vector<double>
+      values;  // per key: ncomp values (CUBICSPLINE: in-tangent, value, out-tangent)
 };
 
 // One primitive of a mesh, decoded once and shared by all instances of the mesh.
@@ -169,10 +171,17 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
     ctx.fail(who + "buffer " + std::to_string(buffer) + " does not exist");
   const auto& data = ctx.model.buffers[buffer].data;
   if (offset > data.size() || length > data.size() - offset)
-    ctx.fail(who + "source bytes [" + std::to_string(offset) + ", " + std::to_string(offset + length) +
-             ") exceed buffer " + std::to_string(buffer) + " of " + std::to_string(data.size()) + " bytes");
+    ctx.fail(who + "source bytes [" + std::to_string(offset) + ", " +
+             std::to_string(offset + length) + ") exceed buffer " + std::to_string(buffer) +
+             " of " + std::to_string(data.size()) + " bytes");
   if (stride == 0 || stride > 256 || count > (uint64_t(1) << 31) / stride)
-    ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " + std::to_string(count));
+    ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " +
+             std::to_string(count));
+  // meshoptimizer's codecs compress at most 64:1 (2 header bits per 16 bytes of zero deltas):
+  // a larger claim is rejected before the output is allocated (issue 18: memory amplification).
+  if (count * stride > 128 * length + 4096)
+    ctx.fail(who + std::to_string(count) + " elements of " + std::to_string(stride) +
+             " bytes cannot come from " + std::to_string(length) + " compressed bytes");
   auto& out = ctx.decoded[view];
   out.assign(size_t(count * stride), 0);
   const unsigned char* src = data.data() + offset;
@@ -188,7 +197,8 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
   } else {
     ctx.fail(who + "unknown mode '" + mode + "'");
   }
-  if (rc != 0) ctx.fail(who + "meshoptimizer could not decode the data (error " + std::to_string(rc) + ")");
+  if (rc != 0)
+    ctx.fail(who + "meshoptimizer could not decode the data (error " + std::to_string(rc) + ")");
   if (filter == "NONE") {
   } else if (mode != "ATTRIBUTES") {
     ctx.fail(who + "filter " + filter + " is only allowed with ATTRIBUTES");
@@ -199,7 +209,8 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
   } else if (filter == "EXPONENTIAL") {
     meshopt_decodeFilterExp(out.data(), count, stride);
   } else {
-    ctx.fail(who + "filter '" + filter + "' is unknown or does not fit byteStride " + std::to_string(stride));
+    ctx.fail(who + "filter '" + filter + "' is unknown or does not fit byteStride " +
+             std::to_string(stride));
   }
 }
 
@@ -227,32 +238,39 @@ Bytes view_bytes(Ctx& ctx, int view, const std::string& who) {
   const auto& data = ctx.model.buffers[bv.buffer].data;
   if (bv.byteOffset > data.size() || bv.byteLength > data.size() - bv.byteOffset)
     ctx.fail("bufferView " + std::to_string(view) + ": bytes [" + std::to_string(bv.byteOffset) +
-             ", " + std::to_string(bv.byteOffset + bv.byteLength) + ") are out of range of buffer " +
-             std::to_string(bv.buffer) + " (" + std::to_string(data.size()) + " bytes)");
+             ", " + std::to_string(bv.byteOffset + bv.byteLength) +
+             ") are out of range of buffer " + std::to_string(bv.buffer) + " (" +
+             std::to_string(data.size()) + " bytes)");
   return {data.data() + bv.byteOffset, bv.byteLength};
 }
 
 double read_component(const unsigned char* p, int type, bool normalized) {
   switch (type) {
     case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      int8_t v; std::memcpy(&v, p, 1);
+      int8_t v;
+      std::memcpy(&v, p, 1);
       return normalized ? std::max(v / 127.0, -1.0) : v;
     }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return normalized ? p[0] / 255.0 : p[0];
     case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      int16_t v; std::memcpy(&v, p, 2);
+      int16_t v;
+      std::memcpy(&v, p, 2);
       return normalized ? std::max(v / 32767.0, -1.0) : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      uint16_t v; std::memcpy(&v, p, 2);
+      uint16_t v;
+      std::memcpy(&v, p, 2);
       return normalized ? v / 65535.0 : v;
     }
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
-      uint32_t v; std::memcpy(&v, p, 4);
+      uint32_t v;
+      std::memcpy(&v, p, 4);
       return v;
     }
     default: {
-      float v; std::memcpy(&v, p, 4);
+      float v;
+      std::memcpy(&v, p, 4);
       return v;
     }
   }
@@ -260,10 +278,17 @@ double read_component(const unsigned char* p, int type, bool normalized) {
 
 int component_size(int type) {
   switch (type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT: case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
   }
 }
 
@@ -279,7 +304,8 @@ void read_elements(Ctx& ctx, const std::string& who, int view, size_t offset, si
     ctx.fail(who + ": byteStride " + std::to_string(stride) + " is smaller than the element (" +
              std::to_string(esize) + " bytes)");
   if (count == 0) return;
-  if (offset > b.size || esize > b.size - offset || (count - 1) > (b.size - offset - esize) / stride)
+  if (offset > b.size || esize > b.size - offset ||
+      (count - 1) > (b.size - offset - esize) / stride)
     ctx.fail(who + ": " + std::to_string(count) + " elements of " + std::to_string(esize) +
              " bytes (stride " + std::to_string(stride) + ") from byte " + std::to_string(offset) +
              " do not fit in bufferView " + std::to_string(view) + " (" + std::to_string(b.size) +
@@ -287,7 +313,8 @@ void read_elements(Ctx& ctx, const std::string& who, int view, size_t offset, si
   for (size_t i = 0; i < count; ++i) {
     const unsigned char* p = b.data + offset + i * stride;
     double* dst = out + (targets ? (*targets)[i] : i) * size_t(ncomp);
-    for (int c = 0; c < ncomp; ++c) dst[c] = read_component(p + size_t(c) * csize, ctype, normalized);
+    for (int c = 0; c < ncomp; ++c)
+      dst[c] = read_component(p + size_t(c) * csize, ctype, normalized);
   }
 }
 
@@ -308,10 +335,31 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
     ctx.fail(who + ": unexpected type with " + std::to_string(ncomp) + " components");
   if (a.count > (size_t(1) << 28))
     ctx.fail(who + ": count " + std::to_string(a.count) + " is too large");
+  // Bound the count by the data before allocating (issue 18): with a bufferView, the elements must
+  // fit in it (checked exactly by read_elements); without one (zeros, maybe sparse), at most 2^24
+  // values, so that a small file cannot ask for gigabytes.
+  if (a.bufferView >= 0 && a.count > 0) {
+    Bytes b = view_bytes(ctx, a.bufferView, who);
+    size_t esize = size_t(component_size(a.componentType)) * size_t(ncomp);
+    size_t stride = size_t(a.bufferView) < ctx.model.bufferViews.size()
+                        ? ctx.model.bufferViews[a.bufferView].byteStride
+                        : 0;
+    if (stride < esize) stride = esize;
+    if (a.byteOffset > b.size || b.size - a.byteOffset < esize ||
+        a.count - 1 > (b.size - a.byteOffset - esize) / stride)
+      ctx.fail(who + ": " + std::to_string(a.count) + " elements of " + std::to_string(esize) +
+               " bytes (stride " + std::to_string(stride) + ") from byte " +
+               std::to_string(a.byteOffset) + " do not fit in bufferView " +
+               std::to_string(a.bufferView) + " (" + std::to_string(b.size) + " bytes)");
+  } else if (a.bufferView < 0 && a.count * size_t(ncomp) > (size_t(1) << 24)) {
+    ctx.fail(who + ": " + std::to_string(a.count) +
+             " elements without a bufferView (more than 2^24 values)");
+  }
   std::vector<double> out(a.count * size_t(ncomp), 0.0);
   if (a.bufferView >= 0) {
     size_t stride = ctx.model.bufferViews.size() > size_t(a.bufferView)
-                        ? ctx.model.bufferViews[a.bufferView].byteStride : 0;
+                        ? ctx.model.bufferViews[a.bufferView].byteStride
+                        : 0;
     read_elements(ctx, who, a.bufferView, a.byteOffset, stride, a.count, ncomp, a.componentType,
                   a.normalized, out.data());
   }
@@ -319,12 +367,14 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
     size_t n = size_t(std::max(a.sparse.count, 0));
     if (n > a.count) ctx.fail(who + ": sparse count exceeds the accessor count");
     int itype = a.sparse.indices.componentType;
-    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+    if (itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
         itype != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
       ctx.fail(who + ": bad sparse index componentType");
     std::vector<double> idx(n);
     read_elements(ctx, who + " sparse indices", a.sparse.indices.bufferView,
-                  size_t(std::max(a.sparse.indices.byteOffset, 0)), 0, n, 1, itype, false, idx.data());
+                  size_t(std::max(a.sparse.indices.byteOffset, 0)), 0, n, 1, itype, false,
+                  idx.data());
     std::vector<size_t> targets(n);
     for (size_t i = 0; i < n; ++i) {
       if (idx[i] >= double(a.count)) ctx.fail(who + ": sparse index out of range");
@@ -371,7 +421,8 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned, bool appea
       const auto& accs = ctx.model.accessors;
       if (size_t(prim.indices) < accs.size()) {
         int ct = accs[prim.indices].componentType;
-        if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        if (ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+            ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
             ct != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
           ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where +
                    "): componentType " + std::to_string(ct) + " is not an unsigned integer type");
@@ -385,9 +436,10 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned, bool appea
         idx[i] = uint32_t(raw[i]);
       }
       if (bad)
-        ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where + "): " +
-                 std::to_string(bad) + " indices out of range (largest " +
-                 std::to_string(uint64_t(worst)) + ", POSITION has " + std::to_string(nv) + " vertices)");
+        ctx.fail("accessor " + std::to_string(prim.indices) + " (indices of " + where +
+                 "): " + std::to_string(bad) + " indices out of range (largest " +
+                 std::to_string(uint64_t(worst)) + ", POSITION has " + std::to_string(nv) +
+                 " vertices)");
     } else {
       idx.resize(nv);
       for (size_t i = 0; i < nv; ++i) idx[i] = uint32_t(i);
@@ -427,8 +479,9 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned, bool appea
       std::string what = "POSITION of morph target " + std::to_string(ti) + " of " + where;
       auto d = read_accessor(ctx, t_it->second, what, nc, {3});
       if (d.size() != 3 * nv)
-        ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what + "): " +
-                 std::to_string(d.size() / 3) + " elements, but POSITION has " + std::to_string(nv));
+        ctx.fail("accessor " + std::to_string(t_it->second) + " (" + what +
+                 "): " + std::to_string(d.size() / 3) + " elements, but POSITION has " +
+                 std::to_string(nv));
       std::vector<Vec3> disp(nv);
       for (size_t v = 0; v < nv; ++v) {
         disp[v] = {d[3 * v], d[3 * v + 1], d[3 * v + 2]};
@@ -485,10 +538,14 @@ std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t
       const auto& ch = an.channels[ci];
       std::string where = "animation " + std::to_string(ai) + " channel " + std::to_string(ci);
       Channel c;
-      if (ch.target_path == "translation") c.path = 0;
-      else if (ch.target_path == "rotation") c.path = 1;
-      else if (ch.target_path == "scale") c.path = 2;
-      else if (ch.target_path == "weights") c.path = 3;
+      if (ch.target_path == "translation")
+        c.path = 0;
+      else if (ch.target_path == "rotation")
+        c.path = 1;
+      else if (ch.target_path == "scale")
+        c.path = 2;
+      else if (ch.target_path == "weights")
+        c.path = 3;
       else {
         ctx.warnings->push_back(ctx.path + ": " + where + ": target path '" + ch.target_path +
                                 "' is not supported; channel ignored");
@@ -499,8 +556,8 @@ std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t
       if (c.path == 3) {
         c.ncomp = node_targets[size_t(ch.target_node)];
         if (c.ncomp == 0)
-          ctx.fail(where + ": animates the morph weights of node " + std::to_string(ch.target_node) +
-                   ", which has no mesh with morph targets");
+          ctx.fail(where + ": animates the morph weights of node " +
+                   std::to_string(ch.target_node) + ", which has no mesh with morph targets");
       } else {
         c.ncomp = c.path == 1 ? 4 : 3;
       }
@@ -511,14 +568,14 @@ std::vector<Channel> read_channels(Ctx& ctx, int which, const std::vector<size_t
       c.interp = s.interpolation == "STEP" ? 1 : s.interpolation == "CUBICSPLINE" ? 2 : 0;
       int nc;
       c.times = read_accessor(ctx, s.input, "input of " + where, nc, {1});
-      c.values = read_accessor(ctx, s.output, "output of " + where, nc,
-                               {c.path == 3 ? 1 : int(c.ncomp)});
+      c.values =
+          read_accessor(ctx, s.output, "output of " + where, nc, {c.path == 3 ? 1 : int(c.ncomp)});
       size_t per_key = c.ncomp * (c.interp == 2 ? 3 : 1);
       if (c.times.empty() || c.values.size() != c.times.size() * per_key)
-        ctx.fail("accessor " + std::to_string(s.output) + " (output of " + where + "): " +
-                 std::to_string(c.values.size()) + " values, but " + std::to_string(c.times.size()) +
-                 " keys (accessor " + std::to_string(s.input) + ") need " +
-                 std::to_string(c.times.size() * per_key) +
+        ctx.fail("accessor " + std::to_string(s.output) + " (output of " + where +
+                 "): " + std::to_string(c.values.size()) + " values, but " +
+                 std::to_string(c.times.size()) + " keys (accessor " + std::to_string(s.input) +
+                 ") need " + std::to_string(c.times.size() * per_key) +
                  (c.path == 3 ? " (" + std::to_string(c.ncomp) + " morph weights per key" +
                                     (c.interp == 2 ? ", times 3 for CUBICSPLINE)" : ")")
                               : std::string()));
@@ -553,7 +610,7 @@ void sample(const Channel& c, double t, double* v) {
     for (size_t i = 0; i < n; ++i) {
       double p0 = val(k0, i), p1 = val(k, i);
       double m0 = dt * c.values[k0 * stride + 2 * n + i];  // out-tangent of k0
-      double m1 = dt * c.values[k * stride + i];          // in-tangent of k
+      double m1 = dt * c.values[k * stride + i];           // in-tangent of k
       v[i] = (2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 +
              (s3 - s2) * m1;
     }
@@ -591,19 +648,134 @@ void check_extensions(const Ctx& ctx) {
   }
   for (const auto& e : ctx.model.extensionsUsed)
     if (e == "EXT_mesh_gpu_instancing" || e == "KHR_draco_mesh_compression")
-      ctx.warnings->push_back(ctx.path + ": extension " + e + " is used but not supported; "
+      ctx.warnings->push_back(ctx.path + ": extension " + e +
+                              " is used but not supported; "
                               "geometry that relies on it is missing");
+}
+
+// --- External resources stay inside the asset's folder (issue 18) -------------------------------
+// A buffer or image `uri` that is not a data URI names a file relative to the folder of the .gltf
+// or .glb. tinygltf would open whatever it names ("../../../../etc/hostname", "/etc/passwd", a
+// symbolic link to anywhere) and its error would echo the size of that file. We reject, before
+// tinygltf sees the document, a uri that is absolute, has a `..` component (after tinygltf's own
+// %-decoding, '+' as a space), or resolves through a symbolic link to a file outside the folder;
+// the message names the uri only. tinygltf's file callbacks enforce the same containment again on
+// the path it actually opens.
+
+// tinygltf 2.7's URI decoding (dlib::urldecode): '+' is a space, %XX a byte.
+std::string decode_uri(const std::string& s) {
+  auto hex = [](char c) -> int {
+    if (c >= '0' && c <= '9') return c - '0';
+    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+    return 0;
+  };
+  std::string out;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '+') {
+      out += ' ';
+    } else if (s[i] == '%' && s.size() > i + 2) {
+      out += char((hex(s[i + 1]) << 4) | hex(s[i + 2]));
+      i += 2;
+    } else {
+      out += s[i];
+    }
+  }
+  return out;
+}
+
+// The canonical asset folder (symbolic links resolved), or "" if it cannot be resolved.
+std::filesystem::path asset_folder(const std::string& path) {
+  std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  std::filesystem::path real = std::filesystem::canonical(dir, ec);
+  return ec ? std::filesystem::path() : real;
+}
+
+// True if `p` (an existing file or not) resolves to a path inside `root` (canonical).
+bool resolves_inside(const std::filesystem::path& root, const std::filesystem::path& p) {
+  std::error_code ec;
+  std::filesystem::path real = std::filesystem::weakly_canonical(p, ec);
+  if (ec || root.empty()) return false;
+  std::filesystem::path rel = real.lexically_relative(root);
+  return !rel.empty() && *rel.begin() != ".." && !rel.is_absolute();
+}
+
+void check_external_uris(const Ctx& ctx) {
+  const std::filesystem::path root = asset_folder(ctx.path);
+  for (const char* kind : {"buffers", "images"}) {
+    if (!ctx.doc.contains(kind) || !ctx.doc[kind].is_array()) continue;
+    const json& list = ctx.doc[kind];
+    for (size_t i = 0; i < list.size(); ++i) {
+      if (!list[i].is_object() || !list[i].contains("uri") || !list[i]["uri"].is_string()) continue;
+      const std::string uri = list[i]["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0) continue;
+      std::string who = std::string(kind).substr(0, std::strlen(kind) - 1) + " " +
+                        std::to_string(i) + ": uri '" + uri.substr(0, 200) + "'";
+      const std::string decoded = decode_uri(uri);
+      std::filesystem::path rel(decoded);
+      if (decoded.empty()) ctx.fail(who + " is empty");
+      if (decoded.find('\0') != std::string::npos) ctx.fail(who + " contains a NUL byte");
+      if (rel.is_absolute() || rel.has_root_name() || rel.has_root_directory())
+        ctx.fail(who + " is an absolute path: external files must lie in the asset's folder");
+      for (const auto& part : rel)
+        if (part == "..") ctx.fail(who + " leaves the asset's folder ('..' is not allowed)");
+      if (!resolves_inside(root, root / rel))
+        ctx.fail(who + " resolves (through a symbolic link) outside the asset's folder");
+    }
+  }
+}
+
+// tinygltf file callbacks: only files that resolve inside the asset folder (user data) are seen.
+bool fs_file_exists(const std::string& abs, void* root) {
+  const auto& r = *static_cast<const std::filesystem::path*>(root);
+  std::error_code ec;
+  return resolves_inside(r, abs) && std::filesystem::is_regular_file(abs, ec);
+}
+
+std::string fs_expand(const std::string& p, void*) {
+  return p;
+}
+
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& abs,
+             void* root) {
+  const auto& r = *static_cast<const std::filesystem::path*>(root);
+  std::error_code ec;
+  std::filesystem::path real = std::filesystem::canonical(abs, ec);
+  if (ec || !resolves_inside(r, real) || !std::filesystem::is_regular_file(real, ec)) {
+    if (err) *err += "external file outside the asset's folder or not a regular file\n";
+    return false;
+  }
+  try {
+    std::string bytes = read_file(real.string());
+    out->assign(bytes.begin(), bytes.end());
+  } catch (const std::exception&) {
+    if (err) *err += "cannot read an external file\n";
+    return false;
+  }
+  return true;
+}
+
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is not allowed\n";
+  return false;
 }
 
 // Parses the container, rewrites meshopt fallback buffers and hands the file to tinygltf.
 void parse_file(Ctx& ctx) {
-  const std::string bytes = read_file(ctx.path);
+  // Memory (issue 18: a 200 MB .glb peaked at 1.29 GB): the file is read once and the GLB handed to
+  // tinygltf is rebuilt inside the same string (the BIN chunk is never copied); tinygltf's own copy
+  // of the BIN chunk is the only other one.
+  std::string bytes = read_file(ctx.path);
   bool glb = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
-  std::string json_text, bin;
+  std::string json_text;
   bool has_bin = false;
+  size_t bin_at = 0, bin_len = 0;  // the BIN chunk's payload in `bytes`
   if (glb) {
     if (bytes.size() < 20)
-      ctx.fail("truncated .glb: " + std::to_string(bytes.size()) + " bytes, less than a GLB header");
+      ctx.fail("truncated .glb: " + std::to_string(bytes.size()) +
+               " bytes, less than a GLB header");
     uint32_t version = rd32(bytes, 4), length = rd32(bytes, 8);
     if (version != 2) ctx.fail("unsupported GLB version " + std::to_string(version));
     if (length > bytes.size())
@@ -613,20 +785,24 @@ void parse_file(Ctx& ctx) {
     for (int chunk = 0; at + 8 <= length; ++chunk) {
       uint32_t clen = rd32(bytes, at), ctype = rd32(bytes, at + 4);
       if (clen > length - at - 8)
-        ctx.fail("truncated .glb: chunk " + std::to_string(chunk) + " at byte " + std::to_string(at) +
-                 " declares " + std::to_string(clen) + " bytes, past the end of the file");
-      if (chunk == 0 && ctype != 0x4E4F534Au) ctx.fail("malformed .glb: the first chunk is not JSON");
+        ctx.fail("truncated .glb: chunk " + std::to_string(chunk) + " at byte " +
+                 std::to_string(at) + " declares " + std::to_string(clen) +
+                 " bytes, past the end of the file");
+      if (chunk == 0 && ctype != 0x4E4F534Au)
+        ctx.fail("malformed .glb: the first chunk is not JSON");
       if (chunk == 0) json_text = bytes.substr(at + 8, clen);
-      if (chunk == 1 && ctype == 0x004E4942u) bin = bytes.substr(at + 8, clen), has_bin = true;
+      if (chunk == 1 && ctype == 0x004E4942u) bin_at = at + 8, bin_len = clen, has_bin = true;
       at += 8 + size_t(clen);
       at = (at + 3) & ~size_t(3);
     }
     if (at == 12) ctx.fail("malformed .glb: no JSON chunk");
   } else {
-    json_text = bytes;
+    json_text.swap(bytes);
   }
   try {
     ctx.doc = json::parse(json_text);
+    json_text.clear();
+    json_text.shrink_to_fit();
   } catch (const json::exception& e) {
     ctx.fail(std::string("invalid JSON: ") + e.what());
   }
@@ -645,32 +821,46 @@ void parse_file(Ctx& ctx) {
   for (const auto& v : ctx.doc["bufferViews"])
     if (!v.is_object()) ctx.fail("invalid glTF: a bufferView is not an object");
 
+  check_external_uris(ctx);
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(image_loader_noop, nullptr);
+  const std::filesystem::path root = asset_folder(ctx.path);
+  loader.SetFsCallbacks({&fs_file_exists, &fs_expand, &fs_read, &fs_write,
+                         const_cast<std::filesystem::path*>(&root)});
   std::string err, warn, text = ctx.doc.dump();
   std::string base = std::filesystem::path(ctx.path).parent_path().string();
   bool ok;
   try {
     if (glb) {
-      std::string out(12, '\0');
-      auto put = [&](uint32_t v) { out.append(reinterpret_cast<const char*>(&v), 4); };
+      // [header 12][JSON chunk header 8][text][BIN chunk header 8][BIN], built in `bytes`: the
+      // part before the BIN payload is replaced, what follows the BIN chunk is cut.
       while (text.size() % 4) text += ' ';
-      put(uint32_t(text.size()));
-      put(0x4E4F534Au);
-      out += text;
+      std::string head(12, '\0');
+      auto put = [](std::string& o, uint32_t v) { o.append(reinterpret_cast<const char*>(&v), 4); };
+      put(head, uint32_t(text.size()));
+      put(head, 0x4E4F534Au);
+      head += text;
       if (has_bin) {
-        while (bin.size() % 4) bin += '\0';
-        put(uint32_t(bin.size()));
-        put(0x004E4942u);
-        out += bin;
+        size_t padded = (bin_len + 3) & ~size_t(3);
+        put(head, uint32_t(padded));
+        put(head, 0x004E4942u);
+        bytes.resize(bin_at + bin_len);
+        bytes.replace(0, bin_at, head);
+        bytes.resize(head.size() + padded, '\0');
+      } else {
+        bytes.swap(head);
       }
-      uint32_t head[3] = {0x46546C67u, 2u, uint32_t(out.size())};
-      std::memcpy(&out[0], head, 12);
+      text.clear();
+      text.shrink_to_fit();
+      if (bytes.size() > 0xFFFFFFFFu) ctx.fail(".glb larger than 4 GiB");
+      uint32_t header[3] = {0x46546C67u, 2u, uint32_t(bytes.size())};
+      std::memcpy(&bytes[0], header, 12);
       ok = loader.LoadBinaryFromMemory(&ctx.model, &err, &warn,
-                                       reinterpret_cast<const unsigned char*>(out.data()),
-                                       unsigned(out.size()), base);
+                                       reinterpret_cast<const unsigned char*>(bytes.data()),
+                                       unsigned(bytes.size()), base);
     } else {
-      ok = loader.LoadASCIIFromString(&ctx.model, &err, &warn, text.c_str(), unsigned(text.size()), base);
+      ok = loader.LoadASCIIFromString(&ctx.model, &err, &warn, text.c_str(), unsigned(text.size()),
+                                      base);
     }
   } catch (const std::exception& e) {
     ok = false;
@@ -829,10 +1019,13 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     std::copy(nd.translation.begin(), nd.translation.end(), rest[n].t);
     std::copy(nd.rotation.begin(), nd.rotation.end(), rest[n].r);
     std::copy(nd.scale.begin(), nd.scale.end(), rest[n].s);
-    if (nd.mesh >= int(model.meshes.size())) ctx.fail(who + ": mesh " + std::to_string(nd.mesh) + " does not exist");
-    if (nd.skin >= int(model.skins.size())) ctx.fail(who + ": skin " + std::to_string(nd.skin) + " does not exist");
+    if (nd.mesh >= int(model.meshes.size()))
+      ctx.fail(who + ": mesh " + std::to_string(nd.mesh) + " does not exist");
+    if (nd.skin >= int(model.skins.size()))
+      ctx.fail(who + ": skin " + std::to_string(nd.skin) + " does not exist");
     for (int c : nd.children) {
-      if (c < 0 || size_t(c) >= N) ctx.fail(who + ": child " + std::to_string(c) + " does not exist");
+      if (c < 0 || size_t(c) >= N)
+        ctx.fail(who + ": child " + std::to_string(c) + " does not exist");
       if (parent[c] != -1 || size_t(c) == n)
         ctx.fail("node " + std::to_string(c) + " has more than one parent (or is its own child)");
       parent[c] = int(n);
@@ -847,11 +1040,12 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     for (size_t pi = 1; pi < mesh.primitives.size(); ++pi)
       if (mesh.primitives[pi].targets.size() != mesh_targets[m])
         ctx.fail("mesh " + std::to_string(m) + ": primitive " + std::to_string(pi) + " has " +
-                 std::to_string(mesh.primitives[pi].targets.size()) + " morph targets, primitive 0 has " +
-                 std::to_string(mesh_targets[m]));
+                 std::to_string(mesh.primitives[pi].targets.size()) +
+                 " morph targets, primitive 0 has " + std::to_string(mesh_targets[m]));
     if (!mesh.weights.empty() && mesh.weights.size() != mesh_targets[m])
-      ctx.fail("mesh " + std::to_string(m) + ": weights has " + std::to_string(mesh.weights.size()) +
-               " numbers, but the mesh has " + std::to_string(mesh_targets[m]) + " morph targets");
+      ctx.fail("mesh " + std::to_string(m) + ": weights has " +
+               std::to_string(mesh.weights.size()) + " numbers, but the mesh has " +
+               std::to_string(mesh_targets[m]) + " morph targets");
   }
   std::vector<size_t> node_targets(N, 0);
   std::vector<std::vector<double>> rest_weights(N);
@@ -878,9 +1072,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
   std::vector<int> roots;
   if (!model.scenes.empty()) {
     int si = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (size_t(si) >= model.scenes.size()) ctx.fail("default scene " + std::to_string(si) + " does not exist");
+    if (size_t(si) >= model.scenes.size())
+      ctx.fail("default scene " + std::to_string(si) + " does not exist");
     for (int r : model.scenes[si].nodes) {
-      if (r < 0 || size_t(r) >= N) ctx.fail("scene " + std::to_string(si) + ": node " + std::to_string(r) + " does not exist");
+      if (r < 0 || size_t(r) >= N)
+        ctx.fail("scene " + std::to_string(si) + ": node " + std::to_string(r) + " does not exist");
       roots.push_back(r);
     }
   } else {
@@ -902,10 +1098,17 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
 
   // Animation channels and sample times.
   std::vector<Channel> channels;
-  if (options.states > 1 || options.animation >= 0) channels = read_channels(ctx, options.animation, node_targets);
+  if (options.states > 1 || options.animation >= 0)
+    channels = read_channels(ctx, options.animation, node_targets);
   double t_end = 0;
-  for (const auto& c : channels) t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
+  for (const auto& c : channels)
+    t_end = std::max(t_end, *std::max_element(c.times.begin(), c.times.end()));
   size_t K = options.states > 1 && !channels.empty() ? size_t(options.states) : 1;
+  if (options.states <= 1 && !model.animations.empty())
+    ctx.warnings->push_back(
+        ctx.path + ": " + std::to_string(model.animations.size()) +
+        " animation(s) ignored: loaded static, in the rest pose; sample them into key "
+        "states with --states K (e.g. --states 9)");
 
   // World matrices and morph weights of all nodes in each state.
   std::vector<std::vector<Mat4>> world(K, std::vector<Mat4>(N));
@@ -920,7 +1123,10 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
           continue;
         }
         if (local[c.node].has_matrix) continue;  // animated nodes must use TRS (glTF 2.0 §5.25)
-        sample(c, t, c.path == 0 ? local[c.node].t : c.path == 1 ? local[c.node].r : local[c.node].s);
+        sample(c, t,
+               c.path == 0   ? local[c.node].t
+               : c.path == 1 ? local[c.node].r
+                             : local[c.node].s);
       }
     }
     std::vector<char> done(N, 0);
@@ -941,6 +1147,33 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
   }
   Scene scene;
   scene.positions.resize(K);
+  // Memory: the scene's arrays are reserved from the accessor counts (an upper bound: skipped
+  // primitives are counted too), so they never grow by doubling; a decoded mesh is released after
+  // its last instance.
+  std::vector<size_t> uses(model.meshes.size(), 0);
+  size_t vertex_bound = 0, triangle_bound = 0;
+  for (int n : instances) {
+    const auto& mesh = model.meshes[size_t(model.nodes[n].mesh)];
+    ++uses[size_t(model.nodes[n].mesh)];
+    for (const auto& prim : mesh.primitives) {
+      auto count = [&](int acc) {
+        return acc >= 0 && size_t(acc) < model.accessors.size() ? model.accessors[size_t(acc)].count
+                                                                : size_t(0);
+      };
+      auto pos = prim.attributes.find("POSITION");
+      size_t nv = pos == prim.attributes.end() ? 0 : count(pos->second);
+      size_t ni = prim.indices >= 0 ? count(prim.indices) : nv;
+      vertex_bound += nv;
+      triangle_bound += prim.mode == 4 || prim.mode == -1  ? ni / 3
+                        : prim.mode == 5 || prim.mode == 6 ? ni
+                                                           : 0;
+    }
+  }
+  if (vertex_bound < (size_t(1) << 32) && triangle_bound < (size_t(1) << 32)) {
+    for (auto& state : scene.positions) state.reserve(vertex_bound);
+    scene.triangles.reserve(triangle_bound);
+    scene.triangle_object.reserve(triangle_bound);
+  }
   std::vector<std::vector<Prim>> mesh_cache(model.meshes.size());
   std::vector<char> mesh_cached(model.meshes.size(), 0);
   for (int n : instances) {
@@ -950,7 +1183,15 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       mesh_cache[nd.mesh] = decode_mesh(ctx, nd.mesh, skinned, appearance != nullptr);
       mesh_cached[nd.mesh] = 1;
     }
-    std::string name = !nd.name.empty() ? nd.name
+    // Released at the end of this iteration if this is the mesh's last instance.
+    struct Release {
+      std::vector<Prim>& prims;
+      bool last;
+      ~Release() {
+        if (last) std::vector<Prim>().swap(prims);
+      }
+    } release{mesh_cache[nd.mesh], --uses[size_t(nd.mesh)] == 0};
+    std::string name = !nd.name.empty()                      ? nd.name
                        : !model.meshes[nd.mesh].name.empty() ? model.meshes[nd.mesh].name
                                                              : "node" + std::to_string(n);
     uint32_t obj = uint32_t(scene.objects.size());
@@ -962,14 +1203,16 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       std::vector<double> ibm;
       int nc;
       if (skin.inverseBindMatrices >= 0)
-        ibm = read_accessor(ctx, skin.inverseBindMatrices, "inverseBindMatrices of skin " +
-                            std::to_string(nd.skin), nc, {16});
+        ibm = read_accessor(ctx, skin.inverseBindMatrices,
+                            "inverseBindMatrices of skin " + std::to_string(nd.skin), nc, {16});
       if (!ibm.empty() && ibm.size() < 16 * skin.joints.size())
         ctx.fail("skin " + std::to_string(nd.skin) + ": fewer inverse bind matrices than joints");
       joint_m.assign(K, std::vector<Mat4>(skin.joints.size()));
       for (size_t j = 0; j < skin.joints.size(); ++j) {
         int jn = skin.joints[j];
-        if (jn < 0 || size_t(jn) >= N) ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) + " does not exist");
+        if (jn < 0 || size_t(jn) >= N)
+          ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) +
+                   " does not exist");
         Mat4 inv;
         if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inv.m);
         for (size_t k = 0; k < K; ++k) joint_m[k][j] = world[k][jn] * inv;
@@ -988,7 +1231,8 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
           morphed = p.local;
           for (size_t ti = 0; ti < p.targets.size(); ++ti) {
             if (w[ti] == 0 || p.targets[ti].empty()) continue;
-            for (size_t v = 0; v < morphed.size(); ++v) morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
+            for (size_t v = 0; v < morphed.size(); ++v)
+              morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
           }
           local = &morphed;
         }
@@ -1014,7 +1258,8 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
         }
       }
       for (auto t : p.tris) {
-        scene.triangles.push_back({uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
+        scene.triangles.push_back(
+            {uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
         scene.triangle_object.push_back(obj);
       }
       if (appearance) {

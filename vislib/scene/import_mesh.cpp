@@ -1,5 +1,6 @@
-// import_mesh.cpp: polygon-soup formats. PLY, OFF and STL are read through OpenMesh; OBJ is read
-// by our own reader below.
+// import_mesh.cpp: polygon-soup formats, all read by the project's own readers: OBJ below, PLY,
+// OFF and STL in vislib/scene/import_{ply,off,stl}.cpp. (OpenMesh's PLY and OFF readers crashed,
+// hung or allocated gigabytes on small malformed files, issue 18.)
 //
 // Why our own OBJ reader: OpenMesh's OBJ reader drops `g`/`o` statements, so the groups that name
 // the objects of a level (Sauerbraten exports one group per material slot) would be lost, and it
@@ -10,8 +11,6 @@
 // r g b]`, and `\` line continuations. Each distinct `g`/`o` name becomes one Object (the latest
 // statement names the current object; repeating a name returns to that object); faces before any
 // statement go to "default". Vertices keep their file order (vertex i = the i-th `v` line).
-#include <OpenMesh/Core/IO/MeshIO.hh>
-#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -130,43 +129,15 @@ Scene load_obj(const std::string& path, std::vector<std::string>& warnings) {
   return scene;
 }
 
-// PLY, OFF, STL: OpenMesh reads them into a polygon mesh; faces are fan-triangulated in face
-// order, all in one object named after the file stem. OpenMesh may drop faces it cannot add to a
-// half-edge mesh (it reports them on stderr); such faces are then missing from the scene.
-Scene load_openmesh(const std::string& path, std::vector<std::string>& warnings) {
-  read_file(path);  // throws InputError if missing or unreadable
-  OpenMesh::PolyMesh_ArrayKernelT<> mesh;
-  OpenMesh::IO::Options opt;
-  if (!OpenMesh::IO::read_mesh(mesh, path, opt))
-    throw InputError(path, "OpenMesh could not read this file (malformed or unsupported variant)");
-  Scene scene;
-  scene.positions.resize(1);
-  for (auto v : mesh.vertices()) {
-    auto p = mesh.point(v);
-    Vec3 q{double(p[0]), double(p[1]), double(p[2])};
-    if (!is_finite(q))
-      throw InputError(path, "vertex " + std::to_string(v.idx()) + " has a non-finite coordinate");
-    scene.positions[0].push_back(q);
-  }
-  scene.objects.push_back({std::filesystem::path(path).stem().string()});
-  std::vector<uint32_t> face;
-  for (auto f : mesh.faces()) {
-    face.clear();
-    for (auto v : mesh.fv_range(f)) face.push_back(uint32_t(v.idx()));
-    for (size_t i = 1; i + 1 < face.size(); ++i) {
-      scene.triangles.push_back({face[0], face[i], face[i + 1]});
-      scene.triangle_object.push_back(0);
-    }
-  }
-  if (mesh.n_faces() == 0) warnings.push_back(path + ": no faces");
-  return scene;
-}
-
 }  // namespace
 
 Scene load_mesh(const std::string& path, std::vector<std::string>& warnings) {
-  if (file_extension(path) == ".obj") return load_obj(path, warnings);
-  return load_openmesh(path, warnings);
+  std::string ext = file_extension(path);
+  if (ext == ".obj") return load_obj(path, warnings);
+  if (ext == ".ply") return load_ply(path, warnings);
+  if (ext == ".off") return load_off(path, warnings);
+  if (ext == ".stl") return load_stl(path, warnings);
+  throw InputError(path, "not a polygon-soup format (.obj .ply .off .stl)");
 }
 
 }  // namespace vislib

@@ -1,15 +1,21 @@
 // import_spheres.cpp: the sphere text format (docs/sphere-format.md).
 //   vislib-spheres 1
 //   states K
+//   mesh PATH                                                 (any number, after 'states')
 //   radius x0 y0 z0 [x1 y1 z1 ... x(K-1) y(K-1) z(K-1)]      (one line per sphere)
 // '#' starts a comment (to end of line); blank lines are ignored. Sphere i is Object "sphere<i>".
+// A `mesh` line adds a static mesh file (any other format, PATH relative to this file's folder):
+// its triangles and objects come first, in line order, then the spheres (the paper's bouncing
+// spheres over a ground).
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/scene/import.h"
 #include "vislib/scene/import_formats.h"
 
 namespace vislib {
@@ -43,6 +49,7 @@ Scene load_spheres(const std::string& path, std::vector<std::string>& warnings) 
   size_t line_no = 0;
   int stage = 0;  // 0: expect magic, 1: expect states, 2: spheres
   size_t K = 0;
+  std::vector<Scene> meshes;
   auto fail = [&](const std::string& what) {
     throw InputError(path, "line " + std::to_string(line_no) + ": " + what);
   };
@@ -63,6 +70,19 @@ Scene load_spheres(const std::string& path, std::vector<std::string>& warnings) 
       K = size_t(k);
       scene.sphere_centers.resize(K);
       stage = 2;
+    } else if (tok[0] == "mesh") {
+      if (tok.size() != 2) fail("expected 'mesh PATH' (one path without spaces)");
+      std::filesystem::path mp(tok[1]);
+      if (mp.is_relative()) mp = std::filesystem::path(path).parent_path() / mp;
+      if (mp.extension() == ".spheres")
+        fail("a mesh line cannot name a sphere file ('" + tok[1] + "')");
+      try {
+        meshes.push_back(load_scene(mp.string(), LoadOptions{}, &warnings));
+      } catch (const InputError& e) {
+        fail("mesh '" + tok[1] + "': " + e.what());
+      }
+      if (meshes.back().is_dynamic())
+        fail("mesh '" + tok[1] + "' is animated; only static meshes can be added");
     } else {
       if (tok.size() != 1 + 3 * K)
         fail("expected " + std::to_string(1 + 3 * K) + " numbers (radius and " + std::to_string(K) +
@@ -83,7 +103,12 @@ Scene load_spheres(const std::string& path, std::vector<std::string>& warnings) 
   if (stage == 0) throw InputError(path, "empty file: expected the header 'vislib-spheres 1'");
   if (stage == 1) throw InputError(path, "missing the 'states K' line after the header");
   if (scene.sphere_radius.empty()) warnings.push_back(path + ": no spheres");
-  return scene;
+  if (meshes.empty()) return scene;
+  Scene out = std::move(meshes[0]);
+  for (size_t m = 1; m < meshes.size(); ++m) append_scene(out, meshes[m]);
+  append_scene(out,
+               scene);  // triangles first, then the spheres: the one id rule (bake/id_universe.h)
+  return out;
 }
 
 }  // namespace vislib

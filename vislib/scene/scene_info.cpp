@@ -28,6 +28,12 @@ std::array<uint64_t, 3> bits_of(Vec3 p) {
 
 }  // namespace
 
+bool far_from_origin(const Box3& b) {
+  if (b.empty()) return false;
+  double offset = length((b.min + b.max) * 0.5), diagonal = length(b.max - b.min);
+  return offset > kFarFromOriginUnits && offset > kFarFromOriginDiagonals * diagonal;
+}
+
 SceneInfo scene_info(const Scene& s) {
   SceneInfo info;
   info.triangles = s.triangle_count();
@@ -38,10 +44,8 @@ SceneInfo scene_info(const Scene& s) {
   info.dynamic = s.is_dynamic();
   info.bbox = s.bounds();
   if (!info.bbox.empty()) info.diagonal = length(info.bbox.max - info.bbox.min);
-  double d = info.diagonal;
-  info.units_guess = (d >= 0.1 && d <= 3000)     ? "meters (likely)"
-                     : (d > 3000 && d <= 300000) ? "centimeters (likely)"
-                                                 : "unknown";
+  if (!info.bbox.empty()) info.origin_offset = length((info.bbox.min + info.bbox.max) * 0.5);
+  info.far_from_origin = far_from_origin(info.bbox);
   size_t n = s.vertex_count();
   for (size_t v = 0; v < n; ++v)
     for (const auto& state : s.positions)
@@ -86,7 +90,8 @@ std::string to_json(const SceneInfo& info, int indent) {
                  {"max", {info.bbox.max.x, info.bbox.max.y, info.bbox.max.z}}};
   }
   j["diagonal"] = info.diagonal;
-  j["units_guess"] = info.units_guess;
+  j["origin_offset"] = info.origin_offset;
+  j["far_from_origin"] = info.far_from_origin;
   j["degenerate_triangles"] = info.degenerate_triangles;
   j["nonfinite_vertices"] = info.nonfinite_vertices;
   j["duplicate_vertices"] = info.duplicate_vertices;

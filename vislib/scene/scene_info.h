@@ -13,9 +13,12 @@ struct SceneInfo {
   bool dynamic = false;
   Box3 bbox;  // over all states, spheres with their radius (Scene::bounds); empty for an empty scene
   double diagonal = 0;  // length of the bbox diagonal (0 if empty)
-  // From the diagonal, in file units: [0.1, 3000] "meters (likely)", (3000, 300000]
-  // "centimeters (likely)", else "unknown". A guess for the reader, never used in computation.
-  std::string units_guess;
+  // No units claim: mesh formats record none, and a guess from the size alone was wrong on real
+  // scenes (a millimetre hotel room taken for centimetres, Sauerbraten maps for metres).
+  // Distance of the bbox centre from the origin, in file units, and whether that makes the scene
+  // lie far from the origin (far_from_origin below).
+  double origin_offset = 0;
+  bool far_from_origin = false;
   // Hygiene, in state 0 unless said otherwise.
   size_t degenerate_triangles = 0;  // a repeated index or zero area (|cross| == 0, in double)
   size_t nonfinite_vertices = 0;    // vertices with a NaN/inf coordinate in any state
@@ -23,14 +26,23 @@ struct SceneInfo {
   size_t out_of_range_indices = 0;  // triangle corners >= vertex count (0 after a successful import)
 };
 
+// True when a scene with bounding box `bbox` lies far from the origin: its centre farther than
+// kFarFromOriginDiagonals diagonals and than kFarFromOriginUnits units. vislib re-centres and
+// works in double (exact enough), but float32 consumers (the Embree baseline and oracle, renderers,
+// engines) lose precision there: at 1e5, float32 steps are 7.8 mm.
+constexpr double kFarFromOriginDiagonals = 10;
+constexpr double kFarFromOriginUnits = 1e4;
+bool far_from_origin(const Box3& bbox);
+
 // Computes the statistics. Works on any Scene, even one that breaks the scene.h contract
 // (out-of-range indices are counted, never followed). Deterministic; O(V + T) expected time.
 SceneInfo scene_info(const Scene& scene);
 
 // JSON object (a string, to keep nlohmann out of this header) with the keys `triangles`,
 // `vertices`, `objects`, `states`, `spheres`, `dynamic`, `bbox` ({"min":[x,y,z],"max":[x,y,z]}
-// or null), `diagonal`, `units_guess`, `degenerate_triangles`, `nonfinite_vertices`,
-// `duplicate_vertices`, `out_of_range_indices`. `indent` as in nlohmann::json::dump.
+// or null), `diagonal`, `origin_offset`, `far_from_origin`, `degenerate_triangles`,
+// `nonfinite_vertices`, `duplicate_vertices`, `out_of_range_indices`. `indent` as in
+// nlohmann::json::dump.
 std::string to_json(const SceneInfo& info, int indent = 2);
 
 }  // namespace vislib

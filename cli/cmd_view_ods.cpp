@@ -1,0 +1,300 @@
+// pvs view --ods: the omnidirectional stereo panoramas (omnidirectional-stereo.txt, issue 14) of
+// the PVS cells that cover the viewing disc at --at, the full-scene truth with the same settings,
+// and the metrics. Options and output documented in docs/ods.md.
+#include "cli/options.h"
+#include "cli/cmd_view_ods.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "cli/commands.h"
+#include "cli/load_scene.h"
+#include "pvs_format/pvs_format.h"
+#include "runtime/ods.h"
+#include "runtime/pvs_runtime.h"
+#include "vislib/base/error.h"
+#include "vislib/base/file_util.h"
+#include "vislib/eval/embree_scene.h"
+#include "vislib/eval/image_io.h"
+#include "vislib/eval/metrics.h"
+#include "vislib/render/near_far_render.h"
+#include "vislib/render/ods_render.h"
+#include "vislib/scene/scene_fingerprint.h"
+
+namespace pvs_cli {
+namespace {
+
+using nlohmann::json;
+using pvs_runtime::Eye;
+
+std::string sibling(const std::string& out, const std::string& suffix) {
+  std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
+}
+
+pvs_runtime::PoleMerge parse_pole_merge(const std::string& text) {
+  pvs_runtime::PoleMerge m;
+  if (text.empty()) return m;
+  const size_t colon = text.find(':');
+  auto side = [&](const std::string& part) {
+    const std::vector<double> v = parse_doubles(part, "--pole-merge", 3);
+    if (!(v[1] >= 0 && v[1] <= v[0] && v[0] <= 90 && v[2] > 0 && std::isfinite(v[2])))
+      throw CLI::ValidationError("--pole-merge",
+                                 "expected start,end,exponent with 0 <= end <= start <= 90 "
+                                 "(degrees from the pole) and exponent > 0, got '" +
+                                     part + "'");
+    return pvs_runtime::PoleMergeSide{v[0], v[1], v[2]};
+  };
+  m.top = side(text.substr(0, colon));
+  m.bottom = colon == std::string::npos ? m.top : side(text.substr(colon + 1));
+  return m;
+}
+
+json side_json(const pvs_runtime::PoleMergeSide& s) {
+  return {{"start_deg", s.start_deg}, {"end_deg", s.end_deg}, {"exponent", s.exponent}};
+}
+
+json quality_json(const vislib::Frame& truth, const vislib::Frame& test) {
+  const vislib::FrameQuality q = vislib::frame_quality(truth, test);
+  size_t other = 0;
+  for (size_t p = 0; p < truth.pixel_count(); ++p) other += truth.tri[p] != test.tri[p];
+  return {{"epsilon", q.epsilon},
+          {"missed_pixels", q.missed_pixels},
+          {"psnr", std::isfinite(q.psnr) ? json(q.psnr) : json(nullptr)},
+          {"ssim", q.ssim},
+          {"triangle_mismatch", double(other) / double(truth.pixel_count())}};
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void add_ods_view_options(CLI::App* cmd, const std::shared_ptr<OdsViewArgs>& a) {
+  cmd->add_flag("--ods", a->enabled,
+                "Render omnidirectional stereo panoramas (left, right, top-bottom, anaglyph) from "
+                "--at instead of "
+                "the near-far frame; --look is then not needed (docs/ods.md)");
+  cmd->add_option("--ipd", a->ipd_m, "--ods: interpupillary distance in metres")
+      ->check(in_range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option(
+         "--units-per-metre", a->units_per_metre,
+         "--ods: scene units in one metre (the IPD is multiplied by it; glTF is in metres: 1)")
+      ->check(positive())
+      ->capture_default_str();
+  cmd->add_option("--ods-size", a->size, "--ods: panorama width W in pixels (height W/2), even")
+      ->check(in_range(16, 16384))
+      ->capture_default_str();
+  cmd->add_option("--pole-merge", a->pole_merge,
+                  "--ods: pole merging (Eq. 6) start,end,exponent for both poles or top:bottom, "
+                  "angles in degrees "
+                  "from the pole (e.g. 45,0,3); default none");
+  cmd->add_option("--ods-method", a->method,
+                  "--ods: rays (Embree reference), raster-paper (the paper's per-vertex Eq. 5) or "
+                  "raster-exact "
+                  "(exact tangent-ray projection), both rasterised after Alg. 1 tessellation and "
+                  "seam/pole split")
+      ->check(CLI::IsMember({"rays", "raster-paper", "raster-exact"}))
+      ->capture_default_str();
+  cmd->add_option("--ods-tessellation", a->tessellation,
+                  "--ods raster methods: 0 = dynamic (Alg. 1 + Eq. 4), k = static level k for "
+                  "every triangle")
+      ->check(in_range(0, 64))
+      ->capture_default_str();
+}
+
+void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
+  if (o.size % 2 != 0)
+    throw CLI::ValidationError("--ods-size", "must be even (height = width / 2)");
+  const pvs_runtime::PoleMerge merge = parse_pole_merge(o.pole_merge);
+  const vislib::Vec3 eye = parse_vec3(c.at, "--at");
+  const double ipd = o.ipd_m * o.units_per_metre;  // scene units
+  const double radius = 0.5 * ipd;
+
+  vislib::Scene full_scene = load_scene_for_cli(c.scene, c.states);
+  pvs_runtime::OpenOptions opt;
+  opt.expected_fingerprint = vislib::scene_fingerprint(full_scene);
+  std::vector<uint32_t> tris, cells;
+  uint32_t cell = 0;
+  bool disc_in_region = false, disc_covered = false;
+  try {
+    pvs_runtime::Pvs pvs = pvs_runtime::Pvs::open(c.file, opt);
+    const pvs::FileInfo& info = pvs.info();
+    const bool object = info.granularity == pvs::Granularity::Object;
+    if ((object ? full_scene.objects.size() : full_scene.triangle_count()) != info.universe)
+      throw vislib::InputError(
+          c.file, "universe " + std::to_string(info.universe) + " differs from the scene's");
+    const double q[3] = {eye.x, eye.y, eye.z};
+    const std::optional<uint32_t> found = pvs.find_cell(q);
+    if (!found) {
+      std::fprintf(stderr, "pvs: error: no cell contains %s\n", c.at.c_str());
+      throw Exit{2};
+    }
+    cell = *found;
+    const pvs_runtime::Point3 centre{eye.x, eye.y, eye.z};
+    const pvs::Box region = info.layout.view_region(cell);
+    disc_in_region = pvs_runtime::disc_inside_box(centre, radius, region.min, region.max);
+    cells.push_back(cell);
+    if (!disc_in_region)
+      for (uint32_t n : pvs.neighbours(cell, radius)) {
+        const pvs::Box r = info.layout.view_region(n);
+        if (pvs_runtime::disc_touches_box(centre, radius, r.min, r.max)) cells.push_back(n);
+      }
+    // Covered: the centre and 64 points of the rim lie in the view region of a used cell.
+    disc_covered = true;
+    for (int k = -1; k < 64 && disc_covered; ++k) {
+      const double a = 2 * pvs_runtime::kOdsPi * k / 64;
+      const double p[3] = {eye.x + (k < 0 ? 0 : radius * std::cos(a)), eye.y,
+                           eye.z + (k < 0 ? 0 : radius * std::sin(a))};
+      bool in = false;
+      for (uint32_t u : cells) {
+        const pvs::Box r = info.layout.view_region(u);
+        in = in || (p[0] >= r.min[0] && p[0] <= r.max[0] && p[1] >= r.min[1] && p[1] <= r.max[1] &&
+                    p[2] >= r.min[2] && p[2] <= r.max[2]);
+      }
+      disc_covered = in;
+    }
+    std::vector<uint8_t> keep(info.universe, 0);
+    for (uint32_t u : cells) {
+      if (pvs.is_absent(u)) {
+        std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", u);
+        throw Exit{2};
+      }
+      for (uint32_t id : pvs.visible_ids(u)) keep[id] = 1;
+    }
+    for (uint32_t t = 0; t < full_scene.triangle_count(); ++t)
+      if (keep[object ? full_scene.triangle_object[t] : t]) tris.push_back(t);
+  } catch (const pvs_runtime::OpenError& e) {
+    throw vislib::InputError(c.file, e.what());
+  } catch (const pvs::FormatError& e) {
+    throw vislib::InputError(c.file, e.what());
+  }
+
+  const vislib::Scene scene = vislib::scene_at(full_scene, c.tau);
+  vislib::OdsSettings s;
+  s.centre = eye;
+  s.ipd = ipd;
+  s.merge = merge;
+  s.width = o.size;
+  s.height = o.size / 2;
+  const auto t_build = std::chrono::steady_clock::now();
+  vislib::EmbreeScene rt(scene, 0.0, eye);  // BVH re-centred at the panorama centre
+  const double build_seconds = seconds_since(t_build);
+  const std::vector<uint8_t> mask = vislib::triangle_mask(scene.triangle_count(), tris);
+  std::vector<uint32_t> all(scene.triangle_count());
+  for (uint32_t t = 0; t < all.size(); ++t) all[t] = t;
+
+  vislib::OdsRasterSettings raster;
+  raster.formula =
+      o.method == "raster-paper" ? vislib::OdsFormula::Paper : vislib::OdsFormula::Exact;
+  raster.static_level = o.tessellation;
+  const bool rays = o.method == "rays";
+  json counts = json::object(), seconds = json::object();
+  // Renders one eye of the triangles `ids` (mask for rays) with the chosen method.
+  auto render = [&](Eye e, bool full, const char* name) {
+    const auto t0 = std::chrono::steady_clock::now();
+    vislib::Frame f;
+    if (rays) {
+      f = vislib::render_ods_rays(scene, rt, s, e, full ? nullptr : mask.data());
+      counts[name] = {{"rays", size_t(s.width) * size_t(s.height)}};
+    } else {
+      vislib::OdsRasterStats st;
+      f = vislib::render_ods_raster(scene, full ? all : tris, s, e, raster, &st);
+      counts[name] = {{"input_triangles", st.input_triangles},
+                      {"tessellated", st.tessellated},
+                      {"drawn", st.drawn},
+                      {"pole_triangles", st.pole_triangles},
+                      {"dropped_inside_circle", st.dropped_inside_circle}};
+    }
+    seconds[name] = seconds_since(t0);
+    return f;
+  };
+  const vislib::Frame left = render(Eye::Left, false, "left");
+  const vislib::Frame right = render(Eye::Right, false, "right");
+  const vislib::Frame truth_left = render(Eye::Left, true, "truth_left");
+  const vislib::Frame truth_right = render(Eye::Right, true, "truth_right");
+
+  const int w = s.width, h = s.height;
+  vislib::write_rgb8_image(c.output, w, 2 * h, vislib::pack_top_bottom(left, right));
+  vislib::write_rgb8_image(sibling(c.output, "_left"), w, h, left.rgb);
+  vislib::write_rgb8_image(sibling(c.output, "_right"), w, h, right.rgb);
+  vislib::write_rgb8_image(sibling(c.output, "_anaglyph"), w, h, vislib::anaglyph(left, right));
+  vislib::write_rgb8_image(sibling(c.output, "_truth"), w, 2 * h,
+                           vislib::pack_top_bottom(truth_left, truth_right));
+
+  json bands = json::array();
+  for (const vislib::BandDisagreement& b : vislib::lr_disagreement_by_latitude(left, right, 5))
+    bands.push_back({{"lat_max", b.lat_max_deg},
+                     {"lat_min", b.lat_min_deg},
+                     {"pixels", b.pixels},
+                     {"triangle_mismatch", b.triangle_mismatch},
+                     {"mean_abs_luma", b.mean_abs_luma}});
+  auto seam = [](const vislib::Frame& f) {
+    const vislib::SeamContinuity sc = vislib::seam_continuity(f);
+    return json{{"triangle_mismatch", sc.seam_triangle_mismatch},
+                {"mean_abs_rgb", sc.seam_mean_abs_rgb},
+                {"typical_adjacent_triangle_mismatch", sc.typical_triangle_mismatch},
+                {"typical_adjacent_mean_abs_rgb", sc.typical_mean_abs_rgb}};
+  };
+  json ods = {
+      {"method", o.method},
+      {"tessellation",
+       rays ? json(nullptr) : (o.tessellation == 0 ? json("dynamic") : json(o.tessellation))},
+      {"ipd_m", o.ipd_m},
+      {"units_per_metre", o.units_per_metre},
+      {"ipd_scene_units", ipd},
+      {"size", {w, h}},
+      {"pole_merge", {{"top", side_json(merge.top)}, {"bottom", side_json(merge.bottom)}}},
+      {"centre", {eye.x, eye.y, eye.z}},
+      {"cell", cell},
+      {"cells_used", cells},
+      {"disc_in_cell_view_region", disc_in_region},
+      {"disc_covered", disc_covered},
+      {"triangles", {{"scene", scene.triangle_count()}, {"visible", tris.size()}}},
+      {"left", quality_json(truth_left, left)},
+      {"right", quality_json(truth_right, right)},
+      {"lr_disagreement_by_latitude", bands},
+      {"seam", {{"left", seam(left)}, {"right", seam(right)}}},
+      {"counts", counts},
+      {"seconds", seconds},
+      {"bvh_build_seconds", build_seconds},
+      {"images",
+       {{"top_bottom", c.output},
+        {"left", sibling(c.output, "_left")},
+        {"right", sibling(c.output, "_right")},
+        {"anaglyph", sibling(c.output, "_anaglyph")},
+        {"truth_top_bottom", sibling(c.output, "_truth")}}}};
+  if (!rays) {
+    // The raster method's own error: the full scene rasterised against the full scene ray cast.
+    vislib::Frame ref_left = vislib::render_ods_rays(scene, rt, s, Eye::Left);
+    vislib::Frame ref_right = vislib::render_ods_rays(scene, rt, s, Eye::Right);
+    ods["truth_against_rays"] = {{"left", quality_json(ref_left, truth_left)},
+                                 {"right", quality_json(ref_right, truth_right)}};
+  }
+  json j = {{"file", c.file}, {"scene", c.scene}, {"tau", c.tau}, {"ods", ods}};
+
+  std::fprintf(stderr,
+               "ODS %dx%d %s, IPD %.4g m, cell %u, cells used %zu%s, visible %zu of %zu triangles\n"
+               "  left:  epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n"
+               "  right: epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n",
+               w, h, o.method.c_str(), o.ipd_m, cell, cells.size(),
+               disc_covered ? "" : " (disc NOT covered)", tris.size(),
+               size_t(scene.triangle_count()), ods["left"]["epsilon"].get<double>(),
+               ods["left"]["ssim"].get<double>(), ods["left"]["triangle_mismatch"].get<double>(),
+               seconds["left"].get<double>(), ods["right"]["epsilon"].get<double>(),
+               ods["right"]["ssim"].get<double>(), ods["right"]["triangle_mismatch"].get<double>(),
+               seconds["right"].get<double>());
+  if (c.json_path == "-") {
+    std::printf("%s\n", j.dump(1).c_str());
+  } else if (!c.json_path.empty()) {
+    vislib::write_file_atomic(c.json_path, j.dump(1) + "\n");
+  }
+}
+
+}  // namespace pvs_cli
