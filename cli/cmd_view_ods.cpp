@@ -16,6 +16,7 @@
 #include "pvs_format/pvs_format.h"
 #include "runtime/ods.h"
 #include "runtime/pvs_runtime.h"
+#include "vislib/bake/cell_set.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/embree_scene.h"
@@ -127,9 +128,7 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
     pvs_runtime::Pvs pvs = pvs_runtime::Pvs::open(c.file, opt);
     const pvs::FileInfo& info = pvs.info();
     const bool object = info.granularity == pvs::Granularity::Object;
-    if ((object ? full_scene.objects.size() : full_scene.triangle_count()) != info.universe)
-      throw vislib::InputError(
-          c.file, "universe " + std::to_string(info.universe) + " differs from the scene's");
+    vislib::check_universe(c.file, info, full_scene);  // the bake's id rule (id_universe.h)
     const double q[3] = {eye.x, eye.y, eye.z};
     const std::optional<uint32_t> found = pvs.find_cell(q);
     if (!found) {
@@ -160,7 +159,8 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
       }
       disc_covered = in;
     }
-    std::vector<uint8_t> keep(info.universe, 0);
+    std::vector<uint8_t> keep(
+        info.universe, 0);  // triangle granularity: ids >= triangle_count are spheres (not drawn)
     for (uint32_t u : cells) {
       if (pvs.is_absent(u)) {
         std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", u);

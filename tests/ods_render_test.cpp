@@ -407,10 +407,10 @@ TEST(PvsViewOds, TruckTownCellAgainstTheFullScene) {
   VISLIB_REQUIRE_SHARED(shared);
   using vislib_test::run_pvs;
   const std::string dir = vislib_test::temp_dir("pvs_view_ods_town");
-  const std::string town = shared + "/godot_truck_town/town_model.gltf";
+  const std::string town = shared + "/scenes/godot_truck_town/town_model.gltf";
   std::string out;
   ASSERT_EQ(
-      run_pvs("bake " + town + " " + std::string(TOWN_BAKE) + " --res 32 -o " + dir + "/town.pvs",
+      run_pvs("bake " + town + " " + std::string(TOWN_BAKE) + " --res 64 -o " + dir + "/town.pvs",
               &out),
       0)
       << out;

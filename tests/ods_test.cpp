@@ -410,7 +410,9 @@ TEST(OdsSplit, PoleTriangleBecomesAStripToThePoleRow) {
   double covered = 0;  // lon extent of the strip at the pole row, without the shifted copies
   for (const ProjTriangle& t : out) {
     for (const ProjVertex& p : t.v) {
-      if (p.lat == kPi / 2) EXPECT_EQ(p.range, 1.5);
+      if (p.lat == kPi / 2) {
+        EXPECT_EQ(p.range, 1.5);
+      }
     }
   }
   for (size_t i = 0; i < out.size(); ++i) {

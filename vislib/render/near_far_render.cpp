@@ -15,6 +15,15 @@
 namespace vislib {
 
 namespace {
+// State 0's vertex positions, or none for a scene without triangles (a sphere scene has no
+// positions at all: issue 12, pvs view of a sphere bake crashed here).
+const std::vector<Vec3>& rest_positions(const Scene& scene) {
+  static const std::vector<Vec3> none;
+  return scene.positions.empty() ? none : scene.positions[0];
+}
+}  // namespace
+
+namespace {
 
 namespace nf = pvs_runtime;
 
@@ -191,7 +200,7 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
   assert(s.r1 >= 0 && s.r1 < s.r2 && s.env_size >= 1);
   const nf::Point3 o = to_point(s.centre), u = to_point(camera.eye);
   assert(nf::axis_distance(u, o) < s.r1);
-  const auto& pos = scene.positions[0];
+  const auto& pos = rest_positions(scene);
   std::vector<float> pos_f(3 * pos.size());
   for (size_t v = 0; v < pos.size(); ++v) {
     pos_f[3 * v] = float(pos[v].x), pos_f[3 * v + 1] = float(pos[v].y),
@@ -259,7 +268,7 @@ Frame render_progressive(const Scene& scene, const EmbreeScene& rt,
   const nf::Point3 o = to_point(centre), u = to_point(camera.eye);
   const double r_n = near_fraction * big_r;
   assert(nf::axis_distance(u, o) < r_n);
-  const auto& pos = scene.positions[0];
+  const auto& pos = rest_positions(scene);
   // An object is near (received) when one of its visible vertices is within ring_radius of the
   // axis.
   std::vector<uint8_t> near_object(scene.objects.size(), 0);
@@ -288,7 +297,7 @@ std::vector<double> ring_visible_triangle_contribution(const Scene& scene,
                                                        Vec3 centre,
                                                        const std::vector<double>& radii) {
   const nf::Point3 o = to_point(centre);
-  const auto& pos = scene.positions[0];
+  const auto& pos = rest_positions(scene);
   const double inf = std::numeric_limits<double>::infinity();
   std::vector<double> object_radius(scene.objects.size(), inf),
       object_tris(scene.objects.size(), 0);
