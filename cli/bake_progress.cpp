@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <memory>
 
+#include "cli/options.h"
+
 namespace pvs_cli {
 
 std::string format_duration(double s) {
@@ -25,19 +27,22 @@ vislib::BakeProgressFn progress_printer() {
   struct State {
     bool tty = isatty(fileno(stderr));
     double last_line = -1;
-    uint32_t last_done = 0;
+    double last_done = 0;
   };
   auto st = std::make_shared<State>();
   return [st](const vislib::BakeProgress& p) {
-    uint32_t baked = p.done - p.resumed;
-    double eta = baked > 0 ? p.elapsed / baked * double(p.total - p.done) : NAN;
+    if (!show_progress()) return;
+    // Cells finished plus the finished share of the running ones (a long cell shows progress).
+    const double work = double(p.done - p.resumed) + p.running;
+    double eta = work > 0 ? p.elapsed / work * (double(p.total - p.done) - p.running) : NAN;
     if (st->tty) {
       const int width = 30;
-      int fill = p.total ? int(double(width) * p.done / p.total) : width;
+      int fill = p.total ? int(double(width) * (p.done + p.running) / p.total) : width;
       std::string bar(size_t(fill), '#');
       bar.resize(width, '.');
       std::fprintf(stderr, "\rpvs bake: [%s] %u/%u cells", bar.c_str(), p.done, p.total);
       if (p.resumed) std::fprintf(stderr, " (%u resumed)", p.resumed);
+      if (p.running > 0) std::fprintf(stderr, " + %.2f of running cells", p.running);
       std::fprintf(stderr, "  %s elapsed  ETA %s   ", format_duration(p.elapsed).c_str(),
                    p.done == p.total ? "0:00" : format_duration(eta).c_str());
       if (p.done == p.total) std::fprintf(stderr, "\n");
@@ -45,13 +50,22 @@ vislib::BakeProgressFn progress_printer() {
       return;
     }
     bool first = st->last_line < 0, last = p.done == p.total;
-    bool step = p.done >= st->last_done + std::max<uint32_t>(1, p.total / 20);
+    // A line every 5% of the work (cells, and runs inside the running cells) or every 10 s.
+    const double at = p.done + p.running;
+    bool step = at >= st->last_done + p.total / 20.0;
     if (!first && !last && !step && p.elapsed - st->last_line < 10) return;
     st->last_line = p.elapsed;
-    st->last_done = p.done;
-    std::fprintf(stderr, "pvs bake: %u/%u cells (%u resumed), %s elapsed, ETA %s\n", p.done,
-                 p.total, p.resumed, format_duration(p.elapsed).c_str(),
-                 last ? "0:00" : format_duration(eta).c_str());
+    st->last_done = at;
+    if (p.running > 0 && !last)
+      std::fprintf(
+          stderr,
+          "pvs bake: %u/%u cells + %.2f of running cells (%u resumed), %s elapsed, ETA %s\n",
+          p.done, p.total, p.running, p.resumed, format_duration(p.elapsed).c_str(),
+          format_duration(eta).c_str());
+    else
+      std::fprintf(stderr, "pvs bake: %u/%u cells (%u resumed), %s elapsed, ETA %s\n", p.done,
+                   p.total, p.resumed, format_duration(p.elapsed).c_str(),
+                   last ? "0:00" : format_duration(eta).c_str());
   };
 }
 

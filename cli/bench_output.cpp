@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "vislib/eval/bench_report.h"
 
 namespace pvs_cli {
@@ -124,6 +125,7 @@ json bench_json(const BenchArgs& a, const vislib::Scene& scene, const vislib::Be
 
 // The summary on stderr.
 void print_bench(const BenchArgs& a, const vislib::BenchResult& r, double total_s) {
+  if (!show_progress()) return;  // the summary on stderr obeys -q (bench.json has it all)
   const auto& et = r.equal_time;
   const auto& eq = r.equal_quality;
   if (!et.within_measured)
@@ -132,11 +134,12 @@ void print_bench(const BenchArgs& a, const vislib::BenchResult& r, double total_
          vislib::csv_number(et.seconds) +
          " s: equal_time_share is a lower bound; raise --point-runs");
   auto pct = [](double v) { return 100.0 * v; };
-  std::fprintf(stderr,
-               "pvs bench: from-segment %zu triangles in %.2f s (%zu segments x %d runs); "
-               "from-point %zu in the same time (%d runs): equal-time share %.1f%%\n",
-               et.segment_found, et.seconds, r.segments.size(), a.o.segment_runs, et.point_found,
-               et.point_runs, pct(et.share));
+  if (show_progress())
+    std::fprintf(stderr,
+                 "pvs bench: from-segment %zu triangles in %.2f s (%zu segments x %d runs); "
+                 "from-point %zu in the same time (%d runs): equal-time share %.1f%%\n",
+                 et.segment_found, et.seconds, r.segments.size(), a.o.segment_runs, et.point_found,
+                 et.point_runs, pct(et.share));
   if (eq.reached)
     std::fprintf(stderr, "pvs bench: equal quality: from-point needs %.2f s (%.0f runs), %.2fx\n",
                  eq.point_seconds, eq.point_runs, eq.time_ratio);
@@ -148,20 +151,22 @@ void print_bench(const BenchArgs& a, const vislib::BenchResult& r, double total_
       detail = "extrapolated ratio " + vislib::csv_number(eq.time_ratio) +
                "x (power-law fit of the discovery rate; " + vislib::csv_number(eq.time_ratio_low) +
                " to " + vislib::csv_number(eq.time_ratio_high) + "x over three fit windows)";
-    std::fprintf(stderr,
-                 "pvs bench: equal quality not reached in %d from-point runs (%zu of %zu "
-                 "triangles): measured ratio > %.2fx; %s\n",
-                 r.options.point_runs, r.point.set.size(), eq.target, eq.time_ratio_lower_bound,
-                 detail.c_str());
+    if (show_progress())
+      std::fprintf(stderr,
+                   "pvs bench: equal quality not reached in %d from-point runs (%zu of %zu "
+                   "triangles): measured ratio > %.2fx; %s\n",
+                   r.options.point_runs, r.point.set.size(), eq.target, eq.time_ratio_lower_bound,
+                   detail.c_str());
   }
-  std::fprintf(stderr,
-               "pvs bench: at equal time: segment eps %.3f%% PSNR %s SSIM %.5f | point eps %.3f%% "
-               "PSNR %s SSIM %.5f\npvs bench: wrote %s/bench.json (total %.1f s)\n",
-               pct(et.segment.quality.epsilon_mean),
-               vislib::csv_number(et.segment.quality.psnr).c_str(), et.segment.quality.ssim_mean,
-               pct(et.point.quality.epsilon_mean),
-               vislib::csv_number(et.point.quality.psnr).c_str(), et.point.quality.ssim_mean,
-               a.out.c_str(), total_s);
+  if (show_progress())
+    std::fprintf(
+        stderr,
+        "pvs bench: at equal time: segment eps %.3f%% PSNR %s SSIM %.5f | point eps %.3f%% "
+        "PSNR %s SSIM %.5f\npvs bench: wrote %s/bench.json (total %.1f s)\n",
+        pct(et.segment.quality.epsilon_mean), vislib::csv_number(et.segment.quality.psnr).c_str(),
+        et.segment.quality.ssim_mean, pct(et.point.quality.epsilon_mean),
+        vislib::csv_number(et.point.quality.psnr).c_str(), et.point.quality.ssim_mean,
+        a.out.c_str(), total_s);
 }
 
 }  // namespace pvs_cli

@@ -1,5 +1,6 @@
 // pvs bake: bake a scene's view cells into a PVS file (docs/bake.md); cmd_merge.cpp joins the
 // shard files of a sharded bake.
+#include <fmt/format.h>
 #include <sys/stat.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include "cli/bake_progress.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "vislib/bake/bake.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
@@ -37,7 +39,19 @@ struct BakeArgs {
   std::string coplanar = "both";
   double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
+  std::string preset = "default";
 };
+
+// Quality presets (like vis's -fast / -level): what --preset sets unless given explicitly.
+struct Preset {
+  int resolution, runs;
+  double cell_size;
+};
+Preset preset_values(const std::string& name) {
+  if (name == "draft") return {128, 1, 8.0};
+  if (name == "final") return {2048, 4, 1.0};
+  return {512, 1, 2.0};  // default: the options' own defaults
+}
 
 vislib::Shard parse_shard(const std::string& text) {
   unsigned i = 0, n = 0;
@@ -120,34 +134,34 @@ void add_bake(CLI::App& app) {
   cmd->add_flag("--walkable", a->walkable, "Place cells automatically over upward-facing floors");
   cmd->add_option("--cell-size", a->cell_size,
                   "Cell side: walkable columns (default 2) or grid cells over --box")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->add_option("--eye-height", a->eye,
                   "Eye band h0,h1 above the floor / the cell bottom (walkable default 1.5,1.8)");
   cmd->add_option("--max-slope", a->max_slope, "Walkable: steepest floor, degrees from horizontal")
-      ->check(CLI::Range(0.0, 90.0))
+      ->check(in_range(0.0, 90.0))
       ->capture_default_str();
   cmd->add_flag("--no-headroom", a->no_headroom,
                 "Walkable: keep floors covered by other geometry (under buildings)");
   cmd->add_option("--res", a->resolution, "Cube face resolution N of the from-segment runs")
-      ->check(CLI::Range(1, 16384))
+      ->check(in_range(1, 16384))
       ->capture_default_str();
   cmd->add_option("--runs", a->runs, "Cube orientations K per boundary segment")
-      ->check(CLI::Range(1, 100000))
+      ->check(in_range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--seed", a->seed, "Seed of the orientations (derived per cell)")
       ->capture_default_str();
   cmd->add_option("--near", a->near, "Near plane (view depth, scene units)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
   cmd->add_option("--eps-len", a->eps_len, "Final pieces must be longer than this (in t) to count")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(in_range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--tile", a->tile, "Kernel tile side in pixels")
-      ->check(CLI::Range(1, 4096))
+      ->check(in_range(1, 4096))
       ->capture_default_str();
   cmd->add_option("--states", a->states,
                   "Key states to sample glTF animations into (dynamic scenes)")
-      ->check(CLI::Range(1, 100000));
+      ->check(in_range(1, 100000));
   cmd->add_option("--mode", a->mode,
                   "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))
@@ -158,15 +172,15 @@ void add_bake(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--eps-z", a->eps_z,
                   "Depth tie tolerance, relative to the front depth (as for pvs segment)")
-      ->check(CLI::Range(0.0, 0.1))
+      ->check(in_range(0.0, 0.1))
       ->capture_default_str();
   cmd->add_option("--granularity", a->granularity,
                   "Store triangle ids (spheres after them) or object ids")
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
-  cmd->add_option("--threads", a->threads,
+  cmd->add_option("-j,--threads", a->threads,
                   "Worker threads (0 = all cores); never changes the output")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   cmd->add_option("--shard", a->shard,
                   "Bake only cells c with c % N == i, into a shard file for pvs merge")
       ->capture_default_str();
@@ -175,8 +189,38 @@ void add_bake(CLI::App& app) {
   cmd->add_flag("--dry-run", a->dry_run, "Place the cells, print their count and stop");
   cmd->add_option("--json", a->json_out,
                   "Write a bake report (timings per cell, sizes) as JSON ('-' = stdout)");
-  cmd->callback([a] {
+  cmd->add_option("--preset", a->preset,
+                  "Quality preset: draft (--res 128, --runs 1, --cell-size 8), default (512, 1, 2) "
+                  "or final (2048, 4, 1); options given explicitly win")
+      ->check(CLI::IsMember({"draft", "default", "final"}))
+      ->capture_default_str();
+  cmd->callback([a, cmd] {
     vislib::Shard shard = parse_shard(a->shard);
+    // The preset fills the options not given (issue 17 item 2); the report states the result.
+    const Preset preset = preset_values(a->preset);
+    if (cmd->count("--res") == 0) a->resolution = preset.resolution;
+    if (cmd->count("--runs") == 0) a->runs = preset.runs;
+    const bool cell_size_given = cmd->count("--cell-size") > 0;
+    // Cell size: walkable cells, or a grid over --box by size when a preset is named (without
+    // one, --box still needs --grid or --cell-size).
+    if (!cell_size_given && a->grid.empty() && (a->walkable || cmd->count("--preset")))
+      a->cell_size = preset.cell_size;
+    json preset_j = {{"name", a->preset},
+                     {"res", a->resolution},
+                     {"runs", a->runs},
+                     {"cell_size", a->grid.empty() ? json(a->cell_size) : json(nullptr)}};
+    if (show_progress() && cmd->count("--preset"))
+      std::fprintf(
+          stderr, "pvs bake: preset %s: --res %d%s, --runs %d%s, --cell-size %s\n",
+          a->preset.c_str(), a->resolution, cmd->count("--res") ? " (given)" : "", a->runs,
+          cmd->count("--runs") ? " (given)" : "",
+          !a->grid.empty()
+              ? "none (--grid)"
+              : (fmt::format("{:g}", a->cell_size) + (cell_size_given ? " (given)" : "")).c_str());
+    // Every output is checked before any work (issue 17 item 1).
+    check_output_file(a->output, "--output");
+    check_output_file(a->checkpoint.empty() ? a->output + ".ckpt" : a->checkpoint, "--checkpoint");
+    if (!a->json_out.empty()) check_output_file(a->json_out, "--json", true);
     std::unique_ptr<tbb::global_control> limit;
     if (a->threads > 0)
       limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -216,12 +260,13 @@ void add_bake(CLI::App& app) {
           a->runs);
       return;
     }
-    if (a->resume && !file_exists(checkpoint))
+    if (a->resume && !file_exists(checkpoint) && show_progress())
       std::fprintf(stderr, "pvs bake: no checkpoint %s: starting from the beginning\n",
                    checkpoint.c_str());
-    std::fprintf(stderr, "pvs bake: %u cells (%s), %zu triangles, shard %u/%u\n", n,
-                 cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
-                 scene.triangle_count(), shard.index, shard.count);
+    if (show_progress())
+      std::fprintf(stderr, "pvs bake: %u cells (%s), %zu triangles, shard %u/%u\n", n,
+                   cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
+                   scene.triangle_count(), shard.index, shard.count);
 
     vislib::BakeSettings s;
     s.region.segment.resolution = a->resolution;
@@ -249,17 +294,19 @@ void add_bake(CLI::App& app) {
                    static_cast<unsigned long long>(r.checkpoint_dropped_bytes), r.resumed);
     double kernel = 0;
     for (double x : r.cell_seconds) kernel += x;
-    std::fprintf(
-        stderr,
-        "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
-        "%llu bytes (%.1f per cell) written to %s\n",
-        r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
-        static_cast<unsigned long long>(r.stats.file_bytes),
-        r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a->output.c_str());
+    if (show_progress())
+      std::fprintf(
+          stderr,
+          "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
+          "%llu bytes (%.1f per cell) written to %s\n",
+          r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
+          static_cast<unsigned long long>(r.stats.file_bytes),
+          r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a->output.c_str());
     if (!a->json_out.empty()) {
       json j = {
           {"scene", a->scene},
           {"output", a->output},
+          {"preset", preset_j},
           {"cells", r.cells},
           {"shard", {shard.index, shard.count}},
           {"shard_cells", r.shard_cells},

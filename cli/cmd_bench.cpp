@@ -18,6 +18,7 @@
 #include "cli/bench_output.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/bench_report.h"
 #include "vislib/eval/benchmark_compare.h"
@@ -70,6 +71,7 @@ std::vector<std::string> make_plots(const BenchArgs& a) {
 }
 
 void run(BenchArgs& a) {
+  check_output_dir(a.out, "--out");  // before any work (issue 17 item 1)
   std::unique_ptr<tbb::global_control> limit;
   if (a.threads > 0)
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -97,14 +99,15 @@ void run(BenchArgs& a) {
   if (scene.is_dynamic()) warn(a.scene + ": the scene is animated; the bench uses key state 0");
   const double load_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::fprintf(stderr, "pvs bench: %s: %zu triangles (loaded in %.2f s)\n", a.scene.c_str(),
-               scene.triangle_count(), load_s);
-  fs::create_directories(a.out);
+  if (show_progress())
+    std::fprintf(stderr, "pvs bench: %s: %zu triangles (loaded in %.2f s)\n", a.scene.c_str(),
+                 scene.triangle_count(), load_s);
 
   const bool tty = isatty(fileno(stderr));
   std::string last_stage;
   auto last_print = std::chrono::steady_clock::now();
   auto progress = [&](const std::string& stage, size_t done, size_t total) {
+    if (!show_progress()) return;
     const auto now = std::chrono::steady_clock::now();
     const bool first = stage != last_stage, final = done == total;
     if (!first && !final &&
@@ -149,41 +152,41 @@ void add_bench(CLI::App& app) {
       ->required();
   cmd->add_option("--out", a->out, "Output folder (created)")->required();
   cmd->add_option("--views", a->o.views, "Test views inside the region")
-      ->check(CLI::Range(1, 10000))
+      ->check(in_range(1, 10000))
       ->capture_default_str();
   cmd->add_option("--view-path", a->path, "Test views on a walking path or at random in the box")
       ->check(CLI::IsMember({"walk", "random"}))
       ->capture_default_str();
   cmd->add_option("--segment-runs", a->o.segment_runs,
                   "From-segment cube orientations per perimeter segment (run 0 world-aligned)")
-      ->check(CLI::Range(1, 100000))
+      ->check(in_range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--point-runs", a->o.point_runs,
                   "From-point viewpoints (0 = run for --point-time-factor x the from-segment time)")
-      ->check(CLI::Range(0, 10000000))
+      ->check(in_range(0, 10000000))
       ->capture_default_str();
   cmd->add_option("--point-time-factor", a->o.point_time_factor,
                   "Automatic --point-runs: this multiple of the from-segment seconds")
-      ->check(CLI::Range(1.0, 1000.0))
+      ->check(in_range(1.0, 1000.0))
       ->capture_default_str();
   cmd->add_option("--max-point-runs", a->o.max_point_runs,
                   "Upper bound of the automatic --point-runs")
-      ->check(CLI::Range(2, 10000000))
+      ->check(in_range(2, 10000000))
       ->capture_default_str();
   cmd->add_option("--res", a->o.resolution, "Cube face resolution N of both methods")
-      ->check(CLI::Range(1, 16384))
+      ->check(in_range(1, 16384))
       ->capture_default_str();
   cmd->add_option("--near", a->o.near, "Near plane (view depth) of both methods and the frames")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
   cmd->add_option("--frame", a->frame, "Test frame size WxH")->capture_default_str();
   cmd->add_option("--fov", a->o.vfov_degrees, "Vertical field of view of the test frames (degrees)")
-      ->check(CLI::Range(1.0, 179.0))
+      ->check(in_range(1.0, 179.0))
       ->capture_default_str();
   cmd->add_option("--seed", a->o.seed, "Seed of orientations, viewpoints and test views")
       ->capture_default_str();
-  cmd->add_option("--threads", a->threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("-j,--threads", a->threads, "Worker threads (0 = all cores)")
+      ->check(non_negative());
   cmd->add_flag("--no-frames", a->no_frames, "Do not write the equal-time frames and heat maps");
   cmd->add_flag("--no-plots", a->no_plots, "Do not run the plotting script");
   cmd->add_option("--python", a->python, "Python with matplotlib for the plots")

@@ -11,6 +11,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/id_map.h"
 
@@ -30,6 +31,8 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 }
 
 void run_export(const ExportOptions& o) {
+  check_output_file(o.out, "--output");  // before any work (issue 17 item 1)
+  if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
   double tau = o.time.value_or(0.0);
   std::string obj = "# pvs export of " + o.scene + ": face i is triangle id i\n";
@@ -49,12 +52,14 @@ void run_export(const ExportOptions& o) {
            std::to_string(tri[2] + 1) + "\n";
   }
   vislib::write_file_atomic(o.out, obj);
-  std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
+  if (show_progress())
+    std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
                scene.vertex_count(), scene.triangle_count());
   if (!o.id_map.empty()) {
     const vislib::IdMap map = vislib::id_map(scene);
     vislib::write_file_atomic(o.id_map, vislib::id_map_json(scene, map));
-    std::fprintf(stderr, "pvs: wrote %s (%zu runs, vertices %s)\n", o.id_map.c_str(),
+    if (show_progress())
+      std::fprintf(stderr, "pvs: wrote %s (%zu runs, vertices %s)\n", o.id_map.c_str(),
                  map.runs.size(), map.vertices_tiled ? "tiled per run" : "shared between runs");
   }
   if (scene.sphere_count() == 0) return;
@@ -72,8 +77,9 @@ void run_export(const ExportOptions& o) {
     sp += "\n";
   }
   vislib::write_file_atomic(o.out + ".spheres", sp);
-  std::fprintf(stderr, "pvs: wrote %s.spheres (%zu spheres, %zu states)\n", o.out.c_str(),
-               scene.sphere_count(), K);
+  if (show_progress())
+    std::fprintf(stderr, "pvs: wrote %s.spheres (%zu spheres, %zu states)\n", o.out.c_str(),
+                 scene.sphere_count(), K);
 }
 
 const Registration reg("export", [](CLI::App& app) {
@@ -83,9 +89,9 @@ const Registration reg("export", [](CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file")->required();
   cmd->add_option("-o,--output", o->out, "Output .obj")->required();
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->add_option("--time", o->time, "Animation time in [0,1] (default: state 0)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(in_range(0.0, 1.0));
   cmd->add_option(
       "--id-map", o->id_map,
       "Also write FILE.json: runs of consecutive triangle ids of one object and their vertex "

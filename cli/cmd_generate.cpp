@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/generate.h"
 #include "vislib/scene/write_gltf.h"
@@ -24,7 +25,7 @@ vislib::GenerateProgress progress_printer(const std::string& what, Clock::time_p
   auto last = std::make_shared<double>(0.0);
   return [what, t0, last](double fraction) {
     double t = seconds_since(t0);
-    if (t < 2 || t - *last < 2) return;
+    if (t < 2 || t - *last < 2 || !show_progress()) return;
     *last = t;
     std::fprintf(stderr, "pvs: %s %3.0f%% (%.1f s)\n", what.c_str(), 100 * fraction, t);
   };
@@ -41,7 +42,8 @@ void check_extension(const std::string& path, const std::string& ext, const std:
 void write_and_report(const std::string& kind, const vislib::Scene& scene, const std::string& path,
                       Clock::time_point t0) {
   double gen = seconds_since(t0);
-  if (gen > 2) std::fprintf(stderr, "pvs: generated in %.1f s, writing %s\n", gen, path.c_str());
+  if (gen > 2 && show_progress())
+    std::fprintf(stderr, "pvs: generated in %.1f s, writing %s\n", gen, path.c_str());
   std::string bytes = vislib::file_extension(path) == ".glb" ? vislib::scene_to_glb(scene)
                                                              : vislib::spheres_to_text(scene);
   vislib::write_file_atomic(path, bytes);
@@ -70,22 +72,23 @@ void add_generate(CLI::App& app) {
     c->add_option("--blocks", *blocks, "Blocks along x and z, as X,Z (default 6,6)");
     c->add_option("--block-size", o->block_size, "Side of a block (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--street-width", o->street_width, "Street width (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--lots", o->lots_per_side, "Buildings per block side")
         ->capture_default_str()
-        ->check(CLI::Range(1, 100));
+        ->check(in_range(1, 100));
     c->add_option("--heights", *heights, "Building heights MIN,MAX (m) (default 8,60)");
     c->add_option("--panel", o->panel_size, "Facade panel size (m); 0 = one quad per wall")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(non_negative());
     c->add_option("--target-triangles", o->target_triangles,
                   "Pick the facade detail (and, without --blocks, the grid) for about this many "
                   "triangles");
     c->callback([o, out, blocks, heights] {
       check_extension(*out, ".glb", "city");
+      check_output_file(*out, "--output");
       if (!blocks->empty()) {
         auto b = parse_doubles(*blocks, "--blocks", 2);
         if (b[0] < 1 || b[1] < 1 || b[0] != int(b[0]) || b[1] != int(b[1]))
@@ -118,41 +121,42 @@ void add_generate(CLI::App& app) {
     c->add_option("--seed", o->seed, "Random seed")->capture_default_str();
     c->add_option("--size", o->size, "Side of the square field (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--density", o->density, "Blades per square meter")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(non_negative());
     c->add_option("--target-triangles", o->target_triangles,
                   "Pick the blade count for this many triangles (overrides --density)");
     c->add_option("--blade-triangles", o->blade_triangles, "Triangles per blade")
         ->capture_default_str()
-        ->check(CLI::Range(2, 5));
+        ->check(in_range(2, 5));
     c->add_option("--blade-height", o->blade_height, "Mean blade height (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--blade-width", o->blade_width, "Mean blade base width (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--patch-size", o->patch_size, "Side of the square patch per object (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--terrain-cell", o->terrain_cell, "Terrain grid spacing (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--terrain-amplitude", o->terrain_amplitude, "Hill height (m)")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(non_negative());
     c->add_option("--states", o->states, "Key states of the wind animation")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(in_range(1, 1000));
     c->add_option("--wind", o->wind_amplitude, "Gust bend angle at the tip (radians)")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 1.4));
+        ->check(in_range(0.0, 1.4));
     c->add_option("--wavelength", o->wind_wavelength, "Gust wavelength (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->callback([o, out] {
       check_extension(*out, ".glb", "grass");
+      check_output_file(*out, "--output");
       auto t0 = Clock::now();
       o->progress = progress_printer("generating grass", t0);
       write_and_report("grass", vislib::generate_grass(*o), *out, t0);
@@ -168,30 +172,31 @@ void add_generate(CLI::App& app) {
     c->add_option("--seed", o->seed, "Random seed")->capture_default_str();
     c->add_option("--count", o->count, "Number of spheres")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(non_negative());
     c->add_option("--radius", o->radius, "Sphere radius (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--area", o->area, "Side of the square area (m)")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--states", o->states, "Key states")
         ->capture_default_str()
-        ->check(CLI::Range(1, 100000));
+        ->check(in_range(1, 100000));
     c->add_option("--duration", o->duration, "Simulated seconds from first to last state")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(positive());
     c->add_option("--max-height", o->max_height, "Initial centre height above radius, at most (m)")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(non_negative());
     c->add_option("--speed", o->speed, "Initial speed per axis, at most (m/s)")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(non_negative());
     c->add_option("--restitution", o->restitution, "Vertical speed kept at a bounce")
         ->capture_default_str()
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(in_range(0.0, 1.0));
     c->callback([o, out] {
       check_extension(*out, ".spheres", "sphere");
+      check_output_file(*out, "--output");
       if (o->area < 2 * o->radius)
         throw CLI::ValidationError("--area", "must be at least twice --radius");
       write_and_report("spheres", vislib::generate_spheres(*o), *out, Clock::now());

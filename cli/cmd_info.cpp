@@ -4,6 +4,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
@@ -63,7 +64,7 @@ const Registration reg("info", [](CLI::App& app) {
       ->required();
   cmd->add_flag("--json", o->json, "Machine-readable JSON on stdout");
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->callback([o] { run_info(*o); });
 });
 

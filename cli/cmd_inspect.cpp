@@ -12,6 +12,7 @@
 #include "cli/commands.h"
 #include "cli/inspect_report.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/cell_set.h"
 #include "vislib/bake/pvs_summary.h"
@@ -48,42 +49,44 @@ void add_inspect(CLI::App& app) {
       "Check and summarise a PVS file (cells, bytes, compression mix, visible counts), or "
       "show one cell and export the scene reduced to its visible set as glTF");
   cmd->add_option("PVS", a->file, "PVS file")->required();
-  auto* cell_opt =
-      cmd->add_option("--cell", a->cell, "Show this cell")->check(CLI::NonNegativeNumber);
+  auto* cell_opt = cmd->add_option("--cell", a->cell, "Show this cell")->check(non_negative());
   cmd->add_option("--at", a->at, "Show the cell containing the point x,y,z")->excludes(cell_opt);
   cmd->add_flag("--json", a->json_out, "Print JSON instead of text (all visible ids of a cell)");
   cmd->add_option("--scene", a->scene,
                   "The scene the PVS was baked for (checked by its fingerprint)");
   cmd->add_option("--states", a->states,
                   "With --scene: key states to sample animations into (as for the bake)")
-      ->check(CLI::Range(1, 100000));
+      ->check(in_range(1, 100000));
   cmd->add_option("--export-gltf", a->gltf,
-                  "With --scene and a cell: write the scene reduced to the cell's set (.glb)");
+                  "With --scene and a cell: write the scene reduced to the cell's set (.glb), with the "
+                  "source's normals, UVs, materials, textures and copyright");
   cmd->add_option(
       "--render", a->render_dir,
       "With --scene and a cell: render from the --at point (else the centre of the cell's view "
-      "region), in 4 horizontal directions, the full-scene frame, the PVS frame and the error heat "
+      "region, or the free sample nearest it when the centre is enclosed by the scene), in 4 horizontal directions, the full-scene frame, the PVS frame and the error heat "
       "map into this folder, "
       "with epsilon/PSNR/SSIM");
   cmd->add_option("--frame", a->frame, "Frame size WxH for --render")->capture_default_str();
   cmd->add_option("--max-ids", a->max_ids, "Text output: print at most this many ids of a cell")
       ->capture_default_str();
   cmd->callback([a] {
-    pvs::ReadOptions opt;
-    vislib::Scene scene;
-    if (!a->scene.empty()) {
-      scene = load_scene_for_cli(a->scene, a->states);
-      opt.expected_fingerprint = vislib::scene_fingerprint(scene);
-    }
     if (!a->gltf.empty()) {
       if (a->scene.empty()) throw CLI::ValidationError("--export-gltf", "needs --scene");
       if (a->cell < 0 && a->at.empty())
         throw CLI::ValidationError("--export-gltf", "needs --cell or --at");
+      check_output_file(a->gltf, "--export-gltf");  // before any work (issue 17 item 1)
     }
     if (!a->render_dir.empty()) {
       if (a->scene.empty()) throw CLI::ValidationError("--render", "needs --scene");
       if (a->cell < 0 && a->at.empty())
         throw CLI::ValidationError("--render", "needs --cell or --at");
+      check_output_dir(a->render_dir, "--render");
+    }
+    pvs::ReadOptions opt;
+    vislib::Scene scene;
+    if (!a->scene.empty()) {
+      scene = load_scene_for_cli(a->scene, a->states);
+      opt.expected_fingerprint = vislib::scene_fingerprint(scene);
     }
     int fw = 0, fh = 0;
     if (std::sscanf(a->frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
@@ -113,10 +116,26 @@ void add_inspect(CLI::App& app) {
       if (!cell) {
         json j = summary(r);
         j["file"] = a->file;
-        if (a->json_out)
+        std::vector<uint32_t> enclosed;
+        if (!a->scene.empty()) {
+          // Cells whose view-region centre is enclosed by the scene (issue 17 item 6).
+          for (uint32_t k = 0; k < r.cell_count(); ++k)
+            if (vislib::point_enclosed(scene, vislib::view_region_centre(info.layout, k)))
+              enclosed.push_back(k);
+          j["enclosed_centre_cells"] = enclosed;
+        }
+        if (a->json_out) {
           std::printf("%s\n", j.dump(1).c_str());
-        else
+        } else {
           print_summary(a->file, j);
+          if (!a->scene.empty()) {
+            std::printf("  cells whose view-region centre is enclosed by the scene: %zu",
+                        enclosed.size());
+            for (size_t i = 0; i < enclosed.size() && int(i) < a->max_ids; ++i)
+              std::printf(" %u", enclosed[i]);
+            std::printf("\n");
+          }
+        }
         return;
       }
       // One cell.
@@ -142,19 +161,48 @@ void add_inspect(CLI::App& app) {
       j["visible_count"] = ids.size();
       j["share"] = info.universe ? double(ids.size()) / info.universe : 0.0;
       const vislib::Granularity g = vislib::granularity_of(info);
+      vislib::CellFreeSpace free_space;
       if (!a->scene.empty()) {
+        // Points of the view region enclosed by the scene (issue 17 item 6).
+        free_space = vislib::cell_free_space(scene, vislib::to_box3(info.layout.view_region(c)));
+        j["free_space"] = {{"samples", free_space.samples},
+                           {"enclosed", free_space.enclosed},
+                           {"centre_enclosed", free_space.centre_enclosed}};
+        if (free_space.free_point)
+          j["free_space"]["free_point"] = {free_space.free_point->x, free_space.free_point->y,
+                                           free_space.free_point->z};
+        if (free_space.enclosed > 0)
+          warn("cell " + std::to_string(c) + ": " + std::to_string(free_space.enclosed) + " of " +
+               std::to_string(free_space.samples) +
+               " samples of its view region are enclosed by the scene (it straddles a solid: "
+               "boundary segments run through it)");
         vislib::Scene sub = vislib::scene_subset(scene, ids, g);
         j["visible_triangles"] = sub.triangle_count();
         j["triangle_share"] =
             scene.triangle_count() ? double(sub.triangle_count()) / scene.triangle_count() : 0.0;
         if (!a->gltf.empty()) {
-          vislib::write_file_atomic(a->gltf, vislib::scene_to_glb(sub));
+          // What a viewer needs besides the triangles: normals, UVs, materials, copyright.
+          vislib::LoadOptions lo;
+          lo.states = a->states;
+          std::vector<std::string> warnings;
+          vislib::SceneAppearance app = vislib::load_appearance(a->scene, lo, &warnings);
+          for (const auto& w : warnings) warn(w);
+          vislib::SceneAppearance sub_app = vislib::appearance_subset(scene, app, ids, g);
+          vislib::write_file_atomic(a->gltf, vislib::scene_to_glb(sub, &sub_app));
           j["export_gltf"] = a->gltf;
         }
         if (!a->render_dir.empty()) {
-          // The viewpoint: the --at point, else the centre of the cell's view region.
+          // The viewpoint: the --at point, else the centre of the cell's view region, else (the
+          // centre is enclosed by the scene) the free sample nearest it (issue 17 item 6).
           vislib::Vec3 eye = vislib::view_region_centre(info.layout, c);
-          if (!a->at.empty()) eye = parse_vec3(a->at, "--at");
+          if (!a->at.empty()) {
+            eye = parse_vec3(a->at, "--at");
+          } else if (free_space.centre_enclosed) {
+            if (!free_space.free_point)
+              throw vislib::InputError(a->file, "every sample of cell " + std::to_string(c) +
+                                                    "'s view region is enclosed by the scene: give --at");
+            eye = *free_space.free_point;
+          }
           j["render"] = render_cell(scene, ids, g, eye, a->render_dir, fw, fh);
         }
       }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/cell_set.h"
 #include "vislib/base/file_util.h"
@@ -22,14 +23,16 @@ void add_merge(CLI::App& app) {
   cmd->add_option("SHARD", *shards, "Shard files, any order")->required();
   cmd->add_option("-o,--output", *out, "Output PVS file")->required();
   cmd->callback([shards, out] {
+    check_output_file(*out, "--output");  // before any work (issue 17 item 1)
     std::vector<pvs::Reader> readers;
     for (const auto& path : *shards)
       readers.push_back(vislib::reading_pvs(path, [&] { return pvs::Reader::from_file(path); }));
     const std::string bytes =
         vislib::reading_pvs("pvs merge", [&] { return pvs::merge_pvs(readers); });
     vislib::write_file_atomic(*out, bytes);
-    std::fprintf(stderr, "pvs merge: %zu shards, %u cells, %zu bytes written to %s\n",
-                 readers.size(), readers[0].cell_count(), bytes.size(), out->c_str());
+    if (show_progress())
+      std::fprintf(stderr, "pvs merge: %zu shards, %u cells, %zu bytes written to %s\n",
+                   readers.size(), readers[0].cell_count(), bytes.size(), out->c_str());
   });
 }
 

@@ -13,10 +13,12 @@
 #include "cli/cmd_view_stereo.h"
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "cli/view_report.h"
 #include "pvs_format/pvs_format.h"
 #include "runtime/near_far.h"
 #include "vislib/bake/cell_set.h"
+#include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/embree_scene.h"
@@ -46,6 +48,7 @@ struct ViewCell {
   uint32_t cell = 0;
   std::vector<uint32_t> tris;
   vislib::Vec3 centre;  // of the cell's view region
+  vislib::Box3 region;  // the cell's view region
   pvs::Box box;         // the cell's lookup box
 };
 
@@ -72,6 +75,7 @@ ViewCell read_view_cell(const ViewArgs& a, vislib::Vec3 eye) {
     v.tris =
         vislib::visible_triangles(v.full_scene, r.read_cell(v.cell), vislib::granularity_of(info));
     v.centre = vislib::view_region_centre(info.layout, v.cell);
+    v.region = vislib::to_box3(info.layout.view_region(v.cell));
     v.box = info.layout.cell_box(v.cell);
   });
   return v;
@@ -93,7 +97,20 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
   if (length(target - eye) == 0) throw CLI::ValidationError("--look", "must differ from --at");
 
   ViewCell v = read_view_cell(a, eye);
-  const vislib::Vec3 centre = a.centre.empty() ? v.centre : parse_vec3(a.centre, "--centre");
+  vislib::Vec3 centre = a.centre.empty() ? v.centre : parse_vec3(a.centre, "--centre");
+  if (a.centre.empty()) {
+    // Never a point inside a building as the default centre (issue 17 item 6).
+    vislib::CellFreeSpace fs = vislib::cell_free_space(v.full_scene, v.region);
+    if (fs.centre_enclosed) {
+      if (!fs.free_point)
+        throw vislib::InputError(a.file, "every sample of cell " + std::to_string(v.cell) +
+                                             "'s view region is enclosed by the scene: give --centre");
+      centre = *fs.free_point;
+      warn("the centre of cell " + std::to_string(v.cell) +
+           "'s view region is enclosed by the scene; the free point " + std::to_string(centre.x) +
+           "," + std::to_string(centre.y) + "," + std::to_string(centre.z) + " is the centre");
+    }
+  }
   const double eye_axis =
       pvs_runtime::axis_distance({eye.x, eye.y, eye.z}, {centre.x, centre.y, centre.z});
   if (radii.empty()) {  // derived from the cell, as pvs_rt_cell_near_far (docs/runtime.md)
@@ -239,18 +256,19 @@ void add_view(CLI::App& app) {
                   "DIR/equal_area_NNNN.png");
   cmd->add_option("--centre", a->centre,
                   "Centre O x,y,z of the cylinders and environment map (default: the "
-                  "centre of the cell's view region)");
+                  "centre of the cell's view region, or the free sample of the region nearest "
+                  "it when that is enclosed by the scene)");
   cmd->add_flag("--grow", a->grow,
                 "Also render the progressive near region (CloVR rings up to r2) and report "
                 "the minimum SSIM between consecutive frames");
   cmd->add_option("--rings", a->rings, "--grow: equal-area rings up to r2")
-      ->check(CLI::Range(1, 1000))
+      ->check(in_range(1, 1000))
       ->capture_default_str();
   cmd->add_option("--frames-per-ring", a->frames_per_ring,
                   "--grow: frames over which each ring is injected (Alg. 1 with R animated from "
                   "the previous "
                   "ring's radius to the ring's)")
-      ->check(CLI::Range(1, 1000))
+      ->check(in_range(1, 1000))
       ->capture_default_str();
   cmd->add_option(
       "--merge-min", a->merge_min,
@@ -258,18 +276,18 @@ void add_view(CLI::App& app) {
       "region) each (default: the mean over the equal-area rings)");
   cmd->add_option("--states", a->states,
                   "Key states to sample glTF animations into (as for the bake)")
-      ->check(CLI::Range(1, 100000))
+      ->check(in_range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--time", a->tau, "Animation time tau in [0,1] of the frame (dynamic scenes)")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(in_range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--near-fraction", a->near_fraction, "--grow: R_n / R of Alg. 1")
-      ->check(CLI::Range(0.01, 0.99))
+      ->check(in_range(0.01, 0.99))
       ->capture_default_str();
   cmd->add_option("--frame", a->frame, "Frame size WxH")->capture_default_str();
   cmd->add_option("--env-size", a->env_size,
                   "Environment map face side in pixels (default: the frame height)")
-      ->check(CLI::Range(0, 8192));
+      ->check(in_range(0, 8192));
   cmd->add_option("--lookup", a->lookup,
                   "Environment map lookup: eye (along the eye ray, the paper) or cylinder "
                   "(from O through the eye ray's exit point on the r2 cylinder)")
@@ -284,6 +302,9 @@ void add_view(CLI::App& app) {
   add_ods_view_options(cmd, ods);
   std::shared_ptr<ViewStereoArgs> stereo = add_view_stereo_options(cmd);
   cmd->callback([a, ods, stereo] {
+    // Every output checked before any work, --ods and --stereo too (issue 17 item 1).
+    check_output_file(a->output, "--output");
+    if (!a->json_path.empty()) check_output_file(a->json_path, "--json", true);
     if (ods->enabled && stereo->enabled())
       throw CLI::ValidationError("--stereo", "cannot be combined with --ods");
     if (ods->enabled)

@@ -1,6 +1,7 @@
 // pvs view --ods: the omnidirectional stereo panoramas (omnidirectional-stereo.txt, issue 14) of
 // the PVS cells that cover the viewing disc at --at, the full-scene truth with the same settings,
 // and the metrics. Options and output documented in docs/ods.md.
+#include "cli/options.h"
 #include "cli/cmd_view_ods.h"
 
 #include <chrono>
@@ -81,15 +82,15 @@ void add_ods_view_options(CLI::App* cmd, const std::shared_ptr<OdsViewArgs>& a) 
                 "--at instead of "
                 "the near-far frame; --look is then not needed (docs/ods.md)");
   cmd->add_option("--ipd", a->ipd_m, "--ods: interpupillary distance in metres")
-      ->check(CLI::Range(0.0, 10.0))
+      ->check(in_range(0.0, 10.0))
       ->capture_default_str();
   cmd->add_option(
          "--units-per-metre", a->units_per_metre,
          "--ods: scene units in one metre (the IPD is multiplied by it; glTF is in metres: 1)")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
   cmd->add_option("--ods-size", a->size, "--ods: panorama width W in pixels (height W/2), even")
-      ->check(CLI::Range(16, 16384))
+      ->check(in_range(16, 16384))
       ->capture_default_str();
   cmd->add_option("--pole-merge", a->pole_merge,
                   "--ods: pole merging (Eq. 6) start,end,exponent for both poles or top:bottom, "
@@ -105,7 +106,7 @@ void add_ods_view_options(CLI::App* cmd, const std::shared_ptr<OdsViewArgs>& a) 
   cmd->add_option("--ods-tessellation", a->tessellation,
                   "--ods raster methods: 0 = dynamic (Alg. 1 + Eq. 4), k = static level k for "
                   "every triangle")
-      ->check(CLI::Range(0, 64))
+      ->check(in_range(0, 64))
       ->capture_default_str();
 }
 

@@ -3,6 +3,7 @@
 // hold the eyes; the other eye is reprojected (vislib/render/stereo.h), its holes patched; both
 // are compared with true renders of that eye from the same set (the method's error) and from the
 // full scene (the total error).
+#include "cli/options.h"
 #include "cli/cmd_view_stereo.h"
 
 #include <chrono>
@@ -122,7 +123,7 @@ std::shared_ptr<ViewStereoArgs> add_view_stereo_options(CLI::App* view) {
                    "--stereo: render the second eye instead when more than this share of its "
                    "pixels are holes "
                    "(the paper's §14 fallback)")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(in_range(0.0, 1.0))
       ->capture_default_str();
   return a;
 }

@@ -10,6 +10,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "cli/visibility_common.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
@@ -40,6 +41,7 @@ void add_segment(CLI::App& app) {
       ->excludes(o_opt);
   cmd->add_flag("--witness", *witness, "Add one witness (face, x, y, t) per visible triangle");
   cmd->callback([=] {
+    check_output_file(a->json_out, "--json", true);  // before any work (issue 17 item 1)
     auto limit = thread_limit(a->threads);
     vislib::SegmentOptions so = segment_options(*a);
     so.want_witnesses = *witness;
@@ -81,11 +83,12 @@ void add_segment(CLI::App& app) {
     j["counts"]["scene_triangles"] = scene.triangle_count();
     j["counts"]["peak_rss_bytes"] = peak_rss_bytes();
     write_json(a->json_out, j);
-    std::fprintf(stderr,
-                 "pvs segment: %zu of %zu triangles and %zu of %zu spheres visible (%.3f s, %.2f "
-                 "pieces/pixel)\n",
-                 r.visible.size(), scene.triangle_count(), r.visible_spheres.size(),
-                 scene.sphere_count(), r.stats.seconds, r.stats.pieces_per_pixel());
+    if (show_progress())
+      std::fprintf(stderr,
+                   "pvs segment: %zu of %zu triangles and %zu of %zu spheres visible (%.3f s, %.2f "
+                   "pieces/pixel)\n",
+                   r.visible.size(), scene.triangle_count(), r.visible_spheres.size(),
+                   scene.sphere_count(), r.stats.seconds, r.stats.pieces_per_pixel());
   });
 }
 
@@ -103,13 +106,14 @@ void add_region(CLI::App& app) {
   cmd->add_option("--box", *box, "Region x0,y0,z0,x1,y1,z1 (flat along one axis = view rectangle)")
       ->required();
   cmd->add_option("--runs", *runs, "Cube orientations per perimeter segment (run 0 world-aligned)")
-      ->check(CLI::Range(1, 100000))
+      ->check(in_range(1, 100000))
       ->capture_default_str();
   cmd->add_option("--seed", *seed, "Seed of the random orientations")->capture_default_str();
   cmd->add_flag("--witness", *witness,
                 "Add one witness per id of the union: the perimeter segment and run that saw it, "
                 "and its (face, x, y, t, tau) in that run");
   cmd->callback([=] {
+    check_output_file(a->json_out, "--json", true);  // before any work (issue 17 item 1)
     auto limit = thread_limit(a->threads);
     auto b = parse_doubles(*box, "--box", 6);
     vislib::Box3 region;
@@ -124,8 +128,10 @@ void add_region(CLI::App& app) {
     vislib::Scene scene = load(*a, load_s);
     bool tty = isatty(fileno(stderr));
     auto r = vislib::region_visibility(scene, region, ro, [&](size_t done, size_t total) {
-      std::fprintf(stderr, tty ? "\rpvs region: run %zu/%zu" : "pvs region: run %zu/%zu\n", done,
-                   total);
+      if (!show_progress()) return;
+      if (show_progress())
+        std::fprintf(stderr, tty ? "\rpvs region: run %zu/%zu" : "pvs region: run %zu/%zu\n", done,
+                     total);
       if (tty && done == total) std::fprintf(stderr, "\n");
     });
     json segs = json::array();
@@ -178,9 +184,10 @@ void add_region(CLI::App& app) {
       j["witnesses"] = w;
     }
     write_json(a->json_out, j);
-    std::fprintf(stderr,
-                 "pvs region: %zu of %zu triangles visible from %zu segments x %d runs (%.3f s)\n",
-                 r.visible.size(), scene.triangle_count(), r.segments.size(), ro.runs, r.seconds);
+    if (show_progress())
+      std::fprintf(
+          stderr, "pvs region: %zu of %zu triangles visible from %zu segments x %d runs (%.3f s)\n",
+          r.visible.size(), scene.triangle_count(), r.segments.size(), ro.runs, r.seconds);
   });
 }
 

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/base/error.h"
 
@@ -47,7 +48,7 @@ vislib::Vec3 parse_vec3(const std::string& text, const std::string& option) {
 }
 
 void warn(const std::string& message) {
-  std::fprintf(stderr, "pvs: warning: %s\n", message.c_str());
+  if (show_progress()) std::fprintf(stderr, "pvs: warning: %s\n", message.c_str());
 }
 
 }  // namespace pvs_cli
@@ -62,9 +63,20 @@ int main(int argc, char** argv) {
   auto& reg = pvs_cli::registry();
   std::sort(reg.begin(), reg.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (auto& [name, add] : reg) add(app);
+  for (CLI::App* sub : app.get_subcommands({}))
+    if (!sub->get_name().empty()) pvs_cli::add_common_options(*sub);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() != 0) {
+      // An unknown option is named before any other mistake (a missing required option, which
+      // CLI11 checks first, is often a consequence of it).
+      std::string unknown = pvs_cli::first_unknown_option(app, argc, argv);
+      if (!unknown.empty()) {
+        std::fprintf(stderr, "pvs: error: unknown option '%s' (see --help)\n", unknown.c_str());
+        return 2;
+      }
+    }
     int code = app.exit(e);
     return code == 0 ? 0 : 2;
   } catch (const pvs_cli::Exit& e) {

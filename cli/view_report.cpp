@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "cli/options.h"
 #include "vislib/eval/metrics.h"
 
 namespace pvs_cli {
@@ -57,6 +58,7 @@ json growth_json(const vislib::GrowthRun& g) {
 }
 
 void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
+  if (!show_progress()) return;  // the summary on stderr obeys -q (the JSON has it all)
   auto fmt_psnr = [](const json& v) {
     return v.is_null() ? std::string("inf") : std::to_string(v.get<double>());
   };

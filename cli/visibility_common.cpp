@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "vislib/base/file_util.h"
 
 namespace pvs_cli {
@@ -16,25 +17,25 @@ using nlohmann::json;
 void add_common(CLI::App* cmd, VisibilityArgs& a) {
   cmd->add_option("SCENE", a.scene, "Scene file (.glb .gltf .obj .ply .off .stl)")->required();
   cmd->add_option("--res", a.resolution, "Cube face resolution N (N x N pixels per face)")
-      ->check(CLI::Range(1, 16384))
+      ->check(in_range(1, 16384))
       ->capture_default_str();
   cmd->add_option("--near", a.near, "Near plane: view depth below which hits do not count")
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->capture_default_str();
   cmd->add_option("--eps-len", a.eps_len, "Final pieces must be longer than this (in t) to count")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(in_range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--granularity", a.granularity, "Report visible triangles or objects")
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
-  cmd->add_option("--threads", a.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("-j,--threads", a.threads, "Worker threads (0 = all cores)")
+      ->check(non_negative());
   cmd->add_option("--tile", a.tile, "Tile side in pixels (memory/parallelism grain)")
-      ->check(CLI::Range(1, 4096))
+      ->check(in_range(1, 4096))
       ->capture_default_str();
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")
-      ->check(CLI::Range(1, 100000));
+      ->check(in_range(1, 100000));
   cmd->add_option(
          "--mode", a.mode,
          "Dynamic scenes: 'diagonal' (animation time advances with the eye, the paper's mode) or "
@@ -53,7 +54,7 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
          "--eps-z", a.eps_z,
          "Depth tie tolerance with --coplanar both, relative to the front depth (unitless: 1e-6 = "
          "1 um at 1 m)")
-      ->check(CLI::Range(0.0, 0.1))
+      ->check(in_range(0.0, 0.1))
       ->capture_default_str();
   cmd->add_option("--json", a.json_out, "Write the result as JSON to this file ('-' = stdout)")
       ->required();

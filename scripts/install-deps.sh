@@ -7,13 +7,20 @@ PACKAGES=(
   libembree-dev libtbb-dev libcgal-dev libopenmesh-dev libtinygltf-dev libmeshoptimizer-dev
   libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libstb-dev
-  python3 python3-matplotlib python3-numpy
+  python3 python3-matplotlib python3-numpy help2man
   clang libclang-rt-14-dev clang-format
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Optional, not installed from Debian (nodejs + npm pull hundreds of packages): when node and npm
+# are already present, the Khronos glTF validator for GltfExport.KhronosValidatorFindsNoError...
+# (that test skips without it).
+if command -v node > /dev/null && command -v npm > /dev/null &&
+  ! NODE_PATH="$(npm root -g)" node -e "require('gltf-validator')" 2> /dev/null; then
+  npm install -g gltf-validator > /dev/null 2>&1 || echo "install-deps: npm install -g gltf-validator failed (its test will skip)"
+fi
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#PACKAGES[@]} packages present"
   exit 0

@@ -429,6 +429,31 @@ TEST(PvsFormat, FuzzCorpusIsReadOrRejectedCleanly) {
   EXPECT_GE(files, 2u);
 }
 
+// docs/pvs-format.md, RunLength: the worked byte example, both ways (issue 17 item 4): the
+// writer gives the doc's bytes, and the doc's decoder (pseudocode, transcribed) gives the ids back.
+TEST(PvsFormat, RunLengthWorkedExampleOfTheSpecIsExact) {
+  const std::vector<uint32_t> ids = {3, 4, 5, 9, 200, 201, 202};
+  const std::string doc = std::string("\x03", 1) + std::string("\x03\x02", 2) +
+                          std::string("\x02\x00", 2) + std::string("\xBD\x01\x02", 3);
+  std::string payload;
+  pvs::append_run_length(payload, ids);
+  EXPECT_EQ(payload, doc);
+  // The doc's decoder; all varints here but 0xBD 0x01 are one byte.
+  std::vector<uint32_t> values;
+  for (size_t i = 0; i < doc.size(); ++i) {
+    uint32_t v = uint8_t(doc[i]) & 0x7F;
+    if (uint8_t(doc[i]) & 0x80) v |= uint32_t(uint8_t(doc[++i])) << 7;
+    values.push_back(v);
+  }
+  ASSERT_EQ(values.size(), 7u);
+  std::vector<uint32_t> decoded;
+  uint32_t next = 0;
+  for (uint32_t r = 0; r < values[0]; ++r) {
+    uint32_t first = next + values[1 + 2 * r] + (r > 0 ? 1 : 0);
+    for (uint32_t id = first; id <= first + values[2 + 2 * r]; ++id) decoded.push_back(id);
+    next = first + values[2 + 2 * r] + 1;
+  }
+  EXPECT_EQ(decoded, ids);
 // pvs::StreamWriter (and write_pvs, built on it) gives the bytes of the writer released before
 // streaming: the fnv1a64 of its output on two inputs that use every Delta reference (grid
 // neighbours along x, y, z; box list nearest centres up to 4096 cells back) was computed with

@@ -203,3 +203,44 @@ TEST(ViewCells, CellVisibilityIsTheSameWithOneAndTwoThreads) {
   EXPECT_EQ(one, two);
   EXPECT_NE(cell_seed(7, 0), cell_seed(7, 1));
 }
+
+// Issue 17 item 6: a walkable column that straddles a building holds points inside it.
+TEST(ViewCellsFreeSpace, PointInsideClosedBoxIsEnclosedAndStreetPointIsNot) {
+  Scene s = test_level();  // floor 10 x 10, box 4 x 5 x 4 at the corner
+  EXPECT_TRUE(point_enclosed(s, {2, 1.6, 2}));
+  EXPECT_FALSE(point_enclosed(s, {7, 1.6, 7}));  // sees the sky
+  EXPECT_FALSE(point_enclosed(s, {2, 6.0, 2}));  // above the roof
+}
+
+TEST(ViewCellsFreeSpace, UnderARoofFrontFacesAreNotEnclosure) {
+  // A floor and a downward-facing roof over it: rays up hit the roof's front face, rays
+  // sideways escape; the point is free.
+  Scene s;
+  add_floor(s, -5, 5, -5, 5, 0);
+  add_quad(s, {-5, 3, -5}, {5, 3, -5}, {5, 3, 5}, {-5, 3, 5});  // facing -y
+  EXPECT_FALSE(point_enclosed(s, {0, 1.6, 0}));
+}
+
+TEST(ViewCellsFreeSpace, CellStraddlingABuildingGivesAFreePointOutsideIt) {
+  Scene s = test_level();
+  // A cell over x 0..6, z 0..6: its centre (3, 1.65, 3) is inside the box (0..4), the samples
+  // beyond x or z = 4 are free.
+  Box3 region;
+  region.min = {0, 1.5, 0};
+  region.max = {6, 1.8, 6};
+  CellFreeSpace f = cell_free_space(s, region);
+  EXPECT_EQ(f.samples, 17);
+  EXPECT_TRUE(f.centre_enclosed);
+  EXPECT_GT(f.enclosed, 0);
+  EXPECT_LT(f.enclosed, f.samples);
+  ASSERT_TRUE(f.free_point.has_value());
+  EXPECT_FALSE(point_enclosed(s, *f.free_point));
+  EXPECT_TRUE(f.free_point->x > 4 || f.free_point->z > 4);
+  // A cell wholly in the street: centre free, nothing enclosed.
+  region.min = {6, 1.5, 6};
+  region.max = {10, 1.8, 10};
+  f = cell_free_space(s, region);
+  EXPECT_FALSE(f.centre_enclosed);
+  EXPECT_EQ(f.enclosed, 0);
+  EXPECT_EQ(*f.free_point, (Vec3{8, 1.65, 8}));
+}

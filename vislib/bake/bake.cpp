@@ -59,8 +59,9 @@ uint64_t bake_key(const pvs::FileInfo& info, Shard shard) {
 }
 
 std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                                const BakeSettings& settings, double* seconds) {
-  CellVisibility v = cell_visibility(scene, layout, cell, settings.region);
+                                const BakeSettings& settings, double* seconds,
+                                const std::function<void(double)>& progress) {
+  CellVisibility v = cell_visibility(scene, layout, cell, settings.region, progress);
   if (seconds) *seconds = v.seconds;
   return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
@@ -111,11 +112,14 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   };
   std::mutex progress_mutex;
   uint32_t done = report.resumed;
-  if (progress) progress({done, report.shard_cells, report.resumed, 0.0});
+  std::vector<double> partial(n, 0.0);  // fraction of each running cell's runs done
+  double running = 0;                   // their sum
+  if (progress) progress({done, report.shard_cells, report.resumed, 0.0, 0.0});
   const size_t threads =
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
   const size_t tokens = 4 * std::max<size_t>(1, threads);
   uint32_t next = 0;
+  try {
   tbb::parallel_pipeline(
       tokens,
       tbb::make_filter<void, uint32_t>(tbb::filter_mode::serial_in_order,
@@ -137,22 +141,40 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                   return set;
                 }
                 double seconds = 0;
+                std::function<void(double)> in_cell;  // progress inside the cell
+                if (progress)
+                  in_cell = [&, c](double fraction) {
+                    std::lock_guard<std::mutex> lock(progress_mutex);
+                    running += fraction - partial[c];
+                    partial[c] = fraction;
+                    progress({done, report.shard_cells, report.resumed, elapsed(),
+                              std::max(0.0, running)});
+                  };
                 std::vector<uint32_t> ids = with_memory_stage(
                     "baking cell " + std::to_string(c) + " of " + std::to_string(n),
-                    [&] { return bake_cell(scene, info.layout, c, settings, &seconds); });
+                    [&] { return bake_cell(scene, info.layout, c, settings, &seconds, in_cell); });
                 if (checkpoint) checkpoint->append(c, ids);
                 *set = std::move(ids);
                 report.cell_seconds[c] = seconds;
                 std::lock_guard<std::mutex> guard(progress_mutex);
                 ++done;
                 ++report.baked;
-                if (progress) progress({done, report.shard_cells, report.resumed, elapsed()});
+                running -= partial[c];
+                partial[c] = 0;
+                if (progress)
+                  progress({done, report.shard_cells, report.resumed, elapsed(),
+                            std::max(0.0, running)});
                 return set;
               }) &
           tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
               tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
                 with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
               }));
+  } catch (...) {
+    // A bake that recorded nothing leaves no checkpoint behind (issue 17 item 1).
+    if (checkpoint && done == 0) checkpoint->remove();
+    throw;
+  }
   report.seconds = elapsed();
   report.stats = writer.finish();
   out.commit();

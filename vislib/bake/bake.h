@@ -45,17 +45,22 @@ uint64_t bake_key(const pvs::FileInfo& info, Shard shard);
 
 // The visible set of one cell at the settings' granularity (sorted ids). `seconds` receives the
 // kernel time if given. Thread-safe.
+// `progress` as for cell_visibility (fraction of the cell's runs done).
 std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                                const BakeSettings& settings, double* seconds = nullptr);
+                                const BakeSettings& settings, double* seconds = nullptr,
+                                const std::function<void(double)>& progress = {});
 
 struct BakeProgress {
   uint32_t done = 0;     // cells of the shard finished, resumed ones included
   uint32_t total = 0;    // cells of the shard
   uint32_t resumed = 0;  // of which taken from the checkpoint
   double elapsed = 0;    // seconds since this run started baking
+  // Work inside the cells being baked: the sum over them of the fraction of their from-segment
+  // runs done, so done + running (<= total) counts the cells' work finished (a long cell shows).
+  double running = 0;
 };
-// Called once before the first cell (done = resumed) and after every finished cell, serialised
-// (never two calls at once) but from any worker thread.
+// Called once before the first cell (done = resumed), after every from-segment run inside a cell
+// and after every finished cell, serialised (never two calls at once) but from any worker thread.
 using BakeProgressFn = std::function<void(const BakeProgress&)>;
 
 struct BakeFiles {

@@ -7,6 +7,19 @@
 
 namespace vislib {
 
+SceneAppearance appearance_subset(const Scene& scene, const SceneAppearance& appearance,
+                                  const std::vector<uint32_t>& ids, Granularity granularity) {
+  SceneAppearance out = appearance;
+  if (appearance.triangle_material.size() != scene.triangle_count()) return out;
+  Primitives prims = primitives_of(scene, granularity, ids);
+  std::vector<uint8_t> keep(scene.triangle_count(), 0);
+  for (uint32_t t : prims.triangles) keep[t] = 1;
+  out.triangle_material.clear();
+  for (size_t t = 0; t < scene.triangle_count(); ++t)
+    if (keep[t]) out.triangle_material.push_back(appearance.triangle_material[t]);
+  return out;
+}
+
 Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granularity granularity) {
   // The ids are read with the bake's one id rule (bake/id_universe.h).
   Primitives prims = primitives_of(scene, granularity, ids);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/appearance.h"
 #include "vislib/scene/scene.h"
 
 namespace vislib {
@@ -18,5 +19,11 @@ namespace vislib {
 // positions are kept (unused vertices too: writers such as scene_to_glb write only the vertices an
 // object uses).
 Scene scene_subset(const Scene& scene, const std::vector<uint32_t>& ids, Granularity granularity);
+
+// The appearance of scene_subset(scene, ids, granularity): `appearance` (aligned with `scene`)
+// with the per-triangle materials of the kept triangles; per-vertex data, materials, images and
+// copyright are kept whole (vertex ids do not change).
+SceneAppearance appearance_subset(const Scene& scene, const SceneAppearance& appearance,
+                                  const std::vector<uint32_t>& ids, Granularity granularity);
 
 }  // namespace vislib

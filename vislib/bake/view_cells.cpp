@@ -274,7 +274,8 @@ uint64_t cell_seed(uint64_t seed, uint32_t cell) {
 }
 
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                               const RegionOptions& options) {
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress) {
   Box3 region = to_box3(layout.view_region(cell));
   CellVisibility out;
   out.segments = cell_boundary_segments(region);
@@ -286,7 +287,12 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
   for (int r = 0; r < rects; ++r) {
     RegionOptions o = options;
     o.seed = Rng::derive(seed, uint64_t(r));
-    RegionResult rr = region_visibility(scene, rect[r], o);
+    std::function<void(size_t, size_t)> run_done;
+    if (progress)
+      run_done = [&](size_t done, size_t total) {
+        progress((double(r) + double(done) / double(std::max<size_t>(1, total))) / double(rects));
+      };
+    RegionResult rr = region_visibility(scene, rect[r], o, run_done);
     std::vector<uint32_t> merged;
     merged.reserve(out.triangles.size() + rr.visible.size());
     std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(), rr.visible.end(),
@@ -297,6 +303,93 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
                    rr.visible_spheres.end(), std::back_inserter(merged));
     out.spheres = std::move(merged);
     out.seconds += rr.seconds;
+  }
+  return out;
+}
+
+namespace {
+
+// Möller-Trumbore: distance t > 0 along `d` from `o` to the triangle, if hit.
+std::optional<double> ray_triangle(Vec3 o, Vec3 d, const std::array<Vec3, 3>& c) {
+  Vec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
+  Vec3 pv = cross(d, e2);
+  double det = dot(e1, pv);
+  if (det == 0 || !std::isfinite(det)) return std::nullopt;
+  double inv = 1.0 / det;
+  Vec3 tv = o - c[0];
+  double u = dot(tv, pv) * inv;
+  if (u < 0 || u > 1) return std::nullopt;
+  Vec3 qv = cross(tv, e1);
+  double v = dot(d, qv) * inv;
+  if (v < 0 || u + v > 1) return std::nullopt;
+  double t = dot(e2, qv) * inv;
+  if (!(t > 0)) return std::nullopt;
+  return t;
+}
+
+std::array<Vec3, kEnclosureRays> enclosure_directions() {
+  std::array<Vec3, kEnclosureRays> d;
+  int k = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int s = -1; s <= 1; s += 2) {
+      Vec3 v{0, 0, 0};
+      v[a] = s;
+      d[k++] = v;
+    }
+  for (int sx = -1; sx <= 1; sx += 2)
+    for (int sy = -1; sy <= 1; sy += 2)
+      for (int sz = -1; sz <= 1; sz += 2)
+        d[k++] = Vec3{double(sx), double(sy), double(sz)} * (1 / std::sqrt(3.0));
+  // Tilt every direction by fixed small rotations about y then x (0.1 and 0.07 rad).
+  const double a = 0.1, b = 0.07;
+  for (Vec3& v : d) {
+    Vec3 r{std::cos(a) * v.x + std::sin(a) * v.z, v.y, -std::sin(a) * v.x + std::cos(a) * v.z};
+    v = {r.x, std::cos(b) * r.y - std::sin(b) * r.z, std::sin(b) * r.y + std::cos(b) * r.z};
+  }
+  return d;
+}
+
+}  // namespace
+
+bool point_enclosed(const Scene& scene, Vec3 p, size_t state) {
+  static const std::array<Vec3, kEnclosureRays> dirs = enclosure_directions();
+  int back = 0;
+  for (const Vec3& d : dirs) {
+    double best = INFINITY;
+    bool best_back = false;
+    for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
+      auto c = scene.corners(t, state);
+      auto hit = ray_triangle(p, d, c);
+      if (hit && *hit < best) {
+        best = *hit;
+        best_back = dot(cross(c[1] - c[0], c[2] - c[0]), d) > 0;
+      }
+    }
+    if (!std::isfinite(best)) return false;  // escapes
+    back += best_back;
+  }
+  return 2 * back > kEnclosureRays;
+}
+
+CellFreeSpace cell_free_space(const Scene& scene, const Box3& r, size_t state) {
+  CellFreeSpace out;
+  const Vec3 centre = (r.min + r.max) * 0.5;
+  std::vector<Vec3> samples = {centre};
+  for (int sz = 0; sz < 4; ++sz)
+    for (int sx = 0; sx < 4; ++sx)
+      samples.push_back({r.min.x + (r.max.x - r.min.x) * (sx + 0.5) / 4, centre.y,
+                         r.min.z + (r.max.z - r.min.z) * (sz + 0.5) / 4});
+  double best = INFINITY;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    bool enclosed = point_enclosed(scene, samples[i], state);
+    ++out.samples;
+    out.enclosed += enclosed;
+    if (i == 0) out.centre_enclosed = enclosed;
+    double dist = length(samples[i] - centre);
+    if (!enclosed && dist < best) {  // strict: the first of equally near samples wins
+      best = dist;
+      out.free_point = samples[i];
+    }
   }
   return out;
 }

@@ -11,8 +11,10 @@
 namespace vislib {
 
 // glTF 2.0, .gltf or .glb (import_gltf.cpp).
+struct SceneAppearance;
+// With `appearance`, also fills it (appearance.h).
 Scene load_gltf(const std::string& path, const LoadOptions& options,
-                std::vector<std::string>& warnings);
+                std::vector<std::string>& warnings, SceneAppearance* appearance = nullptr);
 // OBJ (groups become objects), PLY, OFF, STL by extension (import_mesh.cpp).
 Scene load_mesh(const std::string& path, std::vector<std::string>& warnings);
 // PLY ascii / binary little and big endian (vislib/scene/import_ply.cpp).

@@ -36,6 +36,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -43,6 +44,7 @@
 
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/scene/appearance.h"
 #include "vislib/scene/import_formats.h"
 
 namespace vislib {
@@ -119,7 +121,11 @@ struct Prim {
   std::vector<std::array<uint32_t, 4>> joints;  // empty unless skinned
   std::vector<std::array<double, 4>> weights;
   // POSITION displacement of each vertex per morph target; a target without POSITION is empty.
-  std::vector<std::vector<Vec3>> targets;
+  std::vector<std::vector<Vec3>> targets;  // With the appearance only: NORMAL and TEXCOORD_0 per
+                                           // vertex (empty when absent), material.
+  std::vector<Vec3> normals;
+  std::vector<std::array<double, 2>> uvs;
+  int material = -1;
 };
 
 struct Ctx {
@@ -381,7 +387,7 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
   return out;
 }
 
-std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
+std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned, bool appearance) {
   const auto& mesh = ctx.model.meshes[mesh_index];
   std::vector<Prim> prims;
   for (size_t pi = 0; pi < mesh.primitives.size(); ++pi) {
@@ -484,6 +490,33 @@ std::vector<Prim> decode_mesh(Ctx& ctx, int mesh_index, bool skinned) {
                    std::to_string(v) + " is not finite (NaN or inf)");
       }
       out.targets.push_back(std::move(disp));
+    }
+    if (appearance) {
+      out.material = prim.material;
+      if (prim.material >= int(ctx.model.materials.size())) out.material = -1;
+      auto n_it = prim.attributes.find("NORMAL");
+      if (n_it != prim.attributes.end()) {
+        auto nv3 = read_accessor(ctx, n_it->second, "NORMAL of " + where, nc, {3});
+        if (nv3.size() == 3 * nv) {
+          out.normals.resize(nv);
+          for (size_t v = 0; v < nv; ++v)
+            out.normals[v] = {nv3[3 * v], nv3[3 * v + 1], nv3[3 * v + 2]};
+        } else {
+          ctx.warnings->push_back(ctx.path + ": " + where +
+                                  ": NORMAL count differs from POSITION; normals dropped");
+        }
+      }
+      auto t_it = prim.attributes.find("TEXCOORD_0");
+      if (t_it != prim.attributes.end()) {
+        auto uv = read_accessor(ctx, t_it->second, "TEXCOORD_0 of " + where, nc, {2});
+        if (uv.size() == 2 * nv) {
+          out.uvs.resize(nv);
+          for (size_t v = 0; v < nv; ++v) out.uvs[v] = {uv[2 * v], uv[2 * v + 1]};
+        } else {
+          ctx.warnings->push_back(ctx.path + ": " + where +
+                                  ": TEXCOORD_0 count differs from POSITION; UVs dropped");
+        }
+      }
     }
     prims.push_back(std::move(out));
   }
@@ -843,10 +876,123 @@ void parse_file(Ctx& ctx) {
   ctx.is_decoded.assign(ctx.model.bufferViews.size(), 0);
 }
 
+// The inverse transpose of the linear part of `a` applied to `n` (a normal), not normalised.
+Vec3 transform_normal(const Mat4& a, Vec3 n) {
+  // cofactor(A) = det(A) * A^-T: the cofactor times sign(det) has the direction of A^-T n.
+  const double* m = a.m;  // column-major: A(r, c) = m[c * 4 + r]
+  auto A = [&](int r, int c) { return m[c * 4 + r]; };
+  double C[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      int r1 = (r + 1) % 3, r2 = (r + 2) % 3, c1 = (c + 1) % 3, c2 = (c + 2) % 3;
+      C[r][c] = A(r1, c1) * A(r2, c2) - A(r1, c2) * A(r2, c1);
+    }
+  double det = A(0, 0) * C[0][0] + A(0, 1) * C[0][1] + A(0, 2) * C[0][2];
+  double s = det < 0 ? -1 : 1;
+  return {s * (C[0][0] * n.x + C[0][1] * n.y + C[0][2] * n.z),
+          s * (C[1][0] * n.x + C[1][1] * n.y + C[1][2] * n.z),
+          s * (C[2][0] * n.x + C[2][1] * n.y + C[2][2] * n.z)};
+}
+
+Vec3 unit_or_nan(Vec3 v) {
+  double l = length(v);
+  if (!(l > 0) || !std::isfinite(l)) return {NAN, NAN, NAN};
+  return v * (1 / l);
+}
+
+std::string image_mime(const tinygltf::Image& im) {
+  if (!im.mimeType.empty()) return im.mimeType;
+  std::string u = im.uri;
+  for (auto& c : u) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (u.size() >= 4 && u.compare(u.size() - 4, 4, ".png") == 0) return "image/png";
+  if ((u.size() >= 4 && u.compare(u.size() - 4, 4, ".jpg") == 0) ||
+      (u.size() >= 5 && u.compare(u.size() - 5, 5, ".jpeg") == 0))
+    return "image/jpeg";
+  return "";
+}
+
+// "a%20b.png" -> "a b.png" (glTF URIs are percent-encoded).
+std::string percent_decode(const std::string& u) {
+  std::string out;
+  for (size_t i = 0; i < u.size(); ++i) {
+    if (u[i] == '%' && i + 2 < u.size() && std::isxdigit(static_cast<unsigned char>(u[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(u[i + 2]))) {
+      out += char(std::stoi(u.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      out += u[i];
+    }
+  }
+  return out;
+}
+
+void read_materials(Ctx& ctx, SceneAppearance& app) {
+  const auto& model = ctx.model;
+  app.copyright = model.asset.copyright;
+  for (size_t i = 0; i < model.images.size(); ++i) {
+    const auto& im = model.images[i];
+    AppearanceImage out;
+    out.name = im.name;
+    out.mime_type = image_mime(im);
+    if (im.bufferView >= 0) {
+      Bytes b = view_bytes(ctx, im.bufferView, "image " + std::to_string(i));
+      out.bytes.assign(reinterpret_cast<const char*>(b.data), b.size);
+    } else if (im.uri.rfind("data:", 0) == 0) {
+      std::vector<unsigned char> data;
+      std::string mime;
+      if (tinygltf::DecodeDataURI(&data, mime, im.uri, 0, false))
+        out.bytes.assign(data.begin(), data.end());
+      if (out.mime_type.empty()) out.mime_type = mime;
+    } else if (!im.uri.empty()) {
+      out.uri = im.uri;
+      std::filesystem::path f =
+          std::filesystem::path(ctx.path).parent_path() / percent_decode(im.uri);
+      try {
+        out.bytes = read_file(f.string());
+      } catch (const std::exception&) {
+        ctx.warnings->push_back(ctx.path + ": image " + std::to_string(i) + ": cannot read " +
+                                f.string());
+      }
+    }
+    app.images.push_back(std::move(out));
+  }
+  for (const auto& m : model.materials) {
+    AppearanceMaterial out;
+    out.name = m.name;
+    const auto& pbr = m.pbrMetallicRoughness;
+    for (int c = 0; c < 4 && c < int(pbr.baseColorFactor.size()); ++c)
+      out.base_color[c] = pbr.baseColorFactor[c];
+    int tex = pbr.baseColorTexture.index;
+    if (tex >= 0 && size_t(tex) < model.textures.size()) {
+      int src = model.textures[size_t(tex)].source;
+      if (src >= 0 && size_t(src) < model.images.size()) out.base_color_image = src;
+    }
+    out.base_color_texcoord = uint32_t(std::max(0, pbr.baseColorTexture.texCoord));
+    if (out.base_color_texcoord != 0) out.base_color_image = -1;  // only TEXCOORD_0 is kept
+    out.metallic = pbr.metallicFactor;
+    out.roughness = pbr.roughnessFactor;
+    for (int c = 0; c < 3 && c < int(m.emissiveFactor.size()); ++c)
+      out.emissive[c] = m.emissiveFactor[c];
+    if (!m.alphaMode.empty()) out.alpha_mode = m.alphaMode;
+    out.alpha_cutoff = m.alphaCutoff;
+    out.double_sided = m.doubleSided;
+    app.materials.push_back(std::move(out));
+  }
+}
+
 }  // namespace
 
+SceneAppearance load_appearance(const std::string& path, const LoadOptions& options,
+                                std::vector<std::string>* warnings) {
+  std::vector<std::string> local;
+  SceneAppearance app;
+  std::string ext = file_extension(path);
+  if (ext == ".gltf" || ext == ".glb") load_gltf(path, options, warnings ? *warnings : local, &app);
+  return app;
+}
+
 Scene load_gltf(const std::string& path, const LoadOptions& options,
-                std::vector<std::string>& warnings) {
+                std::vector<std::string>& warnings, SceneAppearance* appearance) {
   Ctx ctx;
   ctx.path = path;
   ctx.warnings = &warnings;
@@ -995,6 +1141,10 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     }
   }
 
+  if (appearance) {
+    *appearance = SceneAppearance{};
+    read_materials(ctx, *appearance);
+  }
   Scene scene;
   scene.positions.resize(K);
   // Memory: the scene's arrays are reserved from the accessor counts (an upper bound: skipped
@@ -1030,7 +1180,7 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     const auto& nd = model.nodes[n];
     bool skinned = nd.skin >= 0;
     if (!mesh_cached[nd.mesh]) {
-      mesh_cache[nd.mesh] = decode_mesh(ctx, nd.mesh, skinned);
+      mesh_cache[nd.mesh] = decode_mesh(ctx, nd.mesh, skinned, appearance != nullptr);
       mesh_cached[nd.mesh] = 1;
     }
     // Released at the end of this iteration if this is the mesh's last instance.
@@ -1111,6 +1261,31 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
         scene.triangles.push_back(
             {uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
         scene.triangle_object.push_back(obj);
+      }
+      if (appearance) {
+        SceneAppearance& app = *appearance;
+        for (size_t v = 0; v < p.local.size(); ++v) {
+          Vec3 nrm{NAN, NAN, NAN};
+          if (!p.normals.empty()) {
+            if (!skinned || p.joints.empty()) {
+              nrm = unit_or_nan(transform_normal(world[0][n], p.normals[v]));
+            } else {
+              // The weight blend of the joints' normal transforms; joints whose matrix is
+              // singular (scaled to 0) are skipped, and the node transform is the fallback.
+              Vec3 acc{0, 0, 0};
+              for (int c = 0; c < 4; ++c) {
+                if (p.weights[v][c] == 0 || p.joints[v][c] >= joint_m[0].size()) continue;
+                Vec3 t = unit_or_nan(transform_normal(joint_m[0][p.joints[v][c]], p.normals[v]));
+                if (is_finite(t)) acc = acc + t * p.weights[v][c];
+              }
+              nrm = unit_or_nan(acc);
+              if (!is_finite(nrm)) nrm = unit_or_nan(transform_normal(world[0][n], p.normals[v]));
+            }
+          }
+          app.normals.push_back(nrm);
+          app.uvs.push_back(p.uvs.empty() ? std::array<double, 2>{NAN, NAN} : p.uvs[v]);
+        }
+        app.triangle_material.insert(app.triangle_material.end(), p.tris.size(), p.material);
       }
     }
   }

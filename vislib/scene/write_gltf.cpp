@@ -1,228 +1,305 @@
-// write_gltf.cpp: GLB writer (glTF 2.0 spec, section 4.4 "Binary glTF layout"). Writes the bytes
-// directly (JSON chunk + BIN chunk) so that a scene of tens of millions of triangles is copied
-// into the output once; the JSON is built with nlohmann::ordered_json for a stable key order.
+// write_gltf.cpp: GLB writer through tinygltf (glTF 2.0; section 4.4 "Binary glTF layout" is
+// tinygltf's). Builds a tinygltf::Model: one node + mesh per object, a primitive per run of
+// triangles of one material, positions (and morph targets), normals, UVs, materials with their
+// base colour textures embedded in the BIN chunk, and the source's asset.copyright.
 #include "vislib/scene/write_gltf.h"
 
+#include <tiny_gltf.h>
+
 #include <cassert>
+#include <cmath>
 #include <cstring>
 #include <limits>
-#include <nlohmann/json.hpp>
+#include <sstream>
 #include <stdexcept>
 
 namespace vislib {
 
 namespace {
 
-using Json = nlohmann::ordered_json;
+constexpr int kArrayBuffer = TINYGLTF_TARGET_ARRAY_BUFFER;
+constexpr int kElementArrayBuffer = TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER;
 
-constexpr uint32_t kArrayBuffer = 34962, kElementArrayBuffer = 34963;
-constexpr uint32_t kFloat = 5126, kUnsignedInt = 5125;
-
-// Triangles of one object, re-indexed over the vertices it uses.
-struct ObjectMesh {
+// A run of triangles of one object with one material, re-indexed over the vertices it uses.
+struct Primitive {
   std::vector<uint32_t> indices;   // local vertex ids, 3 per triangle
   std::vector<uint32_t> vertices;  // local -> scene vertex id
+  int32_t material = -1;
+  bool normals = false, uvs = false;
+};
+
+struct ObjectMesh {
+  std::vector<Primitive> prims;
   bool dynamic = false;
 };
 
-struct MinMax {
-  float lo[3] = {std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
-                 std::numeric_limits<float>::max()};
-  float hi[3] = {-std::numeric_limits<float>::max(), -std::numeric_limits<float>::max(),
-                 -std::numeric_limits<float>::max()};
-  void extend(const float* v) {
-    for (int i = 0; i < 3; ++i) {
-      lo[i] = v[i] < lo[i] ? v[i] : lo[i];
-      hi[i] = v[i] > hi[i] ? v[i] : hi[i];
+struct Writer {
+  tinygltf::Model model;
+  std::vector<unsigned char>& bin;
+  explicit Writer(std::vector<unsigned char>& b) : bin(b) {}
+
+  int add_view(const void* data, size_t bytes, int target) {
+    while (bin.size() % 4) bin.push_back(0);
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = bin.size();
+    v.byteLength = bytes;
+    if (target) v.target = target;
+    const auto* p = static_cast<const unsigned char*>(data);
+    bin.insert(bin.end(), p, p + bytes);
+    model.bufferViews.push_back(v);
+    return int(model.bufferViews.size() - 1);
+  }
+  int add_accessor(int view, int component, size_t count, int type) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.componentType = component;
+    a.count = count;
+    a.type = type;
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
+  }
+  // Float VEC3/VEC2 data with min/max when `bounds`.
+  int add_floats(const std::vector<float>& f, int ncomp, bool bounds) {
+    int view = add_view(f.data(), 4 * f.size(), kArrayBuffer);
+    int a = add_accessor(view, TINYGLTF_COMPONENT_TYPE_FLOAT, f.size() / ncomp,
+                         ncomp == 3 ? TINYGLTF_TYPE_VEC3 : TINYGLTF_TYPE_VEC2);
+    if (bounds) {
+      std::vector<double> lo(ncomp, std::numeric_limits<float>::max()),
+          hi(ncomp, -std::numeric_limits<float>::max());
+      for (size_t i = 0; i < f.size(); ++i) {
+        lo[i % ncomp] = std::min(lo[i % ncomp], double(f[i]));
+        hi[i % ncomp] = std::max(hi[i % ncomp], double(f[i]));
+      }
+      model.accessors[a].minValues = lo;
+      model.accessors[a].maxValues = hi;
     }
+    return a;
   }
 };
 
-// Float position of vertex `v` in state `k`, as a displacement from state 0 when `k` > 0.
-void vertex_float(const Scene& s, uint32_t v, size_t k, float out[3]) {
-  Vec3 p = k == 0 ? s.positions[0][v] : s.positions[k][v] - s.positions[0][v];
-  out[0] = float(p.x);
-  out[1] = float(p.y);
-  out[2] = float(p.z);
-}
-
-Json vec3_json(const float* v) {
-  return Json::array({double(v[0]), double(v[1]), double(v[2])});
+bool finite3(const Vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
 }  // namespace
 
-std::string scene_to_glb(const Scene& scene) {
+std::string scene_to_glb(const Scene& scene, const SceneAppearance* appearance) {
   const size_t K = scene.positions.size() ? scene.positions.size() : 1;
   const size_t nobj = scene.objects.size();
   assert(scene.triangle_object.size() == scene.triangles.size());
+  const SceneAppearance* app = appearance;
+  const bool has_normals = app && app->normals.size() == scene.vertex_count();
+  const bool has_uvs = app && app->uvs.size() == scene.vertex_count();
+  const bool has_materials = app && app->triangle_material.size() == scene.triangle_count();
 
-  // Bucket triangles by object (stable: id order within an object), then re-index.
+  // Bucket triangles by object (stable: id order within an object), split into runs of one
+  // material, re-index each run over the vertices it uses (numbered by first use).
+  std::vector<std::vector<uint32_t>> by_object(nobj);
+  for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
+    assert(scene.triangle_object[t] < nobj);
+    by_object[scene.triangle_object[t]].push_back(t);
+  }
   std::vector<ObjectMesh> meshes(nobj);
-  {
-    std::vector<size_t> count(nobj, 0);
-    for (uint32_t o : scene.triangle_object) {
-      assert(o < nobj);
-      ++count[o];
-    }
-    for (size_t o = 0; o < nobj; ++o) meshes[o].indices.reserve(3 * count[o]);
-    std::vector<uint32_t> local(scene.vertex_count(), UINT32_MAX);
-    std::vector<uint32_t> touched;
-    std::vector<size_t> order;  // triangle ids grouped by object
-    order.reserve(scene.triangles.size());
-    std::vector<size_t> start(nobj + 1, 0);
-    for (size_t o = 0; o < nobj; ++o) start[o + 1] = start[o] + count[o];
-    order.resize(scene.triangles.size());
-    std::vector<size_t> fill(start.begin(), start.end() - 1);
-    for (size_t t = 0; t < scene.triangles.size(); ++t) order[fill[scene.triangle_object[t]]++] = t;
-    for (size_t o = 0; o < nobj; ++o) {
-      ObjectMesh& m = meshes[o];
-      for (size_t i = start[o]; i < start[o + 1]; ++i)
-        for (uint32_t v : scene.triangles[order[i]]) {
-          assert(v < scene.vertex_count());
-          if (local[v] == UINT32_MAX) {
-            local[v] = uint32_t(m.vertices.size());
-            m.vertices.push_back(v);
-          }
-          m.indices.push_back(local[v]);
+  std::vector<uint32_t> local(scene.vertex_count(), UINT32_MAX);
+  for (size_t o = 0; o < nobj; ++o) {
+    ObjectMesh& m = meshes[o];
+    for (uint32_t t : by_object[o]) {
+      int32_t mat = has_materials ? app->triangle_material[t] : -1;
+      if (mat >= int32_t(app ? app->materials.size() : 0)) mat = -1;
+      if (m.prims.empty() || m.prims.back().material != mat) {
+        for (uint32_t v : m.prims.empty() ? std::vector<uint32_t>{} : m.prims.back().vertices)
+          local[v] = UINT32_MAX;
+        m.prims.emplace_back();
+        m.prims.back().material = mat;
+      }
+      Primitive& p = m.prims.back();
+      for (uint32_t v : scene.triangles[t]) {
+        assert(v < scene.vertex_count());
+        if (local[v] == UINT32_MAX) {
+          local[v] = uint32_t(p.vertices.size());
+          p.vertices.push_back(v);
         }
-      for (uint32_t v : m.vertices) {
+        p.indices.push_back(local[v]);
+      }
+    }
+    for (Primitive& p : m.prims) {
+      for (uint32_t v : p.vertices) {
         local[v] = UINT32_MAX;
         for (size_t k = 1; k < K && !m.dynamic; ++k)
           if (scene.positions[k][v] != scene.positions[0][v]) m.dynamic = true;
       }
+      p.normals = has_normals;
+      p.uvs = has_uvs;
+      for (uint32_t v : p.vertices) {
+        p.normals = p.normals && finite3(app->normals[v]);
+        p.uvs = p.uvs && std::isfinite(app->uvs[v][0]) && std::isfinite(app->uvs[v][1]);
+      }
     }
   }
 
-  // JSON and the BIN layout: per object indices, positions, then K-1 targets if dynamic; then the
-  // animation's time and weight keyframes.
-  Json j;
-  j["asset"] = {{"version", "2.0"}, {"generator", "vislib scene_to_glb"}};
-  j["scene"] = 0;
-  Json nodes = Json::array(), meshes_json = Json::array(), views = Json::array(),
-       accessors = Json::array(), channels = Json::array(), samplers = Json::array();
-  uint64_t offset = 0;
-  auto add_view = [&](uint64_t bytes, uint32_t target) {
-    Json v = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}};
-    if (target) v["target"] = target;
-    views.push_back(v);
-    offset += bytes;
-    return views.size() - 1;
-  };
-  auto add_accessor = [&](size_t view, uint32_t type, size_t count, const char* kind) {
-    accessors.push_back(
-        {{"bufferView", view}, {"componentType", type}, {"count", count}, {"type", kind}});
-    return accessors.size() - 1;
-  };
+  std::vector<unsigned char> bin;
+  Writer w(bin);
+  tinygltf::Model& model = w.model;
+  model.asset.version = "2.0";
+  model.asset.generator = "vislib scene_to_glb";
+  if (app) model.asset.copyright = app->copyright;
+
+  // Materials and their images (embedded), only those some kept triangle uses, in index order.
+  std::vector<int> material_id(app ? app->materials.size() : 0, -1);
+  for (const auto& m : meshes)
+    for (const auto& p : m.prims)
+      if (p.material >= 0) material_id[size_t(p.material)] = 0;
+  std::vector<int> texture_of_image(app ? app->images.size() : 0, -1);
+  for (size_t i = 0; i < material_id.size(); ++i) {
+    if (material_id[i] < 0) continue;
+    const AppearanceMaterial& am = app->materials[i];
+    tinygltf::Material mat;
+    mat.name = am.name;
+    mat.pbrMetallicRoughness.baseColorFactor.assign(am.base_color.begin(), am.base_color.end());
+    mat.pbrMetallicRoughness.metallicFactor = am.metallic;
+    mat.pbrMetallicRoughness.roughnessFactor = am.roughness;
+    mat.emissiveFactor.assign(am.emissive.begin(), am.emissive.end());
+    mat.alphaMode = am.alpha_mode;
+    mat.alphaCutoff = am.alpha_cutoff;
+    mat.doubleSided = am.double_sided;
+    const int im = am.base_color_image;
+    if (im >= 0 && size_t(im) < app->images.size()) {
+      const AppearanceImage& ai = app->images[size_t(im)];
+      const bool embed =
+          !ai.bytes.empty() && (ai.mime_type == "image/png" || ai.mime_type == "image/jpeg");
+      if (texture_of_image[size_t(im)] < 0 && (embed || !ai.uri.empty())) {
+        tinygltf::Image img;
+        img.name = ai.name;
+        if (embed) {
+          img.bufferView = w.add_view(ai.bytes.data(), ai.bytes.size(), 0);
+          img.mimeType = ai.mime_type;
+        } else {
+          img.uri = ai.uri;  // a reference to the source's file, as written there
+        }
+        model.images.push_back(img);
+        if (model.samplers.empty()) model.samplers.emplace_back();  // defaults: repeat, auto filter
+        tinygltf::Texture tex;
+        tex.source = int(model.images.size() - 1);
+        tex.sampler = 0;
+        model.textures.push_back(tex);
+        texture_of_image[size_t(im)] = int(model.textures.size() - 1);
+      }
+      if (texture_of_image[size_t(im)] >= 0) {
+        mat.pbrMetallicRoughness.baseColorTexture.index = texture_of_image[size_t(im)];
+        mat.pbrMetallicRoughness.baseColorTexture.texCoord = 0;
+      }
+    }
+    material_id[i] = int(model.materials.size());
+    model.materials.push_back(mat);
+  }
+
   bool animated = false;
   for (const auto& m : meshes) animated = animated || m.dynamic;
-  size_t time_accessor = 0, weight_accessor = 0;
+  int time_accessor = -1, weight_accessor = -1;
+  tinygltf::Animation anim;
+  anim.name = "states";
   if (animated) {
-    time_accessor = add_accessor(add_view(4 * K, 0), kFloat, K, "SCALAR");
-    accessors[time_accessor]["min"] = {0.0};
-    accessors[time_accessor]["max"] = {double(K - 1)};
-    weight_accessor = add_accessor(add_view(4 * K * (K - 1), 0), kFloat, K * (K - 1), "SCALAR");
+    std::vector<float> times(K), weights(K * (K - 1), 0.0f);
+    for (size_t k = 0; k < K; ++k) {
+      times[k] = float(k);
+      if (k > 0) weights[k * (K - 1) + (k - 1)] = 1.0f;
+    }
+    time_accessor = w.add_accessor(w.add_view(times.data(), 4 * K, 0),
+                                   TINYGLTF_COMPONENT_TYPE_FLOAT, K, TINYGLTF_TYPE_SCALAR);
+    model.accessors[time_accessor].minValues = {0.0};
+    model.accessors[time_accessor].maxValues = {double(K - 1)};
+    weight_accessor =
+        w.add_accessor(w.add_view(weights.data(), 4 * weights.size(), 0),
+                       TINYGLTF_COMPONENT_TYPE_FLOAT, weights.size(), TINYGLTF_TYPE_SCALAR);
   }
-  float f[3];
+
+  tinygltf::Scene root;
   for (size_t o = 0; o < nobj; ++o) {
     const ObjectMesh& m = meshes[o];
-    Json node = {{"name", scene.objects[o].name}};
-    if (!m.indices.empty()) {
-      size_t ia = add_accessor(add_view(4 * m.indices.size(), kElementArrayBuffer), kUnsignedInt,
-                               m.indices.size(), "SCALAR");
-      Json prim = {{"attributes", Json::object()}, {"indices", ia}, {"mode", 4}};
-      const size_t states = m.dynamic ? K : 1;
-      Json targets = Json::array();
-      for (size_t k = 0; k < states; ++k) {
-        MinMax mm;
-        for (uint32_t v : m.vertices) {
-          vertex_float(scene, v, k, f);
-          mm.extend(f);
+    tinygltf::Node node;
+    node.name = scene.objects[o].name;
+    if (!m.prims.empty()) {
+      tinygltf::Mesh mesh;
+      mesh.name = scene.objects[o].name;
+      for (const Primitive& p : m.prims) {
+        tinygltf::Primitive prim;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        prim.indices = w.add_accessor(
+            w.add_view(p.indices.data(), 4 * p.indices.size(), kElementArrayBuffer),
+            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, p.indices.size(), TINYGLTF_TYPE_SCALAR);
+        std::vector<float> f;
+        f.reserve(3 * p.vertices.size());
+        for (size_t k = 0; k < (m.dynamic ? K : 1); ++k) {
+          f.clear();
+          for (uint32_t v : p.vertices) {
+            Vec3 q = k == 0 ? scene.positions[0][v] : scene.positions[k][v] - scene.positions[0][v];
+            f.insert(f.end(), {float(q.x), float(q.y), float(q.z)});
+          }
+          int a = w.add_floats(f, 3, true);
+          if (k == 0)
+            prim.attributes["POSITION"] = a;
+          else
+            prim.targets.push_back({{"POSITION", a}});
         }
-        size_t pa = add_accessor(add_view(12 * m.vertices.size(), kArrayBuffer), kFloat,
-                                 m.vertices.size(), "VEC3");
-        accessors[pa]["min"] = vec3_json(mm.lo);
-        accessors[pa]["max"] = vec3_json(mm.hi);
-        if (k == 0)
-          prim["attributes"]["POSITION"] = pa;
-        else
-          targets.push_back({{"POSITION", pa}});
+        if (p.normals) {
+          f.clear();
+          for (uint32_t v : p.vertices) {
+            // Unit length in float too (the validator checks |n| = 1 within 5e-4).
+            const Vec3& n = app->normals[v];
+            f.insert(f.end(), {float(n.x), float(n.y), float(n.z)});
+          }
+          prim.attributes["NORMAL"] = w.add_floats(f, 3, false);
+        }
+        if (p.uvs) {
+          f.clear();
+          for (uint32_t v : p.vertices)
+            f.insert(f.end(), {float(app->uvs[v][0]), float(app->uvs[v][1])});
+          prim.attributes["TEXCOORD_0"] = w.add_floats(f, 2, false);
+        }
+        if (p.material >= 0) prim.material = material_id[size_t(p.material)];
+        mesh.primitives.push_back(prim);
       }
-      if (m.dynamic) prim["targets"] = targets;
-      Json mesh = {{"name", scene.objects[o].name}, {"primitives", Json::array({prim})}};
       if (m.dynamic) {
-        mesh["weights"] = std::vector<double>(K - 1, 0.0);
-        samplers.push_back(
-            {{"input", time_accessor}, {"interpolation", "LINEAR"}, {"output", weight_accessor}});
-        channels.push_back(
-            {{"sampler", samplers.size() - 1}, {"target", {{"node", o}, {"path", "weights"}}}});
+        mesh.weights.assign(K - 1, 0.0);
+        tinygltf::AnimationSampler s;
+        s.input = time_accessor;
+        s.output = weight_accessor;
+        s.interpolation = "LINEAR";
+        anim.samplers.push_back(s);
+        tinygltf::AnimationChannel c;
+        c.sampler = int(anim.samplers.size() - 1);
+        c.target_node = int(o);
+        c.target_path = "weights";
+        anim.channels.push_back(c);
       }
-      node["mesh"] = meshes_json.size();
-      meshes_json.push_back(mesh);
+      node.mesh = int(model.meshes.size());
+      model.meshes.push_back(mesh);
     }
-    nodes.push_back(node);
+    model.nodes.push_back(node);
+    root.nodes.push_back(int(o));
   }
-  Json root_nodes = Json::array();
-  for (size_t o = 0; o < nobj; ++o) root_nodes.push_back(o);
-  j["scenes"] = Json::array({{{"nodes", root_nodes}}});
-  j["nodes"] = nodes;
-  if (!meshes_json.empty()) j["meshes"] = meshes_json;
-  if (animated)
-    j["animations"] =
-        Json::array({{{"name", "states"}, {"channels", channels}, {"samplers", samplers}}});
-  if (!accessors.empty()) {
-    j["accessors"] = accessors;
-    j["bufferViews"] = views;
-    j["buffers"] = Json::array({{{"byteLength", offset}}});
+  model.scenes.push_back(root);
+  model.defaultScene = 0;
+  if (animated) model.animations.push_back(anim);
+  while (bin.size() % 4) bin.push_back(0);
+  if (!bin.empty()) {
+    tinygltf::Buffer b;
+    b.data = std::move(bin);
+    model.buffers.push_back(std::move(b));
   }
+  const uint64_t bin_size = model.buffers.empty() ? 0 : model.buffers[0].data.size();
+  if (bin_size + (1u << 20) + 64 * model.accessors.size() > 0xFFFFFFFFull)
+    throw std::runtime_error("scene too large for GLB: " + std::to_string(bin_size) +
+                             " bytes of binary data come near the 4 GiB limit of the format");
 
-  std::string json = j.dump();
-  json.append((4 - json.size() % 4) % 4, ' ');
-  const uint64_t bin = offset;  // every view is a multiple of 4 bytes
-  const uint64_t total = 12 + 8 + json.size() + (bin ? 8 + bin : 0);
-  if (total > 0xFFFFFFFFull)
-    throw std::runtime_error("scene too large for GLB: " + std::to_string(total) +
-                             " bytes exceed the 4 GiB limit of the format");
-
-  std::string out(size_t(total), '\0');
-  char* p = out.data();
-  auto put32 = [&](uint32_t v) {
-    std::memcpy(p, &v, 4);  // GLB is little-endian, as are our targets
-    p += 4;
-  };
-  put32(0x46546C67);  // "glTF"
-  put32(2);
-  put32(uint32_t(total));
-  put32(uint32_t(json.size()));
-  put32(0x4E4F534A);  // "JSON"
-  std::memcpy(p, json.data(), json.size());
-  p += json.size();
-  if (bin) {
-    put32(uint32_t(bin));
-    put32(0x004E4942);  // "BIN\0"
-    auto putf = [&](float v) {
-      std::memcpy(p, &v, 4);
-      p += 4;
-    };
-    if (animated) {
-      for (size_t k = 0; k < K; ++k) putf(float(k));
-      for (size_t k = 0; k < K; ++k)
-        for (size_t t = 0; t + 1 < K; ++t) putf(k > 0 && t == k - 1 ? 1.0f : 0.0f);
-    }
-    for (const auto& m : meshes) {
-      if (m.indices.empty()) continue;
-      std::memcpy(p, m.indices.data(), 4 * m.indices.size());
-      p += 4 * m.indices.size();
-      for (size_t k = 0; k < (m.dynamic ? K : 1); ++k)
-        for (uint32_t v : m.vertices) {
-          vertex_float(scene, v, k, f);
-          std::memcpy(p, f, 12);
-          p += 12;
-        }
-    }
-  }
-  assert(p == out.data() + out.size());
-  return out;
+  tinygltf::TinyGLTF writer;
+  writer.SetImageWriter(nullptr,
+                        nullptr);  // images are embedded bytes or kept URIs, never re-encoded
+  std::ostringstream out;
+  if (!writer.WriteGltfSceneToStream(&model, out, false, true))
+    throw std::runtime_error("tinygltf could not write the GLB");
+  return out.str();
 }
 
 }  // namespace vislib

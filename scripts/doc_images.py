@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""doc_images.py WORK OUT: the top views and the frame strip of docs/img/ from the files that
+scripts/make-doc-images.sh leaves in WORK (city.obj from `pvs export`, summary.json and
+cell<i>.json from `pvs inspect --json`, at.json and render/ from `pvs inspect --render`)."""
+import json
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.image as mpimg  # noqa: E402
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.collections import PolyCollection  # noqa: E402
+from matplotlib.patches import Rectangle  # noqa: E402
+
+
+def read_obj(path):
+    v, f = [], []
+    with open(path) as fh:
+        for line in fh:
+            if line.startswith("v "):
+                x, y, z = map(float, line.split()[1:4])
+                v.append((x, y, z))
+            elif line.startswith("f "):
+                f.append([int(t.split("/")[0]) - 1 for t in line.split()[1:4]])
+    return v, f
+
+
+def top_polys(v, f, ids=None):
+    """Triangles seen from above (x right, z down), highest last so roofs cover streets."""
+    tris = f if ids is None else [f[i] for i in ids]
+    tris = sorted(tris, key=lambda t: max(v[i][1] for i in t))
+    return [[(v[i][0], v[i][2]) for i in t] for t in tris]
+
+
+def main(work, out):
+    v, f = read_obj(os.path.join(work, "city.obj"))
+    summary = json.load(open(os.path.join(work, "summary.json")))
+    n = summary["cells"]
+    counts = summary["per_cell"]["visible"]
+    cells = [json.load(open(os.path.join(work, "cell%d.json" % c))) for c in range(n)]
+    at = json.load(open(os.path.join(work, "at.json")))
+    all_polys = top_polys(v, f)
+
+    # 1. cells coloured by PVS size over the scene's top view.
+    fig, ax = plt.subplots(figsize=(5.2, 4.4), dpi=90)
+    ax.add_collection(PolyCollection(all_polys, facecolors="0.8", edgecolors="none"))
+    cmap = plt.get_cmap("viridis")
+    lo, hi = min(counts), max(counts)
+    for c, cell in enumerate(cells):
+        b = cell["view_region"]
+        x0, z0, x1, z1 = b["min"][0], b["min"][2], b["max"][0], b["max"][2]
+        t = (counts[c] - lo) / max(1, hi - lo)
+        ax.add_patch(Rectangle((x0, z0), x1 - x0, z1 - z0, facecolor=cmap(t), alpha=0.75, edgecolor="k", lw=0.3))
+    sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(lo, hi))
+    fig.colorbar(sm, ax=ax, label="visible triangles of the cell")
+    ax.set_title("%d walkable cells of data/city.glb, by PVS size" % n, fontsize=9)
+    finish(ax, all_polys)
+    fig.savefig(os.path.join(out, "cells_top.png"), bbox_inches="tight")
+    plt.close(fig)
+
+    # 2. one cell's visible set against the full scene.
+    fig, ax = plt.subplots(figsize=(4.6, 4.4), dpi=90)
+    ax.add_collection(PolyCollection(all_polys, facecolors="0.85", edgecolors="none"))
+    ax.add_collection(PolyCollection(top_polys(v, f, at["visible"]), facecolors="tab:red", edgecolors="none"))
+    b = at["view_region"]
+    ax.add_patch(Rectangle((b["min"][0], b["min"][2]), b["max"][0] - b["min"][0], b["max"][2] - b["min"][2],
+                           fill=False, edgecolor="k", lw=1.2))
+    ax.set_title("cell %d: %d of %d triangles visible (red)" % (at["cell"], at["visible_count"], len(f)), fontsize=9)
+    finish(ax, all_polys)
+    fig.savefig(os.path.join(out, "cell_set.png"), bbox_inches="tight")
+    plt.close(fig)
+
+    # 3. full-scene frame | PVS frame | error heat map, from the cell.
+    view = at["render"]["views"][0]
+    fig, axes = plt.subplots(1, 3, figsize=(9, 2.5), dpi=90)
+    for a, key, title in zip(axes, ("full", "pvs", "heat_map"), ("full scene", "cell's PVS", "error heat map")):
+        a.imshow(mpimg.imread(view[key]))
+        a.set_title(title, fontsize=9)
+        a.axis("off")
+    fig.suptitle("from %s looking %s: epsilon %.3g, SSIM %.4f" % (view["eye"], view["forward"], view["epsilon"],
+                                                                   view["ssim"]), fontsize=9)
+    fig.savefig(os.path.join(out, "cell_frames.png"), bbox_inches="tight")
+    plt.close(fig)
+
+
+def finish(ax, polys):
+    xs = [p[0] for poly in polys for p in poly]
+    zs = [p[1] for poly in polys for p in poly]
+    ax.set_xlim(min(xs), max(xs))
+    ax.set_ylim(max(zs), min(zs))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("z (m)")
+    ax.tick_params(labelsize=7)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    main(sys.argv[1], sys.argv[2])

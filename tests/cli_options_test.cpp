@@ -1,0 +1,219 @@
+// Tests of the conventions every `pvs` command shares (issue 17 items 1 and 2), run as a user runs
+// them: outputs checked before any work (exit 2 naming the path and the problem, parent folders
+// created, no checkpoint left), -v/-q on every command, -j, --preset, the unknown option named
+// first, validator messages without DBL_MAX, and progress inside a long cell.
+#include <gtest/gtest.h>
+
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <sstream>
+
+#include "tests/test_support.h"
+#include "vislib/base/file_util.h"
+
+using namespace vislib_test;
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A 2 x 2 block city, generated once per test binary run.
+const std::string& city() {
+  static const std::string path = [] {
+    std::string p = temp_dir("cli_options_city") + "/city.glb";
+    std::string out;
+    EXPECT_EQ(run_pvs("generate city --blocks 2,2 -q -o " + p, &out), 0) << out;
+    return p;
+  }();
+  return path;
+}
+
+// 4 grid cells at a tiny resolution.
+std::string small_bake(const std::string& extra) {
+  return "bake " + city() + " --box -30,0,-30,30,3,30 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 " + extra;
+}
+
+std::vector<std::string> subcommands() {
+  std::string out;
+  EXPECT_EQ(run_pvs("--help", &out), 0);
+  std::vector<std::string> cmds;
+  std::istringstream in(out);
+  std::string line;
+  bool on = false;
+  while (std::getline(in, line)) {
+    if (line.rfind("Subcommands:", 0) == 0) {
+      on = true;
+      continue;
+    }
+    if (on && line.size() > 2 && line[0] == ' ' && line[1] == ' ' && std::isalpha(static_cast<unsigned char>(line[2])))
+      cmds.push_back(line.substr(2, line.find(' ', 2) - 2));
+  }
+  return cmds;
+}
+
+}  // namespace
+
+// --- Item 1: output paths checked before any work ---------------------------------------------
+
+TEST(CliOutputs, BakeIntoAFolderFailsBeforeBakingAndLeavesNoCheckpoint) {
+  std::string dir = temp_dir("cli_out_bake") + "/adir";
+  fs::create_directories(dir);
+  std::string out;
+  EXPECT_EQ(run_pvs(small_bake("-o " + dir), &out), 2) << out;
+  EXPECT_NE(out.find(dir), std::string::npos) << out;
+  EXPECT_NE(out.find("is a folder"), std::string::npos) << out;
+  EXPECT_EQ(out.find("cells"), std::string::npos) << "no progress: nothing was baked\n" << out;
+  EXPECT_FALSE(fs::exists(dir + ".ckpt"));
+  // The bake report path too.
+  EXPECT_EQ(run_pvs(small_bake("--json " + dir + " -o " + dir + "/x.pvs"), &out), 2) << out;
+  EXPECT_NE(out.find("--json"), std::string::npos) << out;
+  EXPECT_FALSE(fs::exists(dir + "/x.pvs.ckpt"));
+}
+
+TEST(CliOutputs, SegmentExportAndBenchNameTheBadPath) {
+  std::string base = temp_dir("cli_out_misc");
+  std::string dir = base + "/adir", file = base + "/afile";
+  fs::create_directories(dir);
+  std::ofstream(file) << "x";
+  std::string out;
+  EXPECT_EQ(run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + dir, &out), 2) << out;
+  EXPECT_NE(out.find(dir + "' is a folder"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs("export " + city() + " -o " + dir, &out), 2) << out;
+  EXPECT_NE(out.find(dir + "' is a folder"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs("bench " + city() + " --box -1,1.6,-1,1,1.6,1 --res 8 --out " + file, &out), 2) << out;
+  EXPECT_NE(out.find(file + "' exists and is not a folder"), std::string::npos) << out;
+  EXPECT_EQ(out.find("filesystem error"), std::string::npos) << out;
+  // A parent that is a file.
+  EXPECT_EQ(run_pvs("export " + city() + " -o " + file + "/x.obj", &out), 2) << out;
+  EXPECT_NE(out.find("is not a folder"), std::string::npos) << out;
+}
+
+TEST(CliOutputs, ParentFoldersAreCreatedForEveryOutput) {
+  std::string base = temp_dir("cli_out_parents");
+  std::string out;
+  EXPECT_EQ(run_pvs("export " + city() + " -o " + base + "/e/f/flat.obj", &out), 0) << out;
+  EXPECT_TRUE(fs::exists(base + "/e/f/flat.obj"));
+  EXPECT_EQ(run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + base + "/s/t/seg.json", &out), 0)
+      << out;
+  EXPECT_TRUE(fs::exists(base + "/s/t/seg.json"));
+  EXPECT_EQ(run_pvs(small_bake("-q --json " + base + "/r/report.json -o " + base + "/b/c/city.pvs"), &out), 0) << out;
+  EXPECT_TRUE(fs::exists(base + "/b/c/city.pvs"));
+  EXPECT_TRUE(fs::exists(base + "/r/report.json"));
+  // pvs view -o into a missing folder (it failed before).
+  EXPECT_EQ(run_pvs("view " + base + "/b/c/city.pvs --scene " + city() +
+                        " --at -15,1.6,-15 --look 10,1.6,0 --centre -15,1.65,-15 --near-far 5,10 --frame 32x24 -o " + base + "/v/w/frame.png",
+                    &out),
+            0)
+      << out;
+  EXPECT_TRUE(fs::exists(base + "/v/w/frame.png"));
+}
+
+// --- Item 2: option conventions ---------------------------------------------------------------
+
+TEST(CliConventions, EveryCommandTakesVerboseAndQuiet) {
+  auto cmds = subcommands();
+  ASSERT_GE(cmds.size(), 9u);
+  for (const auto& c : cmds) {
+    std::string out;
+    EXPECT_EQ(run_pvs(c + " --help", &out), 0) << c;
+    EXPECT_NE(out.find("-v,--verbose"), std::string::npos) << c;
+    EXPECT_NE(out.find("-q,--quiet"), std::string::npos) << c;
+  }
+}
+
+TEST(CliConventions, QuietSilencesProgressAndWarnings) {
+  std::string dir = temp_dir("cli_quiet");
+  std::string out;
+  EXPECT_EQ(run_pvs(small_bake("-o " + dir + "/a.pvs"), &out), 0) << out;
+  EXPECT_NE(out.find("cells"), std::string::npos) << "progress is shown by default\n" << out;
+  EXPECT_EQ(run_pvs(small_bake("-q -o " + dir + "/b.pvs"), &out), 0) << out;
+  EXPECT_EQ(out, "");
+  // A warning (a face with 2 vertices is skipped) shows by default and not with -q.
+  std::string obj = dir + "/warn.obj";
+  std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n";
+  EXPECT_EQ(run_pvs("info " + obj, &out), 0) << out;
+  EXPECT_NE(out.find("warning"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs("info -q " + obj, &out), 0) << out;
+  EXPECT_EQ(out.find("warning"), std::string::npos) << out;
+  // -v says more than the default.
+  std::string normal, verbose;
+  EXPECT_EQ(run_pvs("export " + obj + " -o " + dir + "/n/flat.obj", &normal), 0) << normal;
+  EXPECT_EQ(run_pvs("export -v " + obj + " -o " + dir + "/m/flat.obj", &verbose), 0) << verbose;
+  EXPECT_GT(verbose.size(), normal.size()) << verbose;
+}
+
+TEST(CliConventions, DashJIsThreads) {
+  std::string dir = temp_dir("cli_j");
+  std::string out;
+  EXPECT_EQ(run_pvs(small_bake("-q -j 1 -o " + dir + "/a.pvs"), &out), 0) << out;
+  EXPECT_EQ(run_pvs(small_bake("-q --threads 2 -o " + dir + "/b.pvs"), &out), 0) << out;
+  EXPECT_EQ(vislib::read_file(dir + "/a.pvs"), vislib::read_file(dir + "/b.pvs"));
+  for (const char* c : {"bake", "bench", "segment", "region"}) {
+    EXPECT_EQ(run_pvs(std::string(c) + " --help", &out), 0);
+    EXPECT_NE(out.find("-j,--threads"), std::string::npos) << c;
+  }
+}
+
+TEST(CliConventions, PresetSetsResolutionRunsAndCellSizeAndIsReported) {
+  std::string dir = temp_dir("cli_preset");
+  std::string out;
+  std::string bake = "bake " + city() + " --walkable --box -30,-1,-30,30,1,30 ";
+  ASSERT_EQ(run_pvs(bake + "--preset draft -q --json " + dir + "/d.json -o " + dir + "/d.pvs", &out), 0) << out;
+  json d = json::parse(vislib::read_file(dir + "/d.json"));
+  EXPECT_EQ(d["preset"]["name"], "draft");
+  EXPECT_EQ(d["preset"]["res"], 128);
+  EXPECT_EQ(d["preset"]["runs"], 1);
+  EXPECT_EQ(d["preset"]["cell_size"], 8.0);
+  // An explicit option wins over the preset, and the report says so.
+  ASSERT_EQ(run_pvs(bake + "--preset draft --res 64 --json " + dir + "/e.json -o " + dir + "/e.pvs", &out), 0) << out;
+  json e = json::parse(vislib::read_file(dir + "/e.json"));
+  EXPECT_EQ(e["preset"]["res"], 64);
+  EXPECT_NE(out.find("preset draft"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs(bake + "--preset fast -o " + dir + "/f.pvs", &out), 2) << out;
+}
+
+TEST(CliConventions, UnknownOptionIsNamedBeforeMissingRequiredOnes) {
+  std::string out;
+  EXPECT_EQ(run_pvs("bake " + city() + " --bogus", &out), 2) << out;
+  EXPECT_NE(out.find("--bogus"), std::string::npos) << out;
+  EXPECT_EQ(out.find("--output is required"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs("bake " + city() + " -x", &out), 2) << out;
+  EXPECT_NE(out.find("-x"), std::string::npos) << out;
+  EXPECT_EQ(out.find("is required"), std::string::npos) << out;
+  // Without unknown options the missing one is still reported.
+  EXPECT_EQ(run_pvs("bake " + city() + " -v", &out), 2) << out;
+  EXPECT_NE(out.find("--output is required"), std::string::npos) << out;
+}
+
+TEST(CliConventions, ValidatorMessagesNeverPrintDblMax) {
+  const std::vector<std::string> bad = {
+      "bake " + city() + " --walkable --cell-size -1 -o x.pvs", "bake " + city() + " --walkable --near -1 -o x.pvs",
+      "bake " + city() + " --walkable --res 0 -o x.pvs",       "bake " + city() + " --walkable --states 0 -o x.pvs",
+      "bake " + city() + " --walkable -j -1 -o x.pvs",         "segment " + city() + " --from 0,0,0 --to 1,0,0 --near 0 --json -",
+  };
+  for (const auto& args : bad) {
+    std::string out;
+    EXPECT_EQ(run_pvs(args, &out), 2) << args << "\n" << out;
+    EXPECT_EQ(out.find("179769"), std::string::npos) << args << "\n" << out;
+    EXPECT_EQ(out.find("e+308"), std::string::npos) << args << "\n" << out;
+    EXPECT_EQ(out.find("0.000000"), std::string::npos) << args << "\n" << out;
+    EXPECT_NE(out.find("must be"), std::string::npos) << args << "\n" << out;
+  }
+}
+
+TEST(CliConventions, ProgressShowsInsideALongCell) {
+  // One cell, 2 orientations per segment: 16 runs. The progress lines (not a terminal: plain
+  // lines) report the fraction of the running cell before the cell is done.
+  std::string dir = temp_dir("cli_progress");
+  std::string out;
+  ASSERT_EQ(run_pvs("bake " + city() + " --box -5,0,-5,5,3,5 --grid 1,1,1 --eye-height 1.5,1.8 --res 64 --runs 2 -o " +
+                        dir + "/one.pvs",
+                    &out),
+            0)
+      << out;
+  std::smatch m;
+  EXPECT_TRUE(std::regex_search(out, m, std::regex("0/1 cells \\+ 0\\.[0-9]+ of running cells"))) << out;
+}
