@@ -54,13 +54,13 @@ void run_export(const ExportOptions& o) {
   vislib::write_file_atomic(o.out, obj);
   if (show_progress())
     std::fprintf(stderr, "pvs: wrote %s (%zu vertices, %zu triangles)\n", o.out.c_str(),
-               scene.vertex_count(), scene.triangle_count());
+                 scene.vertex_count(), scene.triangle_count());
   if (!o.id_map.empty()) {
     const vislib::IdMap map = vislib::id_map(scene);
     vislib::write_file_atomic(o.id_map, vislib::id_map_json(scene, map));
     if (show_progress())
       std::fprintf(stderr, "pvs: wrote %s (%zu runs, vertices %s)\n", o.id_map.c_str(),
-                 map.runs.size(), map.vertices_tiled ? "tiled per run" : "shared between runs");
+                   map.runs.size(), map.vertices_tiled ? "tiled per run" : "shared between runs");
   }
   if (scene.sphere_count() == 0) return;
   size_t K = o.time ? 1 : scene.sphere_centers.size();

@@ -57,13 +57,15 @@ void add_inspect(CLI::App& app) {
   cmd->add_option("--states", a->states,
                   "With --scene: key states to sample animations into (as for the bake)")
       ->check(in_range(1, 100000));
-  cmd->add_option("--export-gltf", a->gltf,
-                  "With --scene and a cell: write the scene reduced to the cell's set (.glb), with the "
-                  "source's normals, UVs, materials, textures and copyright");
+  cmd->add_option(
+      "--export-gltf", a->gltf,
+      "With --scene and a cell: write the scene reduced to the cell's set (.glb), with the "
+      "source's normals, UVs, materials, textures and copyright");
   cmd->add_option(
       "--render", a->render_dir,
       "With --scene and a cell: render from the --at point (else the centre of the cell's view "
-      "region, or the free sample nearest it when the centre is enclosed by the scene), in 4 horizontal directions, the full-scene frame, the PVS frame and the error heat "
+      "region, or the free sample nearest it when the centre is enclosed by the scene), in 4 "
+      "horizontal directions, the full-scene frame, the PVS frame and the error heat "
       "map into this folder, "
       "with epsilon/PSNR/SSIM");
   cmd->add_option("--frame", a->frame, "Frame size WxH for --render")->capture_default_str();
@@ -199,8 +201,9 @@ void add_inspect(CLI::App& app) {
             eye = parse_vec3(a->at, "--at");
           } else if (free_space.centre_enclosed) {
             if (!free_space.free_point)
-              throw vislib::InputError(a->file, "every sample of cell " + std::to_string(c) +
-                                                    "'s view region is enclosed by the scene: give --at");
+              throw vislib::InputError(a->file,
+                                       "every sample of cell " + std::to_string(c) +
+                                           "'s view region is enclosed by the scene: give --at");
             eye = *free_space.free_point;
           }
           j["render"] = render_cell(scene, ids, g, eye, a->render_dir, fw, fh);

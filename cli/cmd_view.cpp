@@ -103,8 +103,9 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
     vislib::CellFreeSpace fs = vislib::cell_free_space(v.full_scene, v.region);
     if (fs.centre_enclosed) {
       if (!fs.free_point)
-        throw vislib::InputError(a.file, "every sample of cell " + std::to_string(v.cell) +
-                                             "'s view region is enclosed by the scene: give --centre");
+        throw vislib::InputError(a.file,
+                                 "every sample of cell " + std::to_string(v.cell) +
+                                     "'s view region is enclosed by the scene: give --centre");
       centre = *fs.free_point;
       warn("the centre of cell " + std::to_string(v.cell) +
            "'s view region is enclosed by the scene; the free point " + std::to_string(centre.x) +

@@ -1,7 +1,6 @@
 // pvs view --ods: the omnidirectional stereo panoramas (omnidirectional-stereo.txt, issue 14) of
 // the PVS cells that cover the viewing disc at --at, the full-scene truth with the same settings,
 // and the metrics. Options and output documented in docs/ods.md.
-#include "cli/options.h"
 #include "cli/cmd_view_ods.h"
 
 #include <chrono>
@@ -13,6 +12,7 @@
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
+#include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "runtime/ods.h"
 #include "runtime/pvs_runtime.h"

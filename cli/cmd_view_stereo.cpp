@@ -3,7 +3,6 @@
 // hold the eyes; the other eye is reprojected (vislib/render/stereo.h), its holes patched; both
 // are compared with true renders of that eye from the same set (the method's error) and from the
 // full scene (the total error).
-#include "cli/options.h"
 #include "cli/cmd_view_stereo.h"
 
 #include <chrono>
@@ -14,6 +13,7 @@
 #include <optional>
 
 #include "cli/commands.h"
+#include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/base/error.h"
 #include "vislib/eval/image_io.h"

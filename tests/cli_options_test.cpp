@@ -33,7 +33,8 @@ const std::string& city() {
 
 // 4 grid cells at a tiny resolution.
 std::string small_bake(const std::string& extra) {
-  return "bake " + city() + " --box -30,0,-30,30,3,30 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 " + extra;
+  return "bake " + city() + " --box -30,0,-30,30,3,30 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 " +
+         extra;
 }
 
 std::vector<std::string> subcommands() {
@@ -48,7 +49,8 @@ std::vector<std::string> subcommands() {
       on = true;
       continue;
     }
-    if (on && line.size() > 2 && line[0] == ' ' && line[1] == ' ' && std::isalpha(static_cast<unsigned char>(line[2])))
+    if (on && line.size() > 2 && line[0] == ' ' && line[1] == ' ' &&
+        std::isalpha(static_cast<unsigned char>(line[2])))
       cmds.push_back(line.substr(2, line.find(' ', 2) - 2));
   }
   return cmds;
@@ -79,11 +81,14 @@ TEST(CliOutputs, SegmentExportAndBenchNameTheBadPath) {
   fs::create_directories(dir);
   std::ofstream(file) << "x";
   std::string out;
-  EXPECT_EQ(run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + dir, &out), 2) << out;
+  EXPECT_EQ(
+      run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + dir, &out), 2)
+      << out;
   EXPECT_NE(out.find(dir + "' is a folder"), std::string::npos) << out;
   EXPECT_EQ(run_pvs("export " + city() + " -o " + dir, &out), 2) << out;
   EXPECT_NE(out.find(dir + "' is a folder"), std::string::npos) << out;
-  EXPECT_EQ(run_pvs("bench " + city() + " --box -1,1.6,-1,1,1.6,1 --res 8 --out " + file, &out), 2) << out;
+  EXPECT_EQ(run_pvs("bench " + city() + " --box -1,1.6,-1,1,1.6,1 --res 8 --out " + file, &out), 2)
+      << out;
   EXPECT_NE(out.find(file + "' exists and is not a folder"), std::string::npos) << out;
   EXPECT_EQ(out.find("filesystem error"), std::string::npos) << out;
   // A parent that is a file.
@@ -96,15 +101,23 @@ TEST(CliOutputs, ParentFoldersAreCreatedForEveryOutput) {
   std::string out;
   EXPECT_EQ(run_pvs("export " + city() + " -o " + base + "/e/f/flat.obj", &out), 0) << out;
   EXPECT_TRUE(fs::exists(base + "/e/f/flat.obj"));
-  EXPECT_EQ(run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + base + "/s/t/seg.json", &out), 0)
+  EXPECT_EQ(run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + base +
+                        "/s/t/seg.json",
+                    &out),
+            0)
       << out;
   EXPECT_TRUE(fs::exists(base + "/s/t/seg.json"));
-  EXPECT_EQ(run_pvs(small_bake("-q --json " + base + "/r/report.json -o " + base + "/b/c/city.pvs"), &out), 0) << out;
+  EXPECT_EQ(run_pvs(small_bake("-q --json " + base + "/r/report.json -o " + base + "/b/c/city.pvs"),
+                    &out),
+            0)
+      << out;
   EXPECT_TRUE(fs::exists(base + "/b/c/city.pvs"));
   EXPECT_TRUE(fs::exists(base + "/r/report.json"));
   // pvs view -o into a missing folder (it failed before).
   EXPECT_EQ(run_pvs("view " + base + "/b/c/city.pvs --scene " + city() +
-                        " --at -15,1.6,-15 --look 10,1.6,0 --centre -15,1.65,-15 --near-far 5,10 --frame 32x24 -o " + base + "/v/w/frame.png",
+                        " --at -15,1.6,-15 --look 10,1.6,0 --centre -15,1.65,-15 --near-far 5,10 "
+                        "--frame 32x24 -o " +
+                        base + "/v/w/frame.png",
                     &out),
             0)
       << out;
@@ -161,14 +174,19 @@ TEST(CliConventions, PresetSetsResolutionRunsAndCellSizeAndIsReported) {
   std::string dir = temp_dir("cli_preset");
   std::string out;
   std::string bake = "bake " + city() + " --walkable --box -30,-1,-30,30,1,30 ";
-  ASSERT_EQ(run_pvs(bake + "--preset draft -q --json " + dir + "/d.json -o " + dir + "/d.pvs", &out), 0) << out;
+  ASSERT_EQ(
+      run_pvs(bake + "--preset draft -q --json " + dir + "/d.json -o " + dir + "/d.pvs", &out), 0)
+      << out;
   json d = json::parse(vislib::read_file(dir + "/d.json"));
   EXPECT_EQ(d["preset"]["name"], "draft");
   EXPECT_EQ(d["preset"]["res"], 128);
   EXPECT_EQ(d["preset"]["runs"], 1);
   EXPECT_EQ(d["preset"]["cell_size"], 8.0);
   // An explicit option wins over the preset, and the report says so.
-  ASSERT_EQ(run_pvs(bake + "--preset draft --res 64 --json " + dir + "/e.json -o " + dir + "/e.pvs", &out), 0) << out;
+  ASSERT_EQ(run_pvs(bake + "--preset draft --res 64 --json " + dir + "/e.json -o " + dir + "/e.pvs",
+                    &out),
+            0)
+      << out;
   json e = json::parse(vislib::read_file(dir + "/e.json"));
   EXPECT_EQ(e["preset"]["res"], 64);
   EXPECT_NE(out.find("preset draft"), std::string::npos) << out;
@@ -190,9 +208,12 @@ TEST(CliConventions, UnknownOptionIsNamedBeforeMissingRequiredOnes) {
 
 TEST(CliConventions, ValidatorMessagesNeverPrintDblMax) {
   const std::vector<std::string> bad = {
-      "bake " + city() + " --walkable --cell-size -1 -o x.pvs", "bake " + city() + " --walkable --near -1 -o x.pvs",
-      "bake " + city() + " --walkable --res 0 -o x.pvs",       "bake " + city() + " --walkable --states 0 -o x.pvs",
-      "bake " + city() + " --walkable -j -1 -o x.pvs",         "segment " + city() + " --from 0,0,0 --to 1,0,0 --near 0 --json -",
+      "bake " + city() + " --walkable --cell-size -1 -o x.pvs",
+      "bake " + city() + " --walkable --near -1 -o x.pvs",
+      "bake " + city() + " --walkable --res 0 -o x.pvs",
+      "bake " + city() + " --walkable --states 0 -o x.pvs",
+      "bake " + city() + " --walkable -j -1 -o x.pvs",
+      "segment " + city() + " --from 0,0,0 --to 1,0,0 --near 0 --json -",
   };
   for (const auto& args : bad) {
     std::string out;
@@ -209,11 +230,14 @@ TEST(CliConventions, ProgressShowsInsideALongCell) {
   // lines) report the fraction of the running cell before the cell is done.
   std::string dir = temp_dir("cli_progress");
   std::string out;
-  ASSERT_EQ(run_pvs("bake " + city() + " --box -5,0,-5,5,3,5 --grid 1,1,1 --eye-height 1.5,1.8 --res 64 --runs 2 -o " +
-                        dir + "/one.pvs",
-                    &out),
-            0)
+  ASSERT_EQ(
+      run_pvs("bake " + city() +
+                  " --box -5,0,-5,5,3,5 --grid 1,1,1 --eye-height 1.5,1.8 --res 64 --runs 2 -o " +
+                  dir + "/one.pvs",
+              &out),
+      0)
       << out;
   std::smatch m;
-  EXPECT_TRUE(std::regex_search(out, m, std::regex("0/1 cells \\+ 0\\.[0-9]+ of running cells"))) << out;
+  EXPECT_TRUE(std::regex_search(out, m, std::regex("0/1 cells \\+ 0\\.[0-9]+ of running cells")))
+      << out;
 }

@@ -120,56 +120,57 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   const size_t tokens = 4 * std::max<size_t>(1, threads);
   uint32_t next = 0;
   try {
-  tbb::parallel_pipeline(
-      tokens,
-      tbb::make_filter<void, uint32_t>(tbb::filter_mode::serial_in_order,
-                                       [&](tbb::flow_control& fc) -> uint32_t {
-                                         if (next >= n) {
-                                           fc.stop();
-                                           return 0;
-                                         }
-                                         return next++;
-                                       }) &
-          tbb::make_filter<uint32_t, std::shared_ptr<pvs::CellSet>>(
-              tbb::filter_mode::parallel,
-              [&](uint32_t c) {
-                auto set = std::make_shared<pvs::CellSet>();
-                if (!in_shard(c, shard)) return set;  // absent from this shard's file
-                if (recovered[c]) {
-                  *set = std::move(recovered[c]);
-                  recovered[c].reset();
-                  return set;
-                }
-                double seconds = 0;
-                std::function<void(double)> in_cell;  // progress inside the cell
-                if (progress)
-                  in_cell = [&, c](double fraction) {
-                    std::lock_guard<std::mutex> lock(progress_mutex);
-                    running += fraction - partial[c];
-                    partial[c] = fraction;
+    tbb::parallel_pipeline(
+        tokens,
+        tbb::make_filter<void, uint32_t>(tbb::filter_mode::serial_in_order,
+                                         [&](tbb::flow_control& fc) -> uint32_t {
+                                           if (next >= n) {
+                                             fc.stop();
+                                             return 0;
+                                           }
+                                           return next++;
+                                         }) &
+            tbb::make_filter<uint32_t, std::shared_ptr<pvs::CellSet>>(
+                tbb::filter_mode::parallel,
+                [&](uint32_t c) {
+                  auto set = std::make_shared<pvs::CellSet>();
+                  if (!in_shard(c, shard)) return set;  // absent from this shard's file
+                  if (recovered[c]) {
+                    *set = std::move(recovered[c]);
+                    recovered[c].reset();
+                    return set;
+                  }
+                  double seconds = 0;
+                  std::function<void(double)> in_cell;  // progress inside the cell
+                  if (progress)
+                    in_cell = [&, c](double fraction) {
+                      std::lock_guard<std::mutex> lock(progress_mutex);
+                      running += fraction - partial[c];
+                      partial[c] = fraction;
+                      progress({done, report.shard_cells, report.resumed, elapsed(),
+                                std::max(0.0, running)});
+                    };
+                  std::vector<uint32_t> ids = with_memory_stage(
+                      "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
+                        return bake_cell(scene, info.layout, c, settings, &seconds, in_cell);
+                      });
+                  if (checkpoint) checkpoint->append(c, ids);
+                  *set = std::move(ids);
+                  report.cell_seconds[c] = seconds;
+                  std::lock_guard<std::mutex> guard(progress_mutex);
+                  ++done;
+                  ++report.baked;
+                  running -= partial[c];
+                  partial[c] = 0;
+                  if (progress)
                     progress({done, report.shard_cells, report.resumed, elapsed(),
                               std::max(0.0, running)});
-                  };
-                std::vector<uint32_t> ids = with_memory_stage(
-                    "baking cell " + std::to_string(c) + " of " + std::to_string(n),
-                    [&] { return bake_cell(scene, info.layout, c, settings, &seconds, in_cell); });
-                if (checkpoint) checkpoint->append(c, ids);
-                *set = std::move(ids);
-                report.cell_seconds[c] = seconds;
-                std::lock_guard<std::mutex> guard(progress_mutex);
-                ++done;
-                ++report.baked;
-                running -= partial[c];
-                partial[c] = 0;
-                if (progress)
-                  progress({done, report.shard_cells, report.resumed, elapsed(),
-                            std::max(0.0, running)});
-                return set;
-              }) &
-          tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
-              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
-                with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
-              }));
+                  return set;
+                }) &
+            tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
+                tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
+                  with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
+                }));
   } catch (...) {
     // A bake that recorded nothing leaves no checkpoint behind (issue 17 item 1).
     if (checkpoint && done == 0) checkpoint->remove();
