@@ -261,104 +261,105 @@ TEST(CliBake, SecondResumeOfALockedCheckpointIsRefused) {
   ::close(fd);
   EXPECT_EQ(run_pvs(grid_bake(dir + "/other.pvs") + " --resume --checkpoint " + ckpt, &text), 0)
       << text;
-  namespace {
+}
 
-  // A sphere scene with `states` key states, plus (if `ground`) a `mesh` line naming a ground
-  // quad in an OBJ beside it: the paper's bouncing spheres over a ground, from the command line.
-  std::string sphere_scene(const std::string& dir, bool ground) {
-    std::string path = dir + "/balls.spheres", out;
-    EXPECT_EQ(run_pvs("generate spheres --count 40 --radius 1 --area 30 --states 3 --max-height 4 "
-                      "--speed 3 -o " +
-                          path,
+namespace {
+
+// A sphere scene with `states` key states, plus (if `ground`) a `mesh` line naming a ground
+// quad in an OBJ beside it: the paper's bouncing spheres over a ground, from the command line.
+std::string sphere_scene(const std::string& dir, bool ground) {
+  std::string path = dir + "/balls.spheres", out;
+  EXPECT_EQ(run_pvs("generate spheres --count 40 --radius 1 --area 30 --states 3 --max-height 4 "
+                    "--speed 3 -o " +
+                        path,
+                    &out),
+            0)
+      << out;
+  if (!ground) return path;
+  {
+    std::FILE* f = std::fopen((dir + "/ground.obj").c_str(), "w");
+    std::fputs("o ground\nv -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\nf 1 3 2\nf 1 4 3\n", f);
+    std::fclose(f);
+  }
+  std::string text = vislib::read_file(path);
+  size_t at = text.find("states 3\n");
+  EXPECT_NE(at, std::string::npos);
+  text.insert(at + 9, "mesh ground.obj\n");
+  std::string mixed = dir + "/mixed.spheres";
+  std::FILE* f = std::fopen(mixed.c_str(), "w");
+  std::fputs(text.c_str(), f);
+  std::fclose(f);
+  return mixed;
+}
+
+}  // namespace
+
+// Issue 12 items 5 and 6: one id rule for bake, inspect and view, on a sphere scene and on a
+// scene of a mesh plus spheres given from the command line (a `mesh` line in the sphere file).
+TEST(CliBake, SphereAndMixedScenesBakeInspectAndViewWithOneIdUniverse) {
+  std::string dir = temp_dir("cli_spheres");
+  for (bool ground : {false, true}) {
+    std::string scene = sphere_scene(dir, ground),
+                pvs = dir + (ground ? "/mixed.pvs" : "/balls.pvs"), out;
+    const unsigned tris = ground ? 2 : 0;
+    ASSERT_EQ(
+        run_pvs("bake " + scene +
+                    " --box -8,0,-8,8,2,8 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 -o " + pvs,
+                &out),
+        0)
+        << out;
+    EXPECT_EQ(out.find("ignored"), std::string::npos) << out;  // spheres are baked, not "ignored"
+    ASSERT_EQ(run_pvs("inspect --json " + pvs, &out), 0) << out;
+    EXPECT_EQ(json::parse(out)["universe"], tris + 40);
+    ASSERT_EQ(run_pvs("inspect " + pvs + " --scene " + scene + " --cell 0 --json", &out), 0) << out;
+    json c = json::parse(out);
+    ASSERT_GT(c["visible_count"].get<int>(), 0) << out;
+    bool sphere_id = false;
+    for (unsigned id : c["visible"]) sphere_id = sphere_id || id >= tris;
+    EXPECT_TRUE(sphere_id) << "a cell sees some sphere";
+    // The segment command sees the same scene: triangles first, then spheres.
+    ASSERT_EQ(run_pvs("segment " + scene + " --from -2,1.6,0 --to 2,1.6,0 --res 16 --json " + dir +
+                          "/s.json",
                       &out),
               0)
         << out;
-    if (!ground) return path;
-    {
-      std::FILE* f = std::fopen((dir + "/ground.obj").c_str(), "w");
-      std::fputs("o ground\nv -20 0 -20\nv 20 0 -20\nv 20 0 20\nv -20 0 20\nf 1 3 2\nf 1 4 3\n", f);
-      std::fclose(f);
+    json sj = json::parse(vislib::read_file(dir + "/s.json"));
+    if (ground) {
+      EXPECT_EQ(sj["counts"]["scene_triangles"], 2);
     }
-    std::string text = vislib::read_file(path);
-    size_t at = text.find("states 3\n");
-    EXPECT_NE(at, std::string::npos);
-    text.insert(at + 9, "mesh ground.obj\n");
-    std::string mixed = dir + "/mixed.spheres";
-    std::FILE* f = std::fopen(mixed.c_str(), "w");
-    std::fputs(text.c_str(), f);
-    std::fclose(f);
-    return mixed;
-  }
-
-  }  // namespace
-
-  // Issue 12 items 5 and 6: one id rule for bake, inspect and view, on a sphere scene and on a
-  // scene of a mesh plus spheres given from the command line (a `mesh` line in the sphere file).
-  TEST(CliBake, SphereAndMixedScenesBakeInspectAndViewWithOneIdUniverse) {
-    std::string dir = temp_dir("cli_spheres");
-    for (bool ground : {false, true}) {
-      std::string scene = sphere_scene(dir, ground),
-                  pvs = dir + (ground ? "/mixed.pvs" : "/balls.pvs"), out;
-      const unsigned tris = ground ? 2 : 0;
-      ASSERT_EQ(
-          run_pvs("bake " + scene +
-                      " --box -8,0,-8,8,2,8 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 -o " + pvs,
-                  &out),
-          0)
-          << out;
-      EXPECT_EQ(out.find("ignored"), std::string::npos) << out;  // spheres are baked, not "ignored"
-      ASSERT_EQ(run_pvs("inspect --json " + pvs, &out), 0) << out;
-      EXPECT_EQ(json::parse(out)["universe"], tris + 40);
-      ASSERT_EQ(run_pvs("inspect " + pvs + " --scene " + scene + " --cell 0 --json", &out), 0)
-          << out;
-      json c = json::parse(out);
-      ASSERT_GT(c["visible_count"].get<int>(), 0) << out;
-      bool sphere_id = false;
-      for (unsigned id : c["visible"]) sphere_id = sphere_id || id >= tris;
-      EXPECT_TRUE(sphere_id) << "a cell sees some sphere";
-      // The segment command sees the same scene: triangles first, then spheres.
-      ASSERT_EQ(run_pvs("segment " + scene + " --from -2,1.6,0 --to 2,1.6,0 --res 16 --json " +
-                            dir + "/s.json",
-                        &out),
-                0)
-          << out;
-      json sj = json::parse(vislib::read_file(dir + "/s.json"));
-      if (ground) {
-        EXPECT_EQ(sj["counts"]["scene_triangles"], 2);
-      }
-      EXPECT_GT(sj["visible_spheres"].size(), 0u);
-      std::string png = dir + "/view.png";
-      ASSERT_EQ(run_pvs("view " + pvs + " --scene " + scene +
-                            " --at -3,1.6,-3 --look 3,1.6,3 --near-far 3,8 --frame 32x24 -o " +
-                            png + " --json -",
-                        &out),
-                0)
-          << out;
-      size_t brace = out.find('{');
-      ASSERT_NE(brace, std::string::npos) << out;
-      json v = json::parse(out.substr(brace));
-      EXPECT_EQ(v["triangles"]["scene"], tris);
-    }
-  }
-
-  // Issue 12 item 8: an animated glTF without --states warns and names the option; a scene far from
-  // the origin warns; `pvs info` makes no units claim.
-  TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
-    VISLIB_REQUIRE_SHARED(shared);
-    std::string out, box = shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf";
-    ASSERT_EQ(run_pvs("info " + box, &out), 0) << out;
-    EXPECT_NE(out.find("animation(s) ignored"), std::string::npos) << out;
-    EXPECT_NE(out.find("--states"), std::string::npos) << out;
-    EXPECT_EQ(out.find("(likely)"), std::string::npos) << out;
-    ASSERT_EQ(run_pvs("info " + box + " --states 5", &out), 0) << out;
-    EXPECT_EQ(out.find("animation(s) ignored"), std::string::npos) << out;
-    std::string dir = temp_dir("cli_far");
-    std::FILE* f = std::fopen((dir + "/far.obj").c_str(), "w");
-    std::fputs("v 100000 0 0\nv 100001 0 0\nv 100000 1 0\nf 1 2 3\n", f);
-    std::fclose(f);
-    ASSERT_EQ(run_pvs("info " + dir + "/far.obj --json", &out), 0) << out;
-    EXPECT_NE(out.find("far from the origin"), std::string::npos) << out;
+    EXPECT_GT(sj["visible_spheres"].size(), 0u);
+    std::string png = dir + "/view.png";
+    ASSERT_EQ(run_pvs("view " + pvs + " --scene " + scene +
+                          " --at -3,1.6,-3 --look 3,1.6,3 --near-far 3,8 --frame 32x24 -o " + png +
+                          " --json -",
+                      &out),
+              0)
+        << out;
     size_t brace = out.find('{');
-    ASSERT_NE(brace, std::string::npos);
-    EXPECT_TRUE(json::parse(out.substr(brace))["far_from_origin"].get<bool>());
+    ASSERT_NE(brace, std::string::npos) << out;
+    json v = json::parse(out.substr(brace));
+    EXPECT_EQ(v["triangles"]["scene"], tris);
   }
+}
+
+// Issue 12 item 8: an animated glTF without --states warns and names the option; a scene far from
+// the origin warns; `pvs info` makes no units claim.
+TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
+  VISLIB_REQUIRE_SHARED(shared);
+  std::string out, box = shared + "/scenes/khronos_boxanimated/BoxAnimated.gltf";
+  ASSERT_EQ(run_pvs("info " + box, &out), 0) << out;
+  EXPECT_NE(out.find("animation(s) ignored"), std::string::npos) << out;
+  EXPECT_NE(out.find("--states"), std::string::npos) << out;
+  EXPECT_EQ(out.find("(likely)"), std::string::npos) << out;
+  ASSERT_EQ(run_pvs("info " + box + " --states 5", &out), 0) << out;
+  EXPECT_EQ(out.find("animation(s) ignored"), std::string::npos) << out;
+  std::string dir = temp_dir("cli_far");
+  std::FILE* f = std::fopen((dir + "/far.obj").c_str(), "w");
+  std::fputs("v 100000 0 0\nv 100001 0 0\nv 100000 1 0\nf 1 2 3\n", f);
+  std::fclose(f);
+  ASSERT_EQ(run_pvs("info " + dir + "/far.obj --json", &out), 0) << out;
+  EXPECT_NE(out.find("far from the origin"), std::string::npos) << out;
+  size_t brace = out.find('{');
+  ASSERT_NE(brace, std::string::npos);
+  EXPECT_TRUE(json::parse(out.substr(brace))["far_from_origin"].get<bool>());
+}

@@ -454,33 +454,35 @@ TEST(PvsFormat, RunLengthWorkedExampleOfTheSpecIsExact) {
     next = first + values[2 + 2 * r] + 1;
   }
   EXPECT_EQ(decoded, ids);
-  // pvs::StreamWriter (and write_pvs, built on it) gives the bytes of the writer released before
-  // streaming: the fnv1a64 of its output on two inputs that use every Delta reference (grid
-  // neighbours along x, y, z; box list nearest centres up to 4096 cells back) was computed with
-  // pvs_format.cpp of main at 7642afc (the hashes below); the file sink sees the blocks in order.
-  TEST(PvsWriter, StreamingWriterGivesTheBytesOfTheReleasedWriter) {
-    const uint64_t expected[2] = {0x81f9c7a0d67e816aull, 0x1fa9870fb20f9807ull};
-    const size_t sizes[2] = {133943, 527007};
-    for (int kind = 0; kind < 2; ++kind) {
-      vislib_test::StreamCase s = vislib_test::make_stream_case(kind);
-      std::string whole = pvs::write_pvs(s.info, s.cells);
-      EXPECT_EQ(whole.size(), sizes[kind]);
-      EXPECT_EQ(pvs::fnv1a64(whole.data(), whole.size()), expected[kind]) << "kind " << kind;
-      std::string dir = temp_dir("stream_writer");
-      std::string path = dir + "/s.pvs";
-      uint64_t last_block = 0;
-      {
-        vislib::AtomicFile out(path);
-        pvs::StreamWriter w(s.info, [&](uint64_t offset, std::string_view bytes) {
-          out.write_at(offset, bytes);
-          if (offset > last_block) last_block = offset;
-        });
-        for (const pvs::CellSet& c : s.cells) w.add(c);
-        pvs::WriteStats st = w.finish();
-        EXPECT_EQ(st.file_bytes, whole.size());
-        out.commit();
-      }
-      EXPECT_EQ(vislib::read_file(path), whole);
-      EXPECT_LT(last_block, whole.size());
+}
+
+// pvs::StreamWriter (and write_pvs, built on it) gives the bytes of the writer released before
+// streaming: the fnv1a64 of its output on two inputs that use every Delta reference (grid
+// neighbours along x, y, z; box list nearest centres up to 4096 cells back) was computed with
+// pvs_format.cpp of main at 7642afc (the hashes below); the file sink sees the blocks in order.
+TEST(PvsWriter, StreamingWriterGivesTheBytesOfTheReleasedWriter) {
+  const uint64_t expected[2] = {0x81f9c7a0d67e816aull, 0x1fa9870fb20f9807ull};
+  const size_t sizes[2] = {133943, 527007};
+  for (int kind = 0; kind < 2; ++kind) {
+    vislib_test::StreamCase s = vislib_test::make_stream_case(kind);
+    std::string whole = pvs::write_pvs(s.info, s.cells);
+    EXPECT_EQ(whole.size(), sizes[kind]);
+    EXPECT_EQ(pvs::fnv1a64(whole.data(), whole.size()), expected[kind]) << "kind " << kind;
+    std::string dir = temp_dir("stream_writer");
+    std::string path = dir + "/s.pvs";
+    uint64_t last_block = 0;
+    {
+      vislib::AtomicFile out(path);
+      pvs::StreamWriter w(s.info, [&](uint64_t offset, std::string_view bytes) {
+        out.write_at(offset, bytes);
+        if (offset > last_block) last_block = offset;
+      });
+      for (const pvs::CellSet& c : s.cells) w.add(c);
+      pvs::WriteStats st = w.finish();
+      EXPECT_EQ(st.file_bytes, whole.size());
+      out.commit();
     }
+    EXPECT_EQ(vislib::read_file(path), whole);
+    EXPECT_LT(last_block, whole.size());
   }
+}
