@@ -12,7 +12,6 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "cli/bench_output.h"
@@ -27,7 +26,6 @@
 namespace pvs_cli {
 namespace {
 
-using nlohmann::json;
 namespace fs = std::filesystem;
 
 // Runs the plotting script; returns the PNG names written, or warns and returns nothing.
@@ -128,15 +126,16 @@ void run(BenchArgs& a) {
   // CSV.
   vislib::write_bench_csv(r, a.out);
 
-  // Frames at equal time.
-  json frames = json::array();
-  if (!a.no_frames) frames = vislib::write_bench_frames(r, a.out);
-
-  std::vector<std::string> plots;
-  if (!a.no_plots) plots = make_plots(a);
-
-  vislib::write_file_atomic((fs::path(a.out) / "bench.json").string(),
-                            bench_json(a, scene, r, load_s, total_s, frames, plots).dump(1) + "\n");
+  vislib::BenchRunInfo info;
+  info.scene = a.scene;
+  info.scene_triangles = scene.triangle_count();
+  info.given = a.o;
+  info.threads = a.threads;
+  info.load_seconds = load_s;
+  info.total_seconds = total_s;
+  if (!a.no_frames) info.frames = vislib::write_bench_frames(r, a.out);  // frames at equal time
+  if (!a.no_plots) info.plots = make_plots(a);
+  vislib::write_file_atomic((fs::path(a.out) / "bench.json").string(), vislib::bench_json(info, r));
   print_bench(a, r, total_s);
 }
 

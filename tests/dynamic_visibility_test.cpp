@@ -14,7 +14,9 @@
 #include "tests/scene_builders.h"
 #include "tests/support/ray_oracle.h"
 #include "tests/test_support.h"
+#include "vislib/base/polynomial.h"
 #include "vislib/eval/embree_scene.h"
+#include "vislib/kernel/general_depth.h"
 #include "vislib/kernel/segment_visibility.h"
 #include "vislib/kernel/static_coverage.h"
 #include "vislib/scene/generate.h"
@@ -617,4 +619,35 @@ TEST(DynamicVisibility, DecoupledModeHoldsEveryFirstHitOnItsRunsAndOnlyTrueWitne
       (unsigned long long)ambiguous.load(), (unsigned long long)misses.load(),
       (unsigned long long)inner_rays.load(), (unsigned long long)inner_out.load(), c.witnesses,
       c.ambiguous, c.failures);
+}
+
+// kMaxCrossings (interval_list.h) bounds the crossings of one depth_crossings call; the kernels'
+// polynomials reach degree 6, and every root must come back (none dropped at the buffer's end).
+TEST(DepthCrossings, PolynomialOfDegreeSixReturnsAllSixRootsInsideTheRange) {
+  // (t - 0.05)(t - 0.2)(t - 0.35)(t - 0.5)(t - 0.65)(t - 0.8), expanded.
+  const double roots[6] = {0.05, 0.2, 0.35, 0.5, 0.65, 0.8};
+  double c[7] = {1, 0, 0, 0, 0, 0, 0};
+  for (double r : roots) {
+    for (int k = 6; k >= 1; --k) c[k] = c[k - 1] - r * c[k];
+    c[0] = -r * c[0];
+  }
+  double out[kMaxCrossings];
+  ASSERT_EQ(poly_roots_in(c, 6, 0.0, 1.0, out), 6);
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(out[k], roots[k], 1e-12) << k;
+  // A range holding only some of them returns those.
+  EXPECT_EQ(poly_roots_in(c, 6, 0.3, 0.7, out), 3);
+}
+
+TEST(DepthCrossings, TwoRationalDepthsCrossingFiveTimesReturnAllFiveCrossings) {
+  // i: N = (t - 0.1)(t - 0.3)(t - 0.5), D = 1; j: N = 0, D = (t - 0.7)(t - 0.9). The crossing
+  // polynomial P = N_i D_j - N_j D_i has the five roots, each a sign change of lambda_i - lambda_j.
+  GeneralDepth i, j;
+  i.c[0] = -0.015, i.c[1] = 0.23, i.c[2] = -0.9, i.c[3] = 1;  // N_i
+  i.c[4] = 1;                                                 // D_i
+  j.c[4] = 0.63, j.c[5] = -1.6, j.c[6] = 1;                   // D_j
+  double out[kMaxCrossings];
+  const int n = depth_crossings(i, j, 0.0, 1.0, out);
+  ASSERT_EQ(n, 5);
+  const double expected[5] = {0.1, 0.3, 0.5, 0.7, 0.9};
+  for (int k = 0; k < 5; ++k) EXPECT_NEAR(out[k], expected[k], 1e-9) << k;
 }

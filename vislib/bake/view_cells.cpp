@@ -394,4 +394,44 @@ CellFreeSpace cell_free_space(const Scene& scene, const Box3& r, size_t state) {
   return out;
 }
 
+ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
+  const std::optional<Box3>& box = p.box;
+  if (p.walkable) {
+    if (p.grid)
+      throw PlacementError(PlacementProblem::GridWithWalkable,
+                           "grid counts cannot be combined with walkable cells");
+    WalkableOptions w;
+    w.cell_size = p.cell_size > 0 ? p.cell_size : 2.0;
+    if (p.eye) w.eye = *p.eye;
+    w.max_slope_degrees = p.max_slope_degrees;
+    w.require_headroom = p.require_headroom;
+    w.clip = box;
+    const Box3 r = box ? *box : scene.bounds();
+    auto columns = [&](double extent) { return std::max(1.0, std::ceil(extent / w.cell_size)); };
+    if (!r.empty() && columns(r.max.x - r.min.x) * columns(r.max.z - r.min.z) > kMaxPlacedCells)
+      throw PlacementError(PlacementProblem::TooManyColumns, "more than 10^7 walkable columns");
+    return walkable_cells(scene, w);
+  }
+  if (!box) throw PlacementError(PlacementProblem::NoBox, "a grid of cells needs a box");
+  if (p.grid && p.cell_size > 0)
+    throw PlacementError(PlacementProblem::GridAndCellSize,
+                         "grid counts and a cell size cannot both be given");
+  if (p.grid) {
+    const std::array<uint32_t, 3>& g = *p.grid;
+    assert(g[0] >= 1 && g[1] >= 1 && g[2] >= 1);
+    if (double(g[0]) * double(g[1]) * double(g[2]) > kMaxPlacedCells)
+      throw PlacementError(PlacementProblem::TooManyGridCells, "more than 10^7 grid cells");
+    return grid_cells(*box, g[0], g[1], g[2], p.eye);
+  }
+  if (!(p.cell_size > 0))
+    throw PlacementError(PlacementProblem::NoGridNorCellSize,
+                         "a grid of cells needs grid counts or a cell size");
+  double count = 1;
+  for (int k = 0; k < 3; ++k)
+    count *= std::max(1.0, std::ceil((box->max[k] - box->min[k]) / p.cell_size));
+  if (count > kMaxPlacedCells)
+    throw PlacementError(PlacementProblem::TooManySizedCells, "more than 10^7 grid cells");
+  return grid_cells_by_size(*box, p.cell_size, p.eye);
+}
+
 }  // namespace vislib

@@ -17,9 +17,11 @@
 // the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -78,6 +80,49 @@ struct WalkableOptions {
 // Triangles facing up are those with (b - a) x (c - a) having a positive y component: the
 // winding matters (glTF's counter-clockwise front faces).
 ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options);
+
+// How the cells of a bake are placed (pvs bake --box, --grid, --cell-size, --walkable,
+// docs/bake.md): (a) a grid over `box`, given by its counts or by its cell size, or (b) walkable
+// cells.
+struct CellPlacement {
+  std::optional<Box3> box;  // (a) the grid's box; (b) only place cells in it. Finite, min <= max
+  std::optional<std::array<uint32_t, 3>> grid;  // (a) nx, ny, nz, each >= 1
+  double cell_size = 0;   // (a) grid cells of (at most) this side; (b) column side; 0 = not given
+  bool walkable = false;  // (b) instead of (a)
+  std::optional<EyeBand> eye;     // band above a cell's bottom / a floor; (b) default EyeBand{}
+  double max_slope_degrees = 45;  // (b) WalkableOptions::max_slope_degrees
+  bool require_headroom = true;   // (b) WalkableOptions::require_headroom
+};
+
+// At most this many grid cells, or walkable columns, are placed (their index would not fit the
+// memory of a bake long before the 2^32 cell ids of the format run out).
+constexpr double kMaxPlacedCells = 1e7;
+
+// Why place_view_cells refused a placement; nothing was placed.
+enum class PlacementProblem {
+  GridWithWalkable,   // grid counts given with walkable cells
+  TooManyColumns,     // (b) more than kMaxPlacedCells columns over box (or the scene bounds)
+  NoBox,              // (a) without a box
+  GridAndCellSize,    // (a) both grid counts and a cell size
+  TooManyGridCells,   // (a) nx * ny * nz > kMaxPlacedCells
+  NoGridNorCellSize,  // (a) neither grid counts nor a cell size
+  TooManySizedCells,  // (a) more than kMaxPlacedCells cells of cell_size over box
+};
+class PlacementError : public std::invalid_argument {
+ public:
+  PlacementError(PlacementProblem problem, const std::string& what)
+      : std::invalid_argument(what), problem_(problem) {}
+  PlacementProblem problem() const { return problem_; }
+
+ private:
+  PlacementProblem problem_;
+};
+
+// The cells of `placement`: walkable_cells (cell_size 0 = 2) when `walkable`, else grid_cells
+// (counts) or grid_cells_by_size (cell size). Throws PlacementError, checked in the order of
+// PlacementProblem, before placing anything. May return no cell (walkable: no floor in box).
+// Deterministic; `scene` is read only for walkable cells.
+ViewCells place_view_cells(const Scene& scene, const CellPlacement& placement);
 
 // The segments a cell's visibility is computed on: the four sides of the view region's bottom
 // rectangle (y = min.y) then those of its top rectangle (y = max.y), each in the order of

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "vislib/base/file_util.h"
@@ -14,6 +15,116 @@
 namespace vislib {
 
 namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// Finite numbers as numbers, +-inf and NaN as null (JSON has no infinities).
+json num(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+json vec_json(Vec3 v) {
+  return json::array({v.x, v.y, v.z});
+}
+
+json quality_json(const QualitySummary& q) {
+  return {{"epsilon", num(q.epsilon_mean)},
+          {"epsilon_max", num(q.epsilon_max)},
+          {"psnr", num(q.psnr)},
+          {"psnr_min", num(q.psnr_min)},
+          {"ssim", num(q.ssim_mean)},
+          {"ssim_min", num(q.ssim_min)},
+          {"missed_pixels", q.missed_pixels}};
+}
+
+json set_json(const SetComparison& c) {
+  return {{"size", c.size},
+          {"reference_size", c.reference_size},
+          {"common", c.common},
+          {"missed", c.missed},
+          {"extra", c.extra}};
+}
+
+json method_json(const QualityCheckpoint& c, const SetComparison& vs_reference) {
+  json j = quality_json(c.quality);
+  j["runs"] = c.runs;
+  j["seconds"] = num(c.seconds);
+  j["found"] = c.set_size;
+  j["vs_frame_triangles"] = set_json(c.vs_frames);
+  j["vs_reference"] = set_json(vs_reference);
+  return j;
+}
+
+}  // namespace
+
+std::string bench_json(const BenchRunInfo& info, const BenchResult& r) {
+  const BenchOptions& given = info.given;
+  const auto& et = r.equal_time;
+  const auto& eq = r.equal_quality;
+  json j;
+  j["scene"] = info.scene;
+  j["scene_triangles"] = info.scene_triangles;
+  j["box"] = {{"min", vec_json(given.box.min)}, {"max", vec_json(given.box.max)}};
+  j["settings"] = {{"resolution", given.resolution},
+                   {"near", given.near},
+                   {"segment_runs", given.segment_runs},
+                   {"perimeter_segments", r.segments.size()},
+                   {"point_runs", r.options.point_runs},
+                   {"point_runs_automatic", given.point_runs == 0},
+                   {"point_time_factor", given.point_time_factor},
+                   {"views", given.views},
+                   {"view_path", given.path == ViewPath::Random ? "random" : "walk"},
+                   {"frame", {given.width, given.height}},
+                   {"vfov_degrees", given.vfov_degrees},
+                   {"seed", given.seed},
+                   {"threads", info.threads}};
+  j["equal_time_share"] = num(et.share);
+  j["equal_quality_time_ratio"] = num(eq.time_ratio);
+  j["equal_quality_extrapolated"] = eq.extrapolated;
+  j["segment"] = method_json(et.segment, r.segment_vs_reference);
+  j["point"] = method_json(et.point, r.point_equal_time_vs_reference);
+  j["point_final"] = method_json(r.point.checkpoints.back(), r.point_vs_reference);
+  j["equal_time"] = {{"seconds", num(et.seconds)},
+                     {"point_runs", et.point_runs},
+                     {"point_seconds", num(et.point_seconds)},
+                     {"segment_found", et.segment_found},
+                     {"point_found", et.point_found},
+                     {"point_found_of_segment", et.point_found_of_segment},
+                     {"share", num(et.share)},
+                     {"overlap_share", num(et.overlap_share)},
+                     {"within_measured", et.within_measured}};
+  j["equal_quality"] = {{"target_found", eq.target},
+                        {"segment_seconds", num(eq.segment_seconds)},
+                        {"reached", eq.reached},
+                        {"extrapolated", eq.extrapolated},
+                        {"finite", eq.finite},
+                        {"point_runs", num(eq.point_runs)},
+                        {"point_seconds", num(eq.point_seconds)},
+                        {"time_ratio", num(eq.time_ratio)},
+                        {"time_ratio_lower_bound", num(eq.time_ratio_lower_bound)},
+                        {"time_ratio_range", {num(eq.time_ratio_low), num(eq.time_ratio_high)}},
+                        {"rate_coefficient", num(eq.rate_coefficient)},
+                        {"rate_exponent", num(eq.rate_exponent)},
+                        {"fit_points", eq.fit_points},
+                        {"note", eq.note}};
+  j["frame_triangles"] = r.frame_triangles.size();
+  j["reference_triangles"] = r.reference.size();
+  j["timings"] = {{"load_seconds", info.load_seconds},
+                  {"bvh_build_seconds", r.bvh_build_seconds},
+                  {"truth_frames_seconds", r.truth_seconds},
+                  {"segment_seconds", num(et.seconds)},
+                  {"point_seconds", num(r.point.growth.back().seconds)},
+                  {"point_seconds_per_run", num(r.point_seconds_per_run)},
+                  {"point_calibration_seconds_per_run", num(r.calibration_seconds_per_run)},
+                  {"quality_seconds", r.quality_seconds},
+                  {"total_seconds", info.total_seconds}};
+  j["files"] = {
+      {"csv",
+       {"growth_segment.csv", "growth_point.csv", "quality.csv", "quality_views.csv", "views.csv"}},
+      {"frames", info.frames},
+      {"plots", info.plots}};
+  return j.dump(1) + "\n";
+}
 
 std::string csv_number(double v) {
   if (std::isnan(v)) return "nan";

@@ -1,14 +1,33 @@
 // bench_report.h: the files of a `pvs bench` run (docs/bench.md) that come straight from its
-// result: the CSV tables, the frames at equal time, and where the plotting script lives.
-// Writes are atomic (file_util.h); failures throw InputError naming the file.
+// result: bench.json, the CSV tables, the frames at equal time, and where the plotting script
+// lives. Writes are atomic (file_util.h); failures throw InputError naming the file.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
 #include "vislib/eval/benchmark_compare.h"
 
 namespace vislib {
+
+// What bench.json records besides the result: the run as asked for and the files written.
+struct BenchRunInfo {
+  std::string scene;                // the scene path as given
+  size_t scene_triangles = 0;       // of the loaded scene
+  BenchOptions given;               // the options as given (point_runs 0 = automatic)
+  int threads = 0;                  // worker threads as given (0 = all cores)
+  double load_seconds = 0;          // loading the scene
+  double total_seconds = 0;         // run_bench
+  std::vector<std::string> frames;  // write_bench_frames' patterns (empty: no frames)
+  std::vector<std::string> plots;   // PNG plots written, relative to the output folder
+};
+
+// The text of bench.json (docs/bench.md): settings, both methods at equal time, equal quality,
+// timings and the files written; pretty-printed with one space per level, ending in a newline.
+// Non-finite numbers are written as null (JSON has no infinities). Deterministic except for the
+// seconds it reports.
+std::string bench_json(const BenchRunInfo& info, const BenchResult& r);
 
 // A CSV cell: %.10g, or "inf" / "-inf" / "nan" for non-finite values (Python's float() reads them).
 std::string csv_number(double v);

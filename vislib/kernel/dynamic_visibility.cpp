@@ -51,6 +51,11 @@ bool same_depth(const GeneralDepth& a, const GeneralDepth& b) {
   return true;
 }
 
+// The crossings are the roots of a polynomial of degree at most 6 (5 for two triangles, 4 for two
+// spheres, 6 for a sphere and a triangle), and poly_roots_in writes at most deg roots: `out`
+// (kMaxCrossings slots, interval_list.h) holds them all, none is ever dropped.
+static_assert(kMaxCrossings >= 6, "depth_crossings writes up to 6 crossings");
+
 int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, double hi,
                     double* out) {
   if (i.kind == GeneralDepth::Rational && j.kind == GeneralDepth::Rational) {
@@ -62,11 +67,7 @@ int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, dou
     for (double p : P) scale = std::max(scale, std::fabs(p));
     if (scale == 0) return 0;
     for (double& p : P) p /= scale;
-    double r[5];
-    int n = poly_roots_in(P, 5, lo, hi, r);
-    int m = 0;
-    for (int k = 0; k < n && m < kMaxCrossings; ++k) out[m++] = r[k];
-    return m;
+    return poly_roots_in(P, 5, lo, hi, out);  // at most 5 <= kMaxCrossings roots
   }
   if (i.kind != GeneralDepth::Rational && j.kind != GeneralDepth::Rational) {
     // Two spheres that stay disjoint over the run keep their depth order (§4): no crossing.
@@ -124,11 +125,7 @@ int depth_crossings(const GeneralDepth& i, const GeneralDepth& j, double lo, dou
   for (int k = 0; k <= deg; ++k) scale = std::max(scale, std::fabs(Q[k]));
   if (scale == 0) return 0;  // identical surfaces along this ray: ties go to the lower id
   for (int k = 0; k <= deg; ++k) Q[k] /= scale;
-  double r[6];
-  int n = poly_roots_in(Q, deg, lo, hi, r);
-  int m = 0;
-  for (int k = 0; k < n && m < kMaxCrossings; ++k) out[m++] = r[k];
-  return m;
+  return poly_roots_in(Q, deg, lo, hi, out);  // at most deg <= 6 <= kMaxCrossings roots
 }
 
 namespace {

@@ -29,6 +29,9 @@
 
 namespace vislib {
 
+// Room for the crossings of one depth_crossings call. Every depth function here has fewer: one for
+// LinearDepth, at most 6 for GeneralDepth (the roots of a polynomial of degree <= 6,
+// dynamic_visibility.cpp, which static_asserts it), so no crossing is ever dropped.
 constexpr int kMaxCrossings = 8;
 
 // Depth along the pixel ray (view-space depth lambda, scene units) as a function of t.

@@ -1,0 +1,221 @@
+// bake_options.cpp: the options of `pvs bake` and what they map to (bake_options.h).
+#include "cli/bake_options.h"
+
+#include <fmt/format.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "cli/commands.h"
+#include "cli/options.h"
+
+namespace pvs_cli {
+namespace {
+
+// Quality presets (like vis's -fast / -level): what --preset sets unless given explicitly.
+struct Preset {
+  int resolution, runs;
+  double cell_size;
+};
+Preset preset_values(const std::string& name) {
+  if (name == "draft") return {128, 1, 8.0};
+  if (name == "final") return {2048, 4, 1.0};
+  return {512, 1, 2.0};  // default: the options' own defaults
+}
+
+}  // namespace
+
+vislib::Shard parse_shard(const std::string& text) {
+  unsigned i = 0, n = 0;
+  char extra;
+  if (std::sscanf(text.c_str(), "%u/%u%c", &i, &n, &extra) != 2 || n == 0 || i >= n)
+    throw CLI::ValidationError("--shard", "expected i/N with 0 <= i < N, got '" + text + "'");
+  return {i, n};
+}
+
+namespace {
+
+// The placement of the options (parsed here; their combination is checked by the library).
+vislib::CellPlacement placement_of(const BakeArgs& a) {
+  vislib::CellPlacement p;
+  if (!a.eye.empty()) {
+    auto h = parse_doubles(a.eye, "--eye-height", 2);
+    if (!(h[0] <= h[1])) throw CLI::ValidationError("--eye-height", "expected h0,h1 with h0 <= h1");
+    p.eye = vislib::EyeBand{h[0], h[1]};
+  }
+  if (!a.box.empty()) {
+    auto b = parse_doubles(a.box, "--box", 6);
+    p.box = vislib::Box3{};
+    p.box->extend({b[0], b[1], b[2]});
+    p.box->extend({b[3], b[4], b[5]});
+    for (int k = 0; k < 6; ++k)
+      if (!std::isfinite(b[k])) throw CLI::ValidationError("--box", "coordinates must be finite");
+  }
+  p.walkable = a.walkable;
+  p.cell_size = a.cell_size;
+  p.max_slope_degrees = a.max_slope;
+  p.require_headroom = !a.no_headroom;
+  return p;
+}
+
+// --grid nx,ny,nz: three integers in [1, 10^6].
+std::array<uint32_t, 3> parse_grid(const std::string& text) {
+  auto g = parse_doubles(text, "--grid", 3);
+  for (double v : g)
+    if (!(v >= 1 && v == std::floor(v) && v <= 1e6))
+      throw CLI::ValidationError("--grid", "expected three integers >= 1");
+  return {uint32_t(g[0]), uint32_t(g[1]), uint32_t(g[2])};
+}
+
+// The library's refusal, named after the options that caused it.
+CLI::ValidationError placement_error(vislib::PlacementProblem problem) {
+  using P = vislib::PlacementProblem;
+  switch (problem) {
+    case P::GridWithWalkable:
+      return CLI::ValidationError("--grid", "cannot be combined with --walkable");
+    case P::TooManyColumns:
+      return CLI::ValidationError("--cell-size",
+                                  "more than 10^7 columns: use a larger cell size or a --box");
+    case P::NoBox:
+      return CLI::ValidationError("--box", "give --box with --grid or --cell-size, or --walkable");
+    case P::GridAndCellSize:
+      return CLI::ValidationError("--grid", "give --grid or --cell-size, not both");
+    case P::TooManyGridCells:
+      return CLI::ValidationError("--grid", "more than 10^7 cells");
+    case P::NoGridNorCellSize:
+      return CLI::ValidationError("--grid", "give --grid nx,ny,nz or --cell-size S with --box");
+    case P::TooManySizedCells:
+      break;
+  }
+  return CLI::ValidationError("--cell-size", "more than 10^7 cells");
+}
+
+}  // namespace
+
+vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
+  vislib::CellPlacement p = placement_of(a);
+  try {
+    // --grid is parsed only where the library would use it, so that a conflicting combination is
+    // reported before a malformed --grid (as before the placement moved into the library).
+    if (!a.grid.empty()) {
+      const bool grid_used = !a.walkable && p.box && !(a.cell_size > 0);
+      p.grid = grid_used ? parse_grid(a.grid) : std::array<uint32_t, 3>{1, 1, 1};
+    }
+    return vislib::place_view_cells(scene, p);
+  } catch (const vislib::PlacementError& e) {
+    throw placement_error(e.problem());
+  }
+}
+
+// The preset fills the options not given (issue 17 item 2) and says so on stderr.
+void apply_preset(BakeArgs& a, const CLI::App& cmd) {
+  const Preset preset = preset_values(a.preset);
+  if (cmd.count("--res") == 0) a.resolution = preset.resolution;
+  if (cmd.count("--runs") == 0) a.runs = preset.runs;
+  const bool cell_size_given = cmd.count("--cell-size") > 0;
+  // Cell size: walkable cells, or a grid over --box by size when a preset is named (without
+  // one, --box still needs --grid or --cell-size).
+  if (!cell_size_given && a.grid.empty() && (a.walkable || cmd.count("--preset")))
+    a.cell_size = preset.cell_size;
+  if (show_progress() && cmd.count("--preset"))
+    std::fprintf(
+        stderr, "pvs bake: preset %s: --res %d%s, --runs %d%s, --cell-size %s\n", a.preset.c_str(),
+        a.resolution, cmd.count("--res") ? " (given)" : "", a.runs,
+        cmd.count("--runs") ? " (given)" : "",
+        !a.grid.empty()
+            ? "none (--grid)"
+            : (fmt::format("{:g}", a.cell_size) + (cell_size_given ? " (given)" : "")).c_str());
+}
+
+vislib::BakeSettings settings_of(const BakeArgs& a) {
+  vislib::BakeSettings s;
+  s.region.segment.resolution = a.resolution;
+  s.region.segment.near = a.near;
+  s.region.segment.eps_len = a.eps_len;
+  s.region.segment.tile_size = a.tile;
+  s.region.runs = a.runs;
+  s.region.seed = a.seed;
+  s.granularity =
+      a.granularity == "object" ? vislib::Granularity::Object : vislib::Granularity::Triangle;
+  s.region.segment.mode =
+      a.mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
+  s.region.segment.coplanar =
+      a.coplanar == "first" ? vislib::CoplanarRule::First : vislib::CoplanarRule::Both;
+  s.region.segment.eps_z = a.eps_z;
+  return s;
+}
+
+void add_bake_options(CLI::App* cmd, BakeArgs& a) {
+  cmd->add_option("SCENE", a.scene, "Scene file (.glb .gltf .obj .ply .off .stl)")->required();
+  cmd->add_option("-o,--output", a.output, "Output PVS file (a shard file with --shard)")
+      ->required();
+  cmd->add_option("--box", a.box,
+                  "Grid box x0,y0,z0,x1,y1,z1 (with --walkable: only place cells in it)");
+  cmd->add_option("--grid", a.grid, "Grid cells nx,ny,nz over --box");
+  cmd->add_flag("--walkable", a.walkable, "Place cells automatically over upward-facing floors");
+  cmd->add_option("--cell-size", a.cell_size,
+                  "Cell side: walkable columns (default 2) or grid cells over --box")
+      ->check(positive());
+  cmd->add_option("--eye-height", a.eye,
+                  "Eye band h0,h1 above the floor / the cell bottom (walkable default 1.5,1.8)");
+  cmd->add_option("--max-slope", a.max_slope, "Walkable: steepest floor, degrees from horizontal")
+      ->check(in_range(0.0, 90.0))
+      ->capture_default_str();
+  cmd->add_flag("--no-headroom", a.no_headroom,
+                "Walkable: keep floors covered by other geometry (under buildings)");
+  cmd->add_option("--res", a.resolution, "Cube face resolution N of the from-segment runs")
+      ->check(in_range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--runs", a.runs, "Cube orientations K per boundary segment")
+      ->check(in_range(1, 100000))
+      ->capture_default_str();
+  cmd->add_option("--seed", a.seed, "Seed of the orientations (derived per cell)")
+      ->capture_default_str();
+  cmd->add_option("--near", a.near, "Near plane (view depth, scene units)")
+      ->check(positive())
+      ->capture_default_str();
+  cmd->add_option("--eps-len", a.eps_len, "Final pieces must be longer than this (in t) to count")
+      ->check(in_range(0.0, 1.0))
+      ->capture_default_str();
+  cmd->add_option("--tile", a.tile, "Kernel tile side in pixels")
+      ->check(in_range(1, 4096))
+      ->capture_default_str();
+  cmd->add_option("--states", a.states,
+                  "Key states to sample glTF animations into (dynamic scenes)")
+      ->check(in_range(1, 100000));
+  cmd->add_option("--mode", a.mode,
+                  "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
+      ->check(CLI::IsMember({"diagonal", "decoupled"}))
+      ->capture_default_str();
+  cmd->add_option("--coplanar", a.coplanar,
+                  "Depth ties: 'both' (within --eps-z) or 'first' (as for pvs segment)")
+      ->check(CLI::IsMember({"both", "first"}))
+      ->capture_default_str();
+  cmd->add_option("--eps-z", a.eps_z,
+                  "Depth tie tolerance, relative to the front depth (as for pvs segment)")
+      ->check(in_range(0.0, 0.1))
+      ->capture_default_str();
+  cmd->add_option("--granularity", a.granularity,
+                  "Store triangle ids (spheres after them) or object ids")
+      ->check(CLI::IsMember({"triangle", "object"}))
+      ->capture_default_str();
+  cmd->add_option("-j,--threads", a.threads,
+                  "Worker threads (0 = all cores); never changes the output")
+      ->check(non_negative());
+  cmd->add_option("--shard", a.shard,
+                  "Bake only cells c with c % N == i, into a shard file for pvs merge")
+      ->capture_default_str();
+  cmd->add_flag("--resume", a.resume, "Continue an interrupted bake from its checkpoint");
+  cmd->add_option("--checkpoint", a.checkpoint, "Checkpoint file (default OUTPUT.ckpt)");
+  cmd->add_flag("--dry-run", a.dry_run, "Place the cells, print their count and stop");
+  cmd->add_option("--json", a.json_out,
+                  "Write a bake report (timings per cell, sizes) as JSON ('-' = stdout)");
+  cmd->add_option("--preset", a.preset,
+                  "Quality preset: draft (--res 128, --runs 1, --cell-size 8), default (512, 1, 2) "
+                  "or final (2048, 4, 1); options given explicitly win")
+      ->check(CLI::IsMember({"draft", "default", "final"}))
+      ->capture_default_str();
+}
+
+}  // namespace pvs_cli

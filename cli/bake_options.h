@@ -1,0 +1,48 @@
+// bake_options.h: the options of `pvs bake` (cmd_bake.cpp) and what they map to: the quality
+// presets, the shard, the placement of the view cells (vislib/bake/view_cells.h) and the bake
+// settings. Parsing only: errors are CLI::ValidationError naming the option (exit 2).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <string>
+
+#include "vislib/bake/bake.h"
+#include "vislib/bake/view_cells.h"
+#include "vislib/scene/scene.h"
+
+namespace pvs_cli {
+
+struct BakeArgs {
+  std::string scene, output, checkpoint, json_out;
+  std::string box, grid, eye, shard = "0/1";
+  bool walkable = false, resume = false, no_headroom = false, dry_run = false;
+  double cell_size = 0, max_slope = 45;
+  int resolution = 512, runs = 1, threads = 0, tile = 32;
+  uint64_t seed = 1;
+  double near = vislib::kDefaultNear, eps_len = vislib::kDefaultEpsLen;
+  std::string granularity = "triangle";
+  std::string mode = "diagonal";
+  std::string coplanar = "both";
+  double eps_z = vislib::kDefaultEpsZ;
+  int states = 1;
+  std::string preset = "default";
+};
+
+// Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).
+void add_bake_options(CLI::App* cmd, BakeArgs& a);
+
+// --shard i/N.
+vislib::Shard parse_shard(const std::string& text);
+
+// The preset fills the options not given (issue 17 item 2) and says so on stderr (not -q).
+void apply_preset(BakeArgs& a, const CLI::App& cmd);
+
+// The view cells of the options over `scene` (vislib::place_view_cells); a refused placement is
+// reported as the option that caused it.
+vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene);
+
+// The kernel and bake settings of the options.
+vislib::BakeSettings settings_of(const BakeArgs& a);
+
+}  // namespace pvs_cli
