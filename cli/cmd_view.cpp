@@ -27,6 +27,7 @@
 #include "vislib/eval/render.h"
 #include "vislib/render/near_far_render.h"
 #include "vislib/render/near_region_growth.h"
+#include "vislib/render/view_setup.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 namespace pvs_cli {
@@ -42,108 +43,126 @@ struct ViewArgs {
   double near_fraction = 0.7, tau = 0, merge_min = -1;
 };
 
-// The cell of the eye and its visible triangles, read from the PVS file for the scene.
-struct ViewCell {
-  vislib::Scene full_scene;  // every key state
-  uint32_t cell = 0;
-  std::vector<uint32_t> tris;
-  vislib::Vec3 centre;  // of the cell's view region
-  vislib::Box3 region;  // the cell's view region
-  pvs::Box box;         // the cell's lookup box
+// --frame, --near-far, --at and --look, parsed.
+struct ViewInputs {
+  int fw = 0, fh = 0;
+  std::vector<double> radii;  // empty: derived from the cell
+  vislib::Vec3 eye, target;
 };
 
-ViewCell read_view_cell(const ViewArgs& a, vislib::Vec3 eye) {
-  ViewCell v;
-  v.full_scene = load_scene_for_cli(a.scene, a.states);
-  pvs::ReadOptions opt;
-  opt.expected_fingerprint = vislib::scene_fingerprint(v.full_scene);
-  vislib::reading_pvs(a.file, [&] {
-    pvs::Reader r = pvs::Reader::from_file(a.file, opt);
-    const pvs::FileInfo& info = r.info();
-    vislib::check_universe(a.file, info, v.full_scene);
-    double q[3] = {eye.x, eye.y, eye.z};
-    std::optional<uint32_t> c = info.layout.find_cell(q);
-    if (!c) {
-      std::fprintf(stderr, "pvs: error: no cell contains %s\n", a.at.c_str());
-      throw Exit{2};
-    }
-    v.cell = *c;
-    if (r.block_info(v.cell).encoding == pvs::Encoding::Absent) {
-      std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", v.cell);
-      throw Exit{2};
-    }
-    v.tris =
-        vislib::visible_triangles(v.full_scene, r.read_cell(v.cell), vislib::granularity_of(info));
-    v.centre = vislib::view_region_centre(info.layout, v.cell);
-    v.region = vislib::to_box3(info.layout.view_region(v.cell));
-    v.box = info.layout.cell_box(v.cell);
-  });
+ViewInputs parse_view(const ViewArgs& a) {
+  ViewInputs in;
+  if (std::sscanf(a.frame.c_str(), "%dx%d", &in.fw, &in.fh) != 2 || in.fw < 11 || in.fh < 11 ||
+      in.fw > 8192 || in.fh > 8192)
+    throw CLI::ValidationError("--frame",
+                               "expected WxH with 11 <= W, H <= 8192, got '" + a.frame + "'");
+  if (!a.near_far.empty()) {
+    in.radii = parse_doubles(a.near_far, "--near-far", 2);
+    if (!(in.radii[0] >= 0 && in.radii[0] < in.radii[1]))
+      throw CLI::ValidationError("--near-far", "expected 0 <= r1 < r2, got '" + a.near_far + "'");
+  }
+  in.eye = parse_vec3(a.at, "--at");
+  in.target = parse_vec3(a.look, "--look");
+  if (length(in.target - in.eye) == 0)
+    throw CLI::ValidationError("--look", "must differ from --at");
+  return in;
+}
+
+// The visible set of the eye's cell (vislib/bake/cell_set.h), or a message and exit 2.
+vislib::CellViewSet read_view_cell(const ViewArgs& a, const vislib::Scene& full_scene,
+                                   vislib::Vec3 eye) {
+  vislib::CellViewSet v = vislib::read_cell_view_set(a.file, full_scene, eye);
+  if (v.where.status == vislib::PointCell::NoCell) {
+    std::fprintf(stderr, "pvs: error: no cell contains %s\n", a.at.c_str());
+    throw Exit{2};
+  }
+  if (v.where.status == vislib::PointCell::Absent) {
+    std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", v.where.cell);
+    throw Exit{2};
+  }
   return v;
 }
 
-void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
-  int fw = 0, fh = 0;
-  if (std::sscanf(a.frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
-      fh > 8192)
-    throw CLI::ValidationError("--frame",
-                               "expected WxH with 11 <= W, H <= 8192, got '" + a.frame + "'");
-  std::vector<double> radii;
-  if (!a.near_far.empty()) {
-    radii = parse_doubles(a.near_far, "--near-far", 2);
-    if (!(radii[0] >= 0 && radii[0] < radii[1]))
-      throw CLI::ValidationError("--near-far", "expected 0 <= r1 < r2, got '" + a.near_far + "'");
-  }
-  const vislib::Vec3 eye = parse_vec3(a.at, "--at"), target = parse_vec3(a.look, "--look");
-  if (length(target - eye) == 0) throw CLI::ValidationError("--look", "must differ from --at");
+// --centre, or the cell's default (never a point inside a building, issue 17 item 6).
+vislib::Vec3 view_centre(const ViewArgs& a, const vislib::Scene& full_scene,
+                         const vislib::CellViewSet& v) {
+  if (!a.centre.empty()) return parse_vec3(a.centre, "--centre");
+  const uint32_t cell = v.where.cell;
+  const std::optional<vislib::ViewCentre> c =
+      vislib::default_view_centre(full_scene, v.view_region, v.centre);
+  if (!c)
+    throw vislib::InputError(a.file, "every sample of cell " + std::to_string(cell) +
+                                         "'s view region is enclosed by the scene: give --centre");
+  if (c->moved)
+    warn("the centre of cell " + std::to_string(cell) +
+         "'s view region is enclosed by the scene; the free point " + std::to_string(c->point.x) +
+         "," + std::to_string(c->point.y) + "," + std::to_string(c->point.z) + " is the centre");
+  return c->point;
+}
 
-  ViewCell v = read_view_cell(a, eye);
-  vislib::Vec3 centre = a.centre.empty() ? v.centre : parse_vec3(a.centre, "--centre");
-  if (a.centre.empty()) {
-    // Never a point inside a building as the default centre (issue 17 item 6).
-    vislib::CellFreeSpace fs = vislib::cell_free_space(v.full_scene, v.region);
-    if (fs.centre_enclosed) {
-      if (!fs.free_point)
-        throw vislib::InputError(a.file,
-                                 "every sample of cell " + std::to_string(v.cell) +
-                                     "'s view region is enclosed by the scene: give --centre");
-      centre = *fs.free_point;
-      warn("the centre of cell " + std::to_string(v.cell) +
-           "'s view region is enclosed by the scene; the free point " + std::to_string(centre.x) +
-           "," + std::to_string(centre.y) + "," + std::to_string(centre.z) + " is the centre");
-    }
-  }
+// --grow: both growths of the near region (vislib/render/near_region_growth.h), as JSON.
+json grow_json(const ViewArgs& a, const vislib::Scene& scene, const vislib::EmbreeScene& rt,
+               const std::vector<uint32_t>& tris, const vislib::Camera& cam,
+               const vislib::Frame& truth, const vislib::NearFarSettings& s) {
+  const vislib::GrowthPlan plan =
+      vislib::plan_growth(scene, tris, s.centre, s.r2, a.rings, a.merge_min);
+  vislib::GrowthSettings g;
+  g.centre = s.centre;
+  g.near_fraction = a.near_fraction;
+  g.env_size = s.env_size;
+  g.frames_per_ring = a.frames_per_ring;
+  vislib::ScheduleFrameFn on_frame;
+  if (!a.frames_out.empty())
+    on_frame = [&a, &cam](const std::string& schedule, size_t i, const vislib::GrowthStep&,
+                          const vislib::Frame& f) {
+      char name[64];
+      std::snprintf(name, sizeof name, "/%s_%04zu.png", schedule.c_str(), i);
+      vislib::write_rgb8_image(a.frames_out + name, cam.width, cam.height, f.rgb);
+    };
+  if (!a.frames_out.empty()) std::filesystem::create_directories(a.frames_out);
+  const vislib::GrowthComparison runs =
+      vislib::grow_near_region_both(scene, rt, tris, cam, truth, plan, g, on_frame);
+  const json merged_json = growth_json(runs.merged), equal_json = growth_json(runs.equal_area);
+  return {{"min_consecutive_ssim", merged_json["min_consecutive_ssim"]},
+          {"near_fraction", a.near_fraction},
+          {"ring_area", plan.ring_area},
+          {"frames_per_ring", a.frames_per_ring},
+          {"ring_contribution", plan.contribution},
+          {"merge_min_contribution", plan.merge_min_contribution},
+          {"merged", merged_json},
+          {"equal_area", equal_json}};
+}
+
+void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
+  const ViewInputs in = parse_view(a);
+  const vislib::Vec3 eye = in.eye, target = in.target;
+  const int fw = in.fw, fh = in.fh;
+  const vislib::Scene full_scene = load_scene_for_cli(a.scene, a.states);  // every key state
+  const vislib::CellViewSet v = read_view_cell(a, full_scene, eye);
+  const vislib::Vec3 centre = view_centre(a, full_scene, v);
   const double eye_axis =
       pvs_runtime::axis_distance({eye.x, eye.y, eye.z}, {centre.x, centre.y, centre.z});
-  if (radii.empty()) {  // derived from the cell, as pvs_rt_cell_near_far (docs/runtime.md)
-    const double half_diagonal =
-        0.5 * std::hypot(v.box.max[0] - v.box.min[0], v.box.max[2] - v.box.min[2]);
-    const double r1 = 1.25 * std::max({half_diagonal, eye_axis, 1e-6});
-    radii = {r1, 2 * r1};
-  }
-  if (!(eye_axis < radii[0]))
+  vislib::NearFarRadii radii = vislib::default_near_far_radii(v.box, eye_axis);
+  if (!in.radii.empty()) radii = {in.radii[0], in.radii[1]};
+  if (!(eye_axis < radii.r1))
     throw CLI::ValidationError("--near-far", "the eye is " + std::to_string(eye_axis) +
                                                  " from the centre's axis: r1 must exceed it");
 
-  vislib::Camera cam;
-  cam.eye = eye;
-  cam.forward = target - eye;
-  if (length(cross(cam.forward, cam.up)) == 0) cam.up = {0, 0, -1};
-  cam.width = fw;
-  cam.height = fh;
+  const vislib::Camera cam = vislib::look_at_camera(eye, target, fw, fh);
   vislib::NearFarSettings s;
   s.centre = centre;
-  s.r1 = radii[0];
-  s.r2 = radii[1];
+  s.r1 = radii.r1;
+  s.r2 = radii.r2;
   s.env_size = a.env_size > 0 ? a.env_size : fh;
   s.lookup = a.lookup == "cylinder" ? vislib::EnvironmentLookup::CylinderR2
                                     : vislib::EnvironmentLookup::EyeDirection;
 
   // Everything is rendered from the scene at tau (one state); the moving triangles are those of
   // the loaded key states.
-  const std::vector<uint8_t> moving = vislib::moving_triangles(v.full_scene);
+  const std::vector<uint8_t> moving = vislib::moving_triangles(full_scene);
   s.dynamic = moving.data();
-  const vislib::Scene scene = vislib::scene_at(v.full_scene, a.tau);
-  const std::vector<uint32_t>& tris = v.tris;
+  const vislib::Scene scene = vislib::scene_at(full_scene, a.tau);
+  const std::vector<uint32_t>& tris = v.triangles;
   vislib::EmbreeScene rt(scene, 0.0, eye);
   vislib::Frame truth = vislib::render_frame(scene, rt, cam);
   vislib::RegionCounts rc;
@@ -159,14 +178,14 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
 
   json j = quality_json(scene, truth, morphed);
   j["file"] = a.file;
-  j["cell"] = v.cell;
+  j["cell"] = v.where.cell;
   j["eye"] = {eye.x, eye.y, eye.z};
   j["look"] = {target.x, target.y, target.z};
   j["centre"] = {centre.x, centre.y, centre.z};
   j["r1"] = s.r1;
   j["r2"] = s.r2;
   j["tau"] = a.tau;
-  j["states"] = v.full_scene.state_count();
+  j["states"] = full_scene.state_count();
   j["frame"] = {fw, fh};
   j["env_size"] = s.env_size;
   j["lookup"] = a.lookup;
@@ -189,44 +208,9 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
                  {"truth", sibling(a.output, "_truth")},
                  {"nomorph", sibling(a.output, "_nomorph")},
                  {"heat_map", sibling(a.output, "_heat")}};
-
-  if (a.grow) {
-    const vislib::GrowthPlan plan =
-        vislib::plan_growth(scene, tris, centre, s.r2, a.rings, a.merge_min);
-    vislib::GrowthSettings g;
-    g.centre = centre;
-    g.near_fraction = a.near_fraction;
-    g.env_size = s.env_size;
-    g.frames_per_ring = a.frames_per_ring;
-    auto frames_to = [&](const char* prefix) {
-      if (!a.frames_out.empty()) {
-        std::filesystem::create_directories(a.frames_out);
-        g.on_frame = [&a, prefix, fw, fh](size_t i, const vislib::GrowthStep&,
-                                          const vislib::Frame& f) {
-          char name[64];
-          std::snprintf(name, sizeof name, "/%s_%04zu.png", prefix, i);
-          vislib::write_rgb8_image(a.frames_out + name, fw, fh, f.rgb);
-        };
-      }
-    };
-    frames_to("merged");
-    json merged_json =
-        growth_json(vislib::grow_near_region(scene, rt, tris, cam, truth, plan.merged, g));
-    frames_to("equal_area");
-    json equal_json =
-        growth_json(vislib::grow_near_region(scene, rt, tris, cam, truth, plan.equal, g));
-    j["continuity"] = {{"min_consecutive_ssim", merged_json["min_consecutive_ssim"]},
-                       {"near_fraction", a.near_fraction},
-                       {"ring_area", plan.ring_area},
-                       {"frames_per_ring", a.frames_per_ring},
-                       {"ring_contribution", plan.contribution},
-                       {"merge_min_contribution", plan.merge_min_contribution},
-                       {"merged", merged_json},
-                       {"equal_area", equal_json}};
-  }
-
+  if (a.grow) j["continuity"] = grow_json(a, scene, rt, tris, cam, truth, s);
   if (stereo.enabled()) j["stereo"] = run_view_stereo(stereo, a.file, scene, rt, cam, a.output);
-  print_view(j, rc, !moving.empty() && v.full_scene.is_dynamic());
+  print_view(j, rc, !moving.empty() && full_scene.is_dynamic());
   if (a.json_path == "-") {
     std::printf("%s\n", j.dump(1).c_str());
   } else if (!a.json_path.empty()) {

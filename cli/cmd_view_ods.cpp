@@ -127,7 +127,6 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
   try {
     pvs_runtime::Pvs pvs = pvs_runtime::Pvs::open(c.file, opt);
     const pvs::FileInfo& info = pvs.info();
-    const bool object = info.granularity == pvs::Granularity::Object;
     vislib::check_universe(c.file, info, full_scene);  // the bake's id rule (id_universe.h)
     const double q[3] = {eye.x, eye.y, eye.z};
     const std::optional<uint32_t> found = pvs.find_cell(q);
@@ -159,17 +158,15 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
       }
       disc_covered = in;
     }
-    std::vector<uint8_t> keep(
-        info.universe, 0);  // triangle granularity: ids >= triangle_count are spheres (not drawn)
+    std::vector<std::vector<uint32_t>> sets;
     for (uint32_t u : cells) {
       if (pvs.is_absent(u)) {
         std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", u);
         throw Exit{2};
       }
-      for (uint32_t id : pvs.visible_ids(u)) keep[id] = 1;
+      sets.push_back(pvs.visible_ids(u));
     }
-    for (uint32_t t = 0; t < full_scene.triangle_count(); ++t)
-      if (keep[object ? full_scene.triangle_object[t] : t]) tris.push_back(t);
+    tris = vislib::visible_triangles_union(full_scene, sets, vislib::granularity_of(info));
   } catch (const pvs_runtime::OpenError& e) {
     throw vislib::InputError(c.file, e.what());
   } catch (const pvs::FormatError& e) {

@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/cell_set.h"
 #include "vislib/base/error.h"
 #include "vislib/eval/image_io.h"
 #include "vislib/eval/metrics.h"
@@ -59,37 +60,28 @@ json quality(const vislib::Frame& truth, const vislib::Frame& test) {
 std::vector<uint32_t> cells_union(const std::string& file, const vislib::Scene& scene,
                                   const std::vector<std::pair<std::string, vislib::Vec3>>& points,
                                   std::vector<uint32_t>* cells) {
-  std::vector<uint8_t> keep;
-  try {
+  return vislib::reading_pvs(file, [&] {
     pvs::Reader r = pvs::Reader::from_file(file, pvs::ReadOptions{});
-    const pvs::FileInfo& info = r.info();
-    const bool object = info.granularity == pvs::Granularity::Object;
-    keep.assign(object ? scene.objects.size() : scene.triangle_count(), 0);
+    std::vector<std::vector<uint32_t>> sets;
     for (const auto& [name, p] : points) {
-      double q[3] = {p.x, p.y, p.z};
-      std::optional<uint32_t> c = info.layout.find_cell(q);
-      if (!c) {
+      const vislib::PointCell c = vislib::find_point_cell(r, p);
+      if (c.status == vislib::PointCell::NoCell) {
         std::fprintf(stderr, "pvs: error: --stereo: the %s eye (%g,%g,%g) is in no cell of %s\n",
                      name.c_str(), p.x, p.y, p.z, file.c_str());
         throw Exit{2};
       }
-      if (r.block_info(*c).encoding == pvs::Encoding::Absent) {
+      if (c.status == vislib::PointCell::Absent) {
         std::fprintf(stderr,
-                     "pvs: error: --stereo: cell %u of the %s eye is absent from this shard\n", *c,
-                     name.c_str());
+                     "pvs: error: --stereo: cell %u of the %s eye is absent from this shard\n",
+                     c.cell, name.c_str());
         throw Exit{2};
       }
-      if (std::find(cells->begin(), cells->end(), *c) != cells->end()) continue;
-      cells->push_back(*c);
-      for (uint32_t id : r.read_cell(*c)) keep[id] = 1;
+      if (std::find(cells->begin(), cells->end(), c.cell) != cells->end()) continue;
+      cells->push_back(c.cell);
+      sets.push_back(r.read_cell(c.cell));
     }
-    std::vector<uint32_t> tris;
-    for (uint32_t t = 0; t < scene.triangle_count(); ++t)
-      if (keep[object ? scene.triangle_object[t] : t]) tris.push_back(t);
-    return tris;
-  } catch (const pvs::FormatError& e) {
-    throw vislib::InputError(file, e.what());
-  }
+    return vislib::visible_triangles_union(scene, sets, vislib::granularity_of(r.info()));
+  });
 }
 
 }  // namespace

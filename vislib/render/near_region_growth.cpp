@@ -70,4 +70,22 @@ GrowthRun grow_near_region(const Scene& scene, const EmbreeScene& rt,
   return run;
 }
 
+GrowthComparison grow_near_region_both(const Scene& scene, const EmbreeScene& rt,
+                                       const std::vector<uint32_t>& visible, const Camera& camera,
+                                       const Frame& truth, const GrowthPlan& plan,
+                                       GrowthSettings settings, const ScheduleFrameFn& on_frame) {
+  GrowthComparison c;
+  for (const char* schedule : {"merged", "equal_area"}) {
+    settings.on_frame = nullptr;
+    if (on_frame)
+      settings.on_frame = [&on_frame, schedule](size_t i, const GrowthStep& step, const Frame& f) {
+        on_frame(schedule, i, step, f);
+      };
+    const bool merged = std::string(schedule) == "merged";
+    (merged ? c.merged : c.equal_area) = grow_near_region(
+        scene, rt, visible, camera, truth, merged ? plan.merged : plan.equal, settings);
+  }
+  return c;
+}
+
 }  // namespace vislib

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "vislib/base/vec.h"
@@ -66,5 +67,19 @@ GrowthRun grow_near_region(const Scene& scene, const EmbreeScene& rt,
                            const std::vector<uint32_t>& visible, const Camera& camera,
                            const Frame& truth, const std::vector<double>& radii,
                            const GrowthSettings& settings);
+
+// Both growths of a plan, the merged rings then the equal-area rings (pvs view --grow), with the
+// same settings; `on_frame`, when set, gets each frame with its schedule ("merged" or
+// "equal_area") and its index within that growth (settings.on_frame is not used).
+struct GrowthComparison {
+  GrowthRun merged, equal_area;
+};
+using ScheduleFrameFn = std::function<void(const std::string& schedule, size_t index,
+                                           const GrowthStep& step, const Frame& frame)>;
+GrowthComparison grow_near_region_both(const Scene& scene, const EmbreeScene& rt,
+                                       const std::vector<uint32_t>& visible, const Camera& camera,
+                                       const Frame& truth, const GrowthPlan& plan,
+                                       GrowthSettings settings,
+                                       const ScheduleFrameFn& on_frame = {});
 
 }  // namespace vislib
