@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "cli/view_options.h"
 #include "cli/view_report.h"
 #include "pvs_format/pvs_format.h"
 #include "runtime/near_far.h"
@@ -34,39 +35,6 @@ namespace pvs_cli {
 namespace {
 
 using nlohmann::json;
-
-struct ViewArgs {
-  std::string file, scene, at, look, near_far, centre, output, json_path, frames_out;
-  std::string frame = "640x480", lookup = "eye";
-  bool grow = false;
-  int env_size = 0, rings = 8, states = 1, frames_per_ring = 4;
-  double near_fraction = 0.7, tau = 0, merge_min = -1;
-};
-
-// --frame, --near-far, --at and --look, parsed.
-struct ViewInputs {
-  int fw = 0, fh = 0;
-  std::vector<double> radii;  // empty: derived from the cell
-  vislib::Vec3 eye, target;
-};
-
-ViewInputs parse_view(const ViewArgs& a) {
-  ViewInputs in;
-  if (std::sscanf(a.frame.c_str(), "%dx%d", &in.fw, &in.fh) != 2 || in.fw < 11 || in.fh < 11 ||
-      in.fw > 8192 || in.fh > 8192)
-    throw CLI::ValidationError("--frame",
-                               "expected WxH with 11 <= W, H <= 8192, got '" + a.frame + "'");
-  if (!a.near_far.empty()) {
-    in.radii = parse_doubles(a.near_far, "--near-far", 2);
-    if (!(in.radii[0] >= 0 && in.radii[0] < in.radii[1]))
-      throw CLI::ValidationError("--near-far", "expected 0 <= r1 < r2, got '" + a.near_far + "'");
-  }
-  in.eye = parse_vec3(a.at, "--at");
-  in.target = parse_vec3(a.look, "--look");
-  if (length(in.target - in.eye) == 0)
-    throw CLI::ValidationError("--look", "must differ from --at");
-  return in;
-}
 
 // The visible set of the eye's cell (vislib/bake/cell_set.h), or a message and exit 2.
 vislib::CellViewSet read_view_cell(const ViewArgs& a, const vislib::Scene& full_scene,
@@ -226,63 +194,7 @@ void add_view(CLI::App& app) {
                                      "morphed by Eq. 1, far region through an environment map from "
                                      "the centre), with the full-scene "
                                      "frame, the error heat map and the metrics");
-  cmd->add_option("PVS", a->file, "PVS file")->required();
-  cmd->add_option("--scene", a->scene,
-                  "The scene the PVS was baked for (checked by its fingerprint)")
-      ->required();
-  cmd->add_option("--at", a->at, "User eye x,y,z (its cell's visible set is used)")->required();
-  cmd->add_option("--look", a->look, "Point x,y,z the user looks at (required without --ods)");
-  cmd->add_option(
-      "--near-far", a->near_far,
-      "Radii r1,r2 of the cylinders about the centre (scene units; default: r1 = 1.25 x "
-      "the half x-z diagonal of the cell's box, r2 = 2 r1, as pvs_rt_cell_near_far)");
-  cmd->add_option("--frames-out", a->frames_out,
-                  "--grow: also write every growth frame as DIR/merged_NNNN.png and "
-                  "DIR/equal_area_NNNN.png");
-  cmd->add_option("--centre", a->centre,
-                  "Centre O x,y,z of the cylinders and environment map (default: the "
-                  "centre of the cell's view region, or the free sample of the region nearest "
-                  "it when that is enclosed by the scene)");
-  cmd->add_flag("--grow", a->grow,
-                "Also render the progressive near region (CloVR rings up to r2) and report "
-                "the minimum SSIM between consecutive frames");
-  cmd->add_option("--rings", a->rings, "--grow: equal-area rings up to r2")
-      ->check(in_range(1, 1000))
-      ->capture_default_str();
-  cmd->add_option("--frames-per-ring", a->frames_per_ring,
-                  "--grow: frames over which each ring is injected (Alg. 1 with R animated from "
-                  "the previous "
-                  "ring's radius to the ring's)")
-      ->check(in_range(1, 1000))
-      ->capture_default_str();
-  cmd->add_option(
-      "--merge-min", a->merge_min,
-      "--grow: merged rings contribute at least this many visible triangles (entering the near "
-      "region) each (default: the mean over the equal-area rings)");
-  cmd->add_option("--states", a->states,
-                  "Key states to sample glTF animations into (as for the bake)")
-      ->check(in_range(1, 100000))
-      ->capture_default_str();
-  cmd->add_option("--time", a->tau, "Animation time tau in [0,1] of the frame (dynamic scenes)")
-      ->check(in_range(0.0, 1.0))
-      ->capture_default_str();
-  cmd->add_option("--near-fraction", a->near_fraction, "--grow: R_n / R of Alg. 1")
-      ->check(in_range(0.01, 0.99))
-      ->capture_default_str();
-  cmd->add_option("--frame", a->frame, "Frame size WxH")->capture_default_str();
-  cmd->add_option("--env-size", a->env_size,
-                  "Environment map face side in pixels (default: the frame height)")
-      ->check(in_range(0, 8192));
-  cmd->add_option("--lookup", a->lookup,
-                  "Environment map lookup: eye (along the eye ray, the paper) or cylinder "
-                  "(from O through the eye ray's exit point on the r2 cylinder)")
-      ->check(CLI::IsMember({"eye", "cylinder"}))
-      ->capture_default_str();
-  cmd->add_option("-o,--output", a->output,
-                  "Near-far frame (.png); <out>_truth.png, <out>_heat.png and "
-                  "<out>_nomorph.png are written next to it")
-      ->required();
-  cmd->add_option("--json", a->json_path, "Write the metrics as JSON ('-' = stdout)");
+  add_view_options(cmd, *a);
   auto ods = std::make_shared<OdsViewArgs>();
   add_ods_view_options(cmd, ods);
   std::shared_ptr<ViewStereoArgs> stereo = add_view_stereo_options(cmd);

@@ -74,6 +74,58 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// The cells whose visible sets serve the viewing disc of radius `radius` at `eye` (the eye's
+// cell, and its neighbours touching the disc when the disc leaves its view region), and the
+// triangles of their union; a message and exit 2 when the eye is in no cell or one is absent.
+struct OdsCells {
+  uint32_t cell = 0;
+  std::vector<uint32_t> cells, tris;
+  bool disc_in_region = false, disc_covered = false;
+};
+OdsCells ods_cells(const ViewCommonArgs& c, const vislib::Scene& full_scene, vislib::Vec3 eye,
+                   double radius) {
+  pvs_runtime::OpenOptions opt;
+  opt.expected_fingerprint = vislib::scene_fingerprint(full_scene);
+  OdsCells u;
+  try {
+    pvs_runtime::Pvs pvs = pvs_runtime::Pvs::open(c.file, opt);
+    const pvs::FileInfo& info = pvs.info();
+    vislib::check_universe(c.file, info, full_scene);  // the bake's id rule (id_universe.h)
+    const double q[3] = {eye.x, eye.y, eye.z};
+    const std::optional<uint32_t> found = pvs.find_cell(q);
+    if (!found) {
+      std::fprintf(stderr, "pvs: error: no cell contains %s\n", c.at.c_str());
+      throw Exit{2};
+    }
+    u.cell = *found;
+    const pvs_runtime::Point3 centre{eye.x, eye.y, eye.z};
+    const pvs::Box region = info.layout.view_region(u.cell);
+    u.disc_in_region = pvs_runtime::disc_inside_box(centre, radius, region.min, region.max);
+    u.cells.push_back(u.cell);
+    if (!u.disc_in_region)
+      for (uint32_t n : pvs.neighbours(u.cell, radius)) {
+        const pvs::Box r = info.layout.view_region(n);
+        if (pvs_runtime::disc_touches_box(centre, radius, r.min, r.max)) u.cells.push_back(n);
+      }
+    u.disc_covered = vislib::ods_disc_covered(info.layout, u.cells, eye, radius);
+    std::vector<std::vector<uint32_t>> sets;
+    for (uint32_t k : u.cells) {
+      if (pvs.is_absent(k)) {
+        std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", k);
+        throw Exit{2};
+      }
+      sets.push_back(pvs.visible_ids(k));
+    }
+    u.tris = vislib::visible_triangles_union(full_scene, sets, vislib::granularity_of(info));
+  } catch (const pvs_runtime::OpenError& e) {
+    throw vislib::InputError(c.file, e.what());
+  } catch (const pvs::FormatError& e) {
+    throw vislib::InputError(c.file, e.what());
+  }
+
+  return u;
+}
+
 }  // namespace
 
 void add_ods_view_options(CLI::App* cmd, const std::shared_ptr<OdsViewArgs>& a) {
@@ -119,59 +171,8 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
   const double radius = 0.5 * ipd;
 
   vislib::Scene full_scene = load_scene_for_cli(c.scene, c.states);
-  pvs_runtime::OpenOptions opt;
-  opt.expected_fingerprint = vislib::scene_fingerprint(full_scene);
-  std::vector<uint32_t> tris, cells;
-  uint32_t cell = 0;
-  bool disc_in_region = false, disc_covered = false;
-  try {
-    pvs_runtime::Pvs pvs = pvs_runtime::Pvs::open(c.file, opt);
-    const pvs::FileInfo& info = pvs.info();
-    vislib::check_universe(c.file, info, full_scene);  // the bake's id rule (id_universe.h)
-    const double q[3] = {eye.x, eye.y, eye.z};
-    const std::optional<uint32_t> found = pvs.find_cell(q);
-    if (!found) {
-      std::fprintf(stderr, "pvs: error: no cell contains %s\n", c.at.c_str());
-      throw Exit{2};
-    }
-    cell = *found;
-    const pvs_runtime::Point3 centre{eye.x, eye.y, eye.z};
-    const pvs::Box region = info.layout.view_region(cell);
-    disc_in_region = pvs_runtime::disc_inside_box(centre, radius, region.min, region.max);
-    cells.push_back(cell);
-    if (!disc_in_region)
-      for (uint32_t n : pvs.neighbours(cell, radius)) {
-        const pvs::Box r = info.layout.view_region(n);
-        if (pvs_runtime::disc_touches_box(centre, radius, r.min, r.max)) cells.push_back(n);
-      }
-    // Covered: the centre and 64 points of the rim lie in the view region of a used cell.
-    disc_covered = true;
-    for (int k = -1; k < 64 && disc_covered; ++k) {
-      const double a = 2 * pvs_runtime::kOdsPi * k / 64;
-      const double p[3] = {eye.x + (k < 0 ? 0 : radius * std::cos(a)), eye.y,
-                           eye.z + (k < 0 ? 0 : radius * std::sin(a))};
-      bool in = false;
-      for (uint32_t u : cells) {
-        const pvs::Box r = info.layout.view_region(u);
-        in = in || (p[0] >= r.min[0] && p[0] <= r.max[0] && p[1] >= r.min[1] && p[1] <= r.max[1] &&
-                    p[2] >= r.min[2] && p[2] <= r.max[2]);
-      }
-      disc_covered = in;
-    }
-    std::vector<std::vector<uint32_t>> sets;
-    for (uint32_t u : cells) {
-      if (pvs.is_absent(u)) {
-        std::fprintf(stderr, "pvs: error: cell %u is absent from this shard\n", u);
-        throw Exit{2};
-      }
-      sets.push_back(pvs.visible_ids(u));
-    }
-    tris = vislib::visible_triangles_union(full_scene, sets, vislib::granularity_of(info));
-  } catch (const pvs_runtime::OpenError& e) {
-    throw vislib::InputError(c.file, e.what());
-  } catch (const pvs::FormatError& e) {
-    throw vislib::InputError(c.file, e.what());
-  }
+  const OdsCells used = ods_cells(c, full_scene, eye, radius);
+  const std::vector<uint32_t>& tris = used.tris;
 
   const vislib::Scene scene = vislib::scene_at(full_scene, c.tau);
   vislib::OdsSettings s;
@@ -249,10 +250,10 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
       {"size", {w, h}},
       {"pole_merge", {{"top", side_json(merge.top)}, {"bottom", side_json(merge.bottom)}}},
       {"centre", {eye.x, eye.y, eye.z}},
-      {"cell", cell},
-      {"cells_used", cells},
-      {"disc_in_cell_view_region", disc_in_region},
-      {"disc_covered", disc_covered},
+      {"cell", used.cell},
+      {"cells_used", used.cells},
+      {"disc_in_cell_view_region", used.disc_in_region},
+      {"disc_covered", used.disc_covered},
       {"triangles", {{"scene", scene.triangle_count()}, {"visible", tris.size()}}},
       {"left", quality_json(truth_left, left)},
       {"right", quality_json(truth_right, right)},
@@ -280,8 +281,8 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
                "ODS %dx%d %s, IPD %.4g m, cell %u, cells used %zu%s, visible %zu of %zu triangles\n"
                "  left:  epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n"
                "  right: epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n",
-               w, h, o.method.c_str(), o.ipd_m, cell, cells.size(),
-               disc_covered ? "" : " (disc NOT covered)", tris.size(),
+               w, h, o.method.c_str(), o.ipd_m, used.cell, used.cells.size(),
+               used.disc_covered ? "" : " (disc NOT covered)", tris.size(),
                size_t(scene.triangle_count()), ods["left"]["epsilon"].get<double>(),
                ods["left"]["ssim"].get<double>(), ods["left"]["triangle_mismatch"].get<double>(),
                seconds["left"].get<double>(), ods["right"]["epsilon"].get<double>(),

@@ -84,6 +84,72 @@ std::vector<uint32_t> cells_union(const std::string& file, const vislib::Scene& 
   });
 }
 
+// What every eye of the pair shares: the scene, the allowed set, the source frame and camera.
+struct StereoSource {
+  const vislib::Scene& scene;
+  const vislib::EmbreeScene& rt;
+  const std::vector<uint8_t>& allowed;
+  const vislib::Frame& frame;
+  const vislib::Camera& camera;
+  vislib::Splatting splatting;
+  size_t pixels;
+};
+struct StereoTimes {
+  Seconds render, reproject, patch, both;
+  size_t rays = 0;
+};
+
+// The eye `cam` reprojected from the source and patched (or rendered when too many of its pixels
+// are holes), into `out` and `holes_image`; its JSON block without the errors.
+json reprojected_eye(const ViewStereoArgs& a, const StereoSource& src, const vislib::Camera& cam,
+                     const vislib::Frame& truth, StereoTimes& t, vislib::Frame& out,
+                     std::vector<uint8_t>& holes_image) {
+  json ej;
+  ej["rendered"] = false;
+  Stopwatch t0;
+  vislib::Reprojection r = vislib::reproject(src.frame, src.camera, cam, src.splatting);
+  t.reproject.add(t0);
+  const size_t holes = r.holes();
+  const double pixels = double(src.pixels), share = double(holes) / pixels;
+  ej["holes"] = {{"share", share},
+                 {"disocclusion", double(r.count(vislib::HoleKind::Disocclusion)) / pixels},
+                 {"crack", double(r.count(vislib::HoleKind::Crack)) / pixels},
+                 {"outside_view", double(r.count(vislib::HoleKind::OutsideView)) / pixels}};
+  holes_image = vislib::hole_mask_image(truth, r.hole);
+  const bool fallback = share > a.max_hole_share;
+  ej["fallback"] = fallback;
+  if (fallback) {
+    t0 = Stopwatch();
+    out = vislib::render_frame(src.scene, src.rt, cam, src.allowed.data());
+    t.render.add(t0);
+    t.rays += src.pixels;
+    ej["patched_share"] = 0.0;
+    return ej;
+  }
+  t0 = Stopwatch();
+  size_t patched = 0, cast = 0;
+  vislib::ReshadeStats rs;
+  if (a.reshade) rs = vislib::reshade(r, src.scene, cam);
+  if (a.patch == "none") {
+    out = vislib::patch_none(r, &patched);
+  } else if (a.patch == "median") {
+    out = vislib::patch_median(r, &patched);
+  } else if (a.patch == "yoro") {
+    out = vislib::patch_yoro(r, false, &patched);
+  } else {
+    out = vislib::patch_rays(r, src.scene, src.rt, cam, src.allowed.data(), &cast);
+    patched = cast;
+    t.rays += cast;
+  }
+  t.patch.add(t0);
+  // Holes that show a surface afterwards, over the holes plus the filled pixels --reshade found
+  // wrong (they are patched too).
+  const size_t open = holes + rs.unresolved;
+  ej["patched_share"] = open ? double(patched + rs.cracks_resolved) / double(open) : 1.0;
+  ej["reshade"] = {{"cracks_resolved", rs.cracks_resolved}, {"unresolved", rs.unresolved}};
+  return ej;
+}
+
 }  // namespace
 
 std::shared_ptr<ViewStereoArgs> add_view_stereo_options(CLI::App* view) {
@@ -137,18 +203,19 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
       centre ? head : (a.dominant == "left" ? eyes.left : eyes.right);
   const size_t pixels = size_t(head.width) * size_t(head.height);
 
-  Seconds t_render, t_reproject, t_patch, t_both;
-  size_t rays = pixels;
+  StereoTimes t;
+  t.rays = pixels;
   Stopwatch t0;
   const vislib::Frame source = vislib::render_frame(scene, rt, source_cam, allowed.data());
-  t_render.add(t0);
+  t.render.add(t0);
 
   // Reference cost: both eyes rendered from the same set.
   t0 = Stopwatch();
   const vislib::Frame truth_left = vislib::render_frame(scene, rt, eyes.left, allowed.data());
   const vislib::Frame truth_right = vislib::render_frame(scene, rt, eyes.right, allowed.data());
-  t_both.add(t0);
+  t.both.add(t0);
 
+  const StereoSource src{scene, rt, allowed, source, source_cam, splatting, pixels};
   json eyes_json;
   vislib::Frame out_frame[2];
   std::vector<uint8_t> hole_images[2];
@@ -161,49 +228,7 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
       out_frame[e] = source;
       ej["rendered"] = true;
     } else {
-      ej["rendered"] = false;
-      t0 = Stopwatch();
-      vislib::Reprojection r = vislib::reproject(source, source_cam, cam, splatting);
-      t_reproject.add(t0);
-      const size_t holes = r.holes();
-      const double share = double(holes) / double(pixels);
-      ej["holes"] = {
-          {"share", share},
-          {"disocclusion", double(r.count(vislib::HoleKind::Disocclusion)) / double(pixels)},
-          {"crack", double(r.count(vislib::HoleKind::Crack)) / double(pixels)},
-          {"outside_view", double(r.count(vislib::HoleKind::OutsideView)) / double(pixels)}};
-      hole_images[e] = vislib::hole_mask_image(truth, r.hole);
-      const bool fallback = share > a.max_hole_share;
-      ej["fallback"] = fallback;
-      if (fallback) {
-        t0 = Stopwatch();
-        out_frame[e] = vislib::render_frame(scene, rt, cam, allowed.data());
-        t_render.add(t0);
-        rays += pixels;
-        ej["patched_share"] = 0.0;
-      } else {
-        t0 = Stopwatch();
-        size_t patched = 0, cast = 0;
-        vislib::ReshadeStats rs;
-        if (a.reshade) rs = vislib::reshade(r, scene, cam);
-        if (a.patch == "none") {
-          out_frame[e] = vislib::patch_none(r, &patched);
-        } else if (a.patch == "median") {
-          out_frame[e] = vislib::patch_median(r, &patched);
-        } else if (a.patch == "yoro") {
-          out_frame[e] = vislib::patch_yoro(r, false, &patched);
-        } else {
-          out_frame[e] = vislib::patch_rays(r, scene, rt, cam, allowed.data(), &cast);
-          patched = cast;
-          rays += cast;
-        }
-        t_patch.add(t0);
-        // Holes that show a surface afterwards, over the holes plus the filled pixels --reshade
-        // found wrong (they are patched too).
-        const size_t open = holes + rs.unresolved;
-        ej["patched_share"] = open ? double(patched + rs.cracks_resolved) / double(open) : 1.0;
-        ej["reshade"] = {{"cracks_resolved", rs.cracks_resolved}, {"unresolved", rs.unresolved}};
-      }
+      ej = reprojected_eye(a, src, cam, truth, t, out_frame[e], hole_images[e]);
     }
     ej["method_error"] = quality(truth, out_frame[e]);
     const vislib::Frame full = vislib::render_frame(scene, rt, cam);
@@ -243,18 +268,18 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
             {"visible_triangles", tris.size()},
             {"eyes", eyes_json},
             {"seconds",
-             {{"render", t_render.wall},
-              {"reproject", t_reproject.wall},
-              {"patch", t_patch.wall},
-              {"single_render_total", t_render.wall + t_reproject.wall + t_patch.wall},
-              {"render_both_eyes", t_both.wall}}},
+             {{"render", t.render.wall},
+              {"reproject", t.reproject.wall},
+              {"patch", t.patch.wall},
+              {"single_render_total", t.render.wall + t.reproject.wall + t.patch.wall},
+              {"render_both_eyes", t.both.wall}}},
             {"cpu_seconds",
-             {{"render", t_render.cpu},
-              {"reproject", t_reproject.cpu},
-              {"patch", t_patch.cpu},
-              {"single_render_total", t_render.cpu + t_reproject.cpu + t_patch.cpu},
-              {"render_both_eyes", t_both.cpu}}},
-            {"rays", {{"cast", rays}, {"both_eyes", 2 * pixels}}},
+             {{"render", t.render.cpu},
+              {"reproject", t.reproject.cpu},
+              {"patch", t.patch.cpu},
+              {"single_render_total", t.render.cpu + t.reproject.cpu + t.patch.cpu},
+              {"render_both_eyes", t.both.cpu}}},
+            {"rays", {{"cast", t.rays}, {"both_eyes", 2 * pixels}}},
             {"images", images}};
   for (const char* name : {"left", "right"}) {
     const json& ej = j["eyes"][name];
@@ -274,7 +299,7 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
       stderr,
       "stereo CPU time: render %.4f s + reproject %.4f s + patch %.4f s vs both eyes %.4f s; "
       "rays %zu vs %zu\n",
-      t_render.cpu, t_reproject.cpu, t_patch.cpu, t_both.cpu, rays, 2 * pixels);
+      t.render.cpu, t.reproject.cpu, t.patch.cpu, t.both.cpu, t.rays, 2 * pixels);
   return j;
 }
 

@@ -8,8 +8,11 @@
 
 #include <filesystem>
 #include <memory>
+#include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
+#include "vislib/bake/bake_report.h"
+#include "vislib/bake/cell_set.h"
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/scene_subset.h"
 #include "vislib/base/error.h"
@@ -336,4 +339,94 @@ TEST(SceneSubset, KeepsExactlyTheSetAtEachGranularity) {
     expect += std::binary_search(objs.begin(), objs.end(), obj);
   EXPECT_EQ(o.triangle_count(), expect);
   EXPECT_EQ(o.objects[0].name, s.objects[objs[0]].name);
+}
+
+TEST(BakeReportJson, StatesTheRunTheCellsTimingsAndTheFileSizes) {
+  using nlohmann::json;
+  const Scene scene = small_city();
+  const std::string dir = temp_dir("bake_report");
+  const BakeReport r =
+      bake(scene, small_grid(), settings(), Shard{}, {dir + "/c.pvs", dir + "/c.ckpt", false});
+  BakeRunInfo info;
+  info.scene = "city.glb";
+  info.output = dir + "/c.pvs";
+  info.preset = "draft";
+  info.resolution = 24;
+  info.runs = 1;
+  info.setup_seconds = 0.5;
+  const std::string text = bake_report_json(info, r);
+  ASSERT_FALSE(text.empty());
+  EXPECT_EQ(text.back(), '\n');
+  const json j = json::parse(text);
+  EXPECT_EQ(j["scene"], "city.glb");
+  EXPECT_EQ(j["cells"], 9);
+  EXPECT_EQ(j["shard_cells"], 9);
+  EXPECT_EQ(j["baked"], 9);
+  EXPECT_EQ(j["resumed"], 0);
+  EXPECT_EQ(j["shard"], json::array({0, 1}));
+  EXPECT_EQ(j["preset"]["name"], "draft");
+  EXPECT_TRUE(j["preset"]["cell_size"].is_null());  // a grid given by its counts
+  EXPECT_EQ(j["bytes"]["file"].get<uint64_t>(), std::filesystem::file_size(dir + "/c.pvs"));
+  EXPECT_EQ(j["cell_seconds"].size(), 9u);
+  double sum = 0;
+  for (const json& s : j["cell_seconds"]) sum += s.get<double>();
+  EXPECT_DOUBLE_EQ(j["timings"]["kernel_seconds"].get<double>(), sum);
+  EXPECT_EQ(kernel_seconds(r), sum);
+  EXPECT_EQ(j["timings"]["setup_seconds"], 0.5);
+  info.cell_size = 8;
+  EXPECT_EQ(json::parse(bake_report_json(info, r))["preset"]["cell_size"], 8.0);
+}
+
+TEST(CellSet, ReadCellViewSetFindsThePointsCellOrSaysWhyNot) {
+  const Scene scene = small_city();
+  const std::string dir = temp_dir("cell_set");
+  const std::string all = dir + "/all.pvs", even = dir + "/even.pvs";
+  bake(scene, small_grid(), settings(), Shard{}, {all, all + ".ckpt", false});
+  bake(scene, small_grid(), settings(), Shard{0, 2}, {even, even + ".ckpt", false});
+  pvs::Reader r = pvs::Reader::from_file(all);
+  const Vec3 p{1, 1.6, 1};  // inside the middle cell (4) of the 3 x 3 grid over [-30, 30]
+  const CellViewSet v = read_cell_view_set(all, scene, p);
+  ASSERT_EQ(v.where.status, PointCell::Found);
+  EXPECT_EQ(v.where.cell, 4u);
+  EXPECT_EQ(v.triangles, visible_triangles(scene, r.read_cell(4), Granularity::Triangle));
+  EXPECT_FALSE(v.triangles.empty());
+  EXPECT_EQ(v.centre.x, 0);
+  EXPECT_DOUBLE_EQ(v.centre.y, 1.65);
+  EXPECT_EQ(v.view_region.min.y, 1.5);
+  EXPECT_EQ(read_cell_view_set(all, scene, {100, 1.6, 0}).where.status, PointCell::NoCell);
+  // Cell 4 is not in shard 0/2 (cells 0, 2, 4, ... are; 4 % 2 == 0), cell 3 is absent.
+  EXPECT_EQ(read_cell_view_set(even, scene, p).where.status, PointCell::Found);
+  const CellViewSet odd = read_cell_view_set(even, scene, {-20, 1.6, 0});
+  EXPECT_EQ(odd.where.status, PointCell::Absent);
+  EXPECT_EQ(odd.where.cell, 3u);
+  EXPECT_TRUE(odd.triangles.empty());
+  // Another scene: refused by the fingerprint, naming the file.
+  Scene other = scene;
+  other.positions[0][0].x += 1;
+  try {
+    read_cell_view_set(all, other, p);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.path(), all);
+  }
+}
+
+TEST(CellSet, UnionOfSetsIsEveryTriangleOfAnySetAscending) {
+  Scene s = small_city();
+  const uint32_t tris = uint32_t(s.triangle_count());
+  s.sphere_radius = {1.0};
+  s.sphere_centers = {{Vec3{0, 50, 0}}};
+  s.sphere_object = {0};
+  // Triangle ids: the sphere's id (tris) is left out; duplicates and order do not matter.
+  EXPECT_EQ(visible_triangles_union(s, {{7, 3, tris}, {3, 1}, {}}, Granularity::Triangle),
+            (std::vector<uint32_t>{1, 3, 7}));
+  // Object ids: every triangle of those objects.
+  const uint32_t a = s.triangle_object[0], b = s.triangle_object[tris - 1];
+  std::vector<uint32_t> expect;
+  for (uint32_t t = 0; t < tris; ++t)
+    if (s.triangle_object[t] == a || s.triangle_object[t] == b) expect.push_back(t);
+  EXPECT_EQ(visible_triangles_union(s, {{b}, {a, b}}, Granularity::Object), expect);
+  EXPECT_EQ(visible_triangles_union(s, {{b}, {a}}, Granularity::Object),
+            visible_triangles(s, a < b ? std::vector<uint32_t>{a, b} : std::vector<uint32_t>{b, a},
+                              Granularity::Object));
 }

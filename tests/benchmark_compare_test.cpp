@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
+#include "vislib/eval/bench_report.h"
 #include "vislib/scene/generate.h"
 
 using namespace vislib;
@@ -178,4 +180,51 @@ TEST(BenchmarkCompare, RepeatedRunGivesTheSameSetsAndQuality) {
               b.segment.checkpoints[i].quality.ssim_mean);
   }
   EXPECT_EQ(a.segments.size(), 12u);  // a box with a height band: twelve edges
+}
+
+TEST(BenchJson, RecordsTheRunAsGivenTheResultAndNullForNonFiniteNumbers) {
+  using nlohmann::json;
+  CityOptions co;
+  co.blocks_x = co.blocks_z = 2;
+  const Scene s = generate_city(co);
+  BenchOptions o;
+  o.box = box({-3, 1.7, -20}, {3, 1.7, 20});
+  o.point_runs = 6;
+  o.resolution = 32;
+  o.views = 2;
+  o.width = 32, o.height = 24;
+  o.path = ViewPath::Random;
+  BenchResult r = run_bench(s, o);
+  BenchRunInfo info;
+  info.scene = "city.glb";
+  info.scene_triangles = s.triangle_count();
+  info.given = o;
+  info.threads = 3;
+  info.load_seconds = 0.25;
+  info.total_seconds = 2;
+  info.frames = {"frames/view0_*.png"};
+  r.equal_quality.time_ratio = INFINITY;  // JSON has no infinities
+  const std::string text = bench_json(info, r);
+  ASSERT_EQ(text.back(), '\n');
+  const json j = json::parse(text);
+  EXPECT_EQ(j["scene"], "city.glb");
+  EXPECT_EQ(j["scene_triangles"], s.triangle_count());
+  EXPECT_EQ(j["settings"]["view_path"], "random");
+  EXPECT_EQ(j["settings"]["threads"], 3);
+  EXPECT_EQ(j["settings"]["point_runs"], 6);
+  EXPECT_EQ(j["settings"]["point_runs_automatic"], false);
+  EXPECT_EQ(j["settings"]["perimeter_segments"], r.segments.size());
+  EXPECT_EQ(j["box"]["min"], json::array({-3, 1.7, -20}));
+  EXPECT_TRUE(j["equal_quality"]["time_ratio"].is_null());
+  EXPECT_TRUE(j["equal_quality_time_ratio"].is_null());
+  EXPECT_EQ(j["equal_time"]["segment_found"], r.equal_time.segment_found);
+  EXPECT_EQ(j["segment"]["found"], r.equal_time.segment.set_size);
+  EXPECT_EQ(j["timings"]["load_seconds"], 0.25);
+  EXPECT_EQ(j["timings"]["total_seconds"], 2.0);
+  EXPECT_EQ(j["files"]["frames"], json::array({"frames/view0_*.png"}));
+  EXPECT_EQ(j["files"]["plots"], json::array());
+  EXPECT_EQ(j["files"]["csv"].size(), 5u);
+  // The automatic point runs are recorded as such.
+  info.given.point_runs = 0;
+  EXPECT_EQ(json::parse(bench_json(info, r))["settings"]["point_runs_automatic"], true);
 }

@@ -6,11 +6,15 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "scene_builders.h"
 #include "test_support.h"
 #include "vislib/eval/metrics.h"
+#include "vislib/render/near_region_growth.h"
+#include "vislib/render/view_setup.h"
+#include "vislib/scene/generate.h"
 
 namespace {
 
@@ -299,4 +303,92 @@ TEST(NearFarRender, ObjectFootprintCompletionFollowsClovrEquation2) {
   c = vislib::object_completion(s, truth, frame({0, 0, 0, 1}));
   EXPECT_DOUBLE_EQ(c.ofc_eq2, 3.0 / 4.0);
   EXPECT_DOUBLE_EQ(c.ofc, (1.0 + 0.0) / 2.0);
+}
+
+// The setup of a near-far view of a cell (vislib/render/view_setup.h) and both growths.
+TEST(ViewSetup, DefaultRadiiHoldTheCellAndTheEyeInsideR1AndR2IsTwiceR1) {
+  pvs::Box box;
+  box.min[0] = 0, box.min[1] = 0, box.min[2] = 0;
+  box.max[0] = 6, box.max[1] = 3, box.max[2] = 8;  // half x-z diagonal 5
+  const vislib::NearFarRadii r = vislib::default_near_far_radii(box, 1.0);
+  EXPECT_EQ(r.r1, 6.25);
+  EXPECT_EQ(r.r2, 12.5);
+  EXPECT_EQ(vislib::default_near_far_radii(box, 8.0).r1, 10.0);  // the eye far off the axis
+  box.max[0] = 0, box.max[2] = 0;
+  EXPECT_GT(vislib::default_near_far_radii(box, 0.0).r1, 0.0);  // never zero
+}
+
+TEST(ViewSetup, CameraLookingAlongTheUpVectorGetsMinusZUp) {
+  const vislib::Camera c = vislib::look_at_camera({1, 2, 3}, {1, 2, -7}, 64, 48);
+  EXPECT_EQ(c.eye.z, 3);
+  EXPECT_EQ(c.forward.z, -10);
+  EXPECT_EQ(c.width, 64);
+  EXPECT_EQ(c.height, 48);
+  const vislib::Camera down = vislib::look_at_camera({0, 5, 0}, {0, 0, 0}, 64, 48);
+  EXPECT_GT(length(cross(down.forward, down.up)), 0);
+  EXPECT_EQ(down.up.z, -1);
+}
+
+TEST(ViewSetup, DefaultCentreLeavesABuildingForTheNearestFreeSample) {
+  vislib::Scene s;  // a closed box [-1, 1]^3, faces outward
+  const double a = -1, b = 1;
+  add_quad(s, {a, a, a}, {b, a, a}, {b, a, b}, {a, a, b});
+  add_quad(s, {a, b, a}, {a, b, b}, {b, b, b}, {b, b, a});
+  add_quad(s, {a, a, a}, {a, a, b}, {a, b, b}, {a, b, a});
+  add_quad(s, {b, a, a}, {b, b, a}, {b, b, b}, {b, a, b});
+  add_quad(s, {a, a, a}, {a, b, a}, {b, b, a}, {b, a, a});
+  add_quad(s, {a, a, b}, {b, a, b}, {b, b, b}, {a, b, b});
+  auto region = [](Vec3 lo, Vec3 hi) {
+    vislib::Box3 r;
+    r.extend(lo);
+    r.extend(hi);
+    return r;
+  };
+  // Free centre: kept.
+  const vislib::Box3 street = region({3, -0.5, 3}, {5, 0.5, 5});
+  const auto kept = vislib::default_view_centre(s, street, {4, 0, 4});
+  ASSERT_TRUE(kept);
+  EXPECT_FALSE(kept->moved);
+  EXPECT_EQ(kept->point.x, 4);
+  // A region straddling the box: its centre (0.5, 0, 0.5) is inside, a free sample is not.
+  const vislib::Box3 straddling = region({-0.5, -0.5, -0.5}, {1.5, 0.5, 1.5});
+  const auto moved = vislib::default_view_centre(s, straddling, {0.5, 0, 0.5});
+  ASSERT_TRUE(moved);
+  EXPECT_TRUE(moved->moved);
+  EXPECT_TRUE(moved->point.x > 1 || moved->point.z > 1) << moved->point.x << "," << moved->point.z;
+  // Wholly inside: no default.
+  EXPECT_FALSE(
+      vislib::default_view_centre(s, region({-0.5, -0.5, -0.5}, {0.5, 0.5, 0.5}), {0, 0, 0}));
+}
+
+TEST(NearRegionGrowth, BothSchedulesAreTheSeparateGrowthsWithEveryFrameReported) {
+  vislib::CityOptions co;
+  co.blocks_x = co.blocks_z = 2;
+  const vislib::Scene s = vislib::generate_city(co);
+  const std::vector<uint32_t> visible = all_ids(s);
+  const vislib::Camera cam = vislib::look_at_camera({5, 1.6, 5}, {40, 1.6, 5}, 48, 32);
+  const vislib::EmbreeScene rt(s, 0.0, cam.eye);
+  const vislib::Frame truth = vislib::render_frame(s, rt, cam);
+  const Vec3 centre{5, 1.6, 5};
+  const vislib::GrowthPlan plan = vislib::plan_growth(s, visible, centre, 30, 4, -1);
+  vislib::GrowthSettings g;
+  g.centre = centre;
+  g.env_size = 32;
+  g.frames_per_ring = 2;
+  std::map<std::string, size_t> frames;
+  const vislib::GrowthComparison both = vislib::grow_near_region_both(
+      s, rt, visible, cam, truth, plan, g,
+      [&](const std::string& schedule, size_t i, const vislib::GrowthStep&, const vislib::Frame&) {
+        EXPECT_EQ(i, frames[schedule]++);  // in order, from 0
+      });
+  const vislib::GrowthRun merged = grow_near_region(s, rt, visible, cam, truth, plan.merged, g);
+  const vislib::GrowthRun equal = grow_near_region(s, rt, visible, cam, truth, plan.equal, g);
+  EXPECT_EQ(both.merged.radii, merged.radii);
+  EXPECT_EQ(both.equal_area.radii, equal.radii);
+  ASSERT_EQ(both.equal_area.steps.size(), equal.steps.size());
+  EXPECT_GT(equal.steps.size(), 1u);
+  EXPECT_EQ(both.merged.min_consecutive_ssim, merged.min_consecutive_ssim);
+  EXPECT_EQ(both.equal_area.min_consecutive_ssim, equal.min_consecutive_ssim);
+  EXPECT_EQ(frames["merged"], merged.steps.size());
+  EXPECT_EQ(frames["equal_area"], equal.steps.size());
 }

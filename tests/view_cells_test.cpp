@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <array>
+#include <optional>
+
 #include "tests/scene_builders.h"
 
 using namespace vislib;
@@ -243,4 +246,66 @@ TEST(ViewCellsFreeSpace, CellStraddlingABuildingGivesAFreePointOutsideIt) {
   EXPECT_FALSE(f.centre_enclosed);
   EXPECT_EQ(f.enclosed, 0);
   EXPECT_EQ(*f.free_point, (Vec3{8, 1.65, 8}));
+}
+
+// place_view_cells (pvs bake's placement options, checked in the library).
+TEST(CellPlacement, GridByCountsBySizeAndWalkableGiveTheDirectPlacements) {
+  const Scene s = test_level();
+  Box3 box;
+  box.extend({0, 0, 0});
+  box.extend({10, 3, 10});
+  CellPlacement p;
+  p.box = box;
+  p.grid = std::array<uint32_t, 3>{2, 1, 5};
+  p.eye = EyeBand{1.5, 1.8};
+  const ViewCells counts = place_view_cells(s, p);
+  const ViewCells direct = grid_cells(box, 2, 1, 5, EyeBand{1.5, 1.8});
+  ASSERT_EQ(counts.layout.cell_count(), 10u);
+  for (uint32_t c = 0; c < 10; ++c)
+    EXPECT_TRUE(counts.layout.view_region(c) == direct.layout.view_region(c)) << c;
+  p.grid.reset();
+  p.cell_size = 4;  // ceil(10/4) * ceil(3/4) * ceil(10/4)
+  EXPECT_EQ(place_view_cells(s, p).layout.cell_count(), 3u * 1 * 3);
+  CellPlacement w;
+  w.walkable = true;  // cell size 0: columns of 2
+  WalkableOptions wo;
+  wo.cell_size = 2;
+  EXPECT_EQ(place_view_cells(s, w).layout.boxes.size(), walkable_cells(s, wo).layout.boxes.size());
+  EXPECT_GT(place_view_cells(s, w).layout.cell_count(), 0u);
+}
+
+TEST(CellPlacement, InconsistentPlacementsAreRefusedWithTheirProblem) {
+  const Scene s = test_level();
+  Box3 box;
+  box.extend({0, 0, 0});
+  box.extend({10, 3, 10});
+  auto problem = [&](const CellPlacement& p) {
+    try {
+      place_view_cells(s, p);
+    } catch (const PlacementError& e) {
+      return std::optional<PlacementProblem>(e.problem());
+    }
+    return std::optional<PlacementProblem>();
+  };
+  CellPlacement p;
+  p.walkable = true;
+  p.grid = std::array<uint32_t, 3>{1, 1, 1};
+  EXPECT_EQ(problem(p), PlacementProblem::GridWithWalkable);
+  p = {};
+  p.walkable = true;
+  p.cell_size = 1e-4;  // 10 / 1e-4 = 1e5 columns per side: 1e10 columns
+  EXPECT_EQ(problem(p), PlacementProblem::TooManyColumns);
+  p = {};
+  p.cell_size = 1;
+  EXPECT_EQ(problem(p), PlacementProblem::NoBox);
+  p.box = box;
+  p.grid = std::array<uint32_t, 3>{1, 1, 1};
+  EXPECT_EQ(problem(p), PlacementProblem::GridAndCellSize);
+  p.cell_size = 0;
+  p.grid = std::array<uint32_t, 3>{1000, 100, 101};  // 1.01e7
+  EXPECT_EQ(problem(p), PlacementProblem::TooManyGridCells);
+  p.grid.reset();
+  EXPECT_EQ(problem(p), PlacementProblem::NoGridNorCellSize);
+  p.cell_size = 0.004;  // 2500 * 750 * 2500 cells
+  EXPECT_EQ(problem(p), PlacementProblem::TooManySizedCells);
 }

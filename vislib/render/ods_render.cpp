@@ -511,4 +511,21 @@ SeamContinuity seam_continuity(const Frame& f) {
   return s;
 }
 
+bool ods_disc_covered(const pvs::CellLayout& layout, const std::vector<uint32_t>& cells,
+                      Vec3 centre, double radius) {
+  for (int k = -1; k < 64; ++k) {  // k = -1: the centre
+    const double a = 2 * pvs_runtime::kOdsPi * k / 64;
+    const double p[3] = {centre.x + (k < 0 ? 0 : radius * std::cos(a)), centre.y,
+                         centre.z + (k < 0 ? 0 : radius * std::sin(a))};
+    bool in = false;
+    for (uint32_t u : cells) {
+      const pvs::Box r = layout.view_region(u);
+      in = in || (p[0] >= r.min[0] && p[0] <= r.max[0] && p[1] >= r.min[1] && p[1] <= r.max[1] &&
+                  p[2] >= r.min[2] && p[2] <= r.max[2]);
+    }
+    if (!in) return false;
+  }
+  return true;
+}
+
 }  // namespace vislib

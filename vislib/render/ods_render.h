@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "pvs_format/pvs_format.h"
 #include "runtime/ods.h"
 #include "vislib/base/vec.h"
 #include "vislib/eval/embree_scene.h"
@@ -103,5 +104,11 @@ struct SeamContinuity {
   double typical_triangle_mismatch = 0, typical_mean_abs_rgb = 0;  // mean over columns x, x+1
 };
 SeamContinuity seam_continuity(const Frame& frame);
+
+// True when the centre and 64 points of the rim of the viewing disc (`radius` about `centre`, in
+// the horizontal plane y = centre.y) each lie in the view region of one of `cells` (closed boxes):
+// the cells' visible sets then serve every eye position of the panorama (pvs view --ods).
+bool ods_disc_covered(const pvs::CellLayout& layout, const std::vector<uint32_t>& cells,
+                      Vec3 centre, double radius);
 
 }  // namespace vislib
