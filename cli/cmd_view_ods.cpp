@@ -6,13 +6,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "cli/view_report.h"
 #include "pvs_format/pvs_format.h"
 #include "runtime/ods.h"
 #include "runtime/pvs_runtime.h"
@@ -31,11 +31,6 @@ namespace {
 
 using nlohmann::json;
 using pvs_runtime::Eye;
-
-std::string sibling(const std::string& out, const std::string& suffix) {
-  std::filesystem::path p(out);
-  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
-}
 
 pvs_runtime::PoleMerge parse_pole_merge(const std::string& text) {
   pvs_runtime::PoleMerge m;
@@ -57,17 +52,6 @@ pvs_runtime::PoleMerge parse_pole_merge(const std::string& text) {
 
 json side_json(const pvs_runtime::PoleMergeSide& s) {
   return {{"start_deg", s.start_deg}, {"end_deg", s.end_deg}, {"exponent", s.exponent}};
-}
-
-json quality_json(const vislib::Frame& truth, const vislib::Frame& test) {
-  const vislib::FrameQuality q = vislib::frame_quality(truth, test);
-  size_t other = 0;
-  for (size_t p = 0; p < truth.pixel_count(); ++p) other += truth.tri[p] != test.tri[p];
-  return {{"epsilon", q.epsilon},
-          {"missed_pixels", q.missed_pixels},
-          {"psnr", std::isfinite(q.psnr) ? json(q.psnr) : json(nullptr)},
-          {"ssim", q.ssim},
-          {"triangle_mismatch", double(other) / double(truth.pixel_count())}};
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -127,40 +111,6 @@ OdsCells ods_cells(const ViewCommonArgs& c, const vislib::Scene& full_scene, vis
 }
 
 }  // namespace
-
-void add_ods_view_options(CLI::App* cmd, const std::shared_ptr<OdsViewArgs>& a) {
-  cmd->add_flag("--ods", a->enabled,
-                "Render omnidirectional stereo panoramas (left, right, top-bottom, anaglyph) from "
-                "--at instead of "
-                "the near-far frame; --look is then not needed (docs/ods.md)");
-  cmd->add_option("--ipd", a->ipd_m, "--ods: interpupillary distance in metres")
-      ->check(in_range(0.0, 10.0))
-      ->capture_default_str();
-  cmd->add_option(
-         "--units-per-metre", a->units_per_metre,
-         "--ods: scene units in one metre (the IPD is multiplied by it; glTF is in metres: 1)")
-      ->check(positive())
-      ->capture_default_str();
-  cmd->add_option("--ods-size", a->size, "--ods: panorama width W in pixels (height W/2), even")
-      ->check(in_range(16, 16384))
-      ->capture_default_str();
-  cmd->add_option("--pole-merge", a->pole_merge,
-                  "--ods: pole merging (Eq. 6) start,end,exponent for both poles or top:bottom, "
-                  "angles in degrees "
-                  "from the pole (e.g. 45,0,3); default none");
-  cmd->add_option("--ods-method", a->method,
-                  "--ods: rays (Embree reference), raster-paper (the paper's per-vertex Eq. 5) or "
-                  "raster-exact "
-                  "(exact tangent-ray projection), both rasterised after Alg. 1 tessellation and "
-                  "seam/pole split")
-      ->check(CLI::IsMember({"rays", "raster-paper", "raster-exact"}))
-      ->capture_default_str();
-  cmd->add_option("--ods-tessellation", a->tessellation,
-                  "--ods raster methods: 0 = dynamic (Alg. 1 + Eq. 4), k = static level k for "
-                  "every triangle")
-      ->check(in_range(0, 64))
-      ->capture_default_str();
-}
 
 void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
   if (o.size % 2 != 0)
@@ -255,8 +205,8 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
       {"disc_in_cell_view_region", used.disc_in_region},
       {"disc_covered", used.disc_covered},
       {"triangles", {{"scene", scene.triangle_count()}, {"visible", tris.size()}}},
-      {"left", quality_json(truth_left, left)},
-      {"right", quality_json(truth_right, right)},
+      {"left", frame_error_json(truth_left, left)},
+      {"right", frame_error_json(truth_right, right)},
       {"lr_disagreement_by_latitude", bands},
       {"seam", {{"left", seam(left)}, {"right", seam(right)}}},
       {"counts", counts},
@@ -272,8 +222,8 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
     // The raster method's own error: the full scene rasterised against the full scene ray cast.
     vislib::Frame ref_left = vislib::render_ods_rays(scene, rt, s, Eye::Left);
     vislib::Frame ref_right = vislib::render_ods_rays(scene, rt, s, Eye::Right);
-    ods["truth_against_rays"] = {{"left", quality_json(ref_left, truth_left)},
-                                 {"right", quality_json(ref_right, truth_right)}};
+    ods["truth_against_rays"] = {{"left", frame_error_json(ref_left, truth_left)},
+                                 {"right", frame_error_json(ref_right, truth_right)}};
   }
   json j = {{"file", c.file}, {"scene", c.scene}, {"tau", c.tau}, {"ods", ods}};
 

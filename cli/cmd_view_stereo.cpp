@@ -9,11 +9,11 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
-#include <filesystem>
 #include <optional>
 
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "cli/view_report.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/cell_set.h"
 #include "vislib/base/error.h"
@@ -41,19 +41,11 @@ struct Seconds {
   }
 };
 
-std::string with_suffix(const std::string& out, const std::string& suffix) {
-  std::filesystem::path p(out);
-  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
-}
-
+// The errors of `test` against `truth`, without the missed pixels.
 json quality(const vislib::Frame& truth, const vislib::Frame& test) {
-  const vislib::FrameQuality q = vislib::frame_quality(truth, test);
-  size_t other = 0;
-  for (size_t p = 0; p < truth.pixel_count(); ++p) other += truth.tri[p] != test.tri[p];
-  return {{"epsilon", q.epsilon},
-          {"psnr", std::isfinite(q.psnr) ? json(q.psnr) : json(nullptr)},
-          {"ssim", q.ssim},
-          {"triangle_mismatch", double(other) / double(truth.pixel_count())}};
+  json j = frame_error_json(truth, test);
+  j.erase("missed_pixels");
+  return j;
 }
 
 // The visible triangles of the cells holding `points` (union), and those cells.
@@ -152,40 +144,6 @@ json reprojected_eye(const ViewStereoArgs& a, const StereoSource& src, const vis
 
 }  // namespace
 
-std::shared_ptr<ViewStereoArgs> add_view_stereo_options(CLI::App* view) {
-  auto a = std::make_shared<ViewStereoArgs>();
-  view->add_option(
-          "--stereo", a->mode,
-          "Also build a stereo pair by single-render reprojection (YORO): yoro or true (exact "
-          "world-space splatting, holes kept open) or alg2 (the paper's Alg. 2 as printed, "
-          "parallel "
-          "eyes only); --at is the point between the eyes")
-      ->check(CLI::IsMember({"yoro", "true", "alg2"}));
-  view->add_option("--dominant", a->dominant,
-                   "--stereo: the eye that is rendered: left, right or centre (a view between the "
-                   "eyes, both "
-                   "eyes reprojected)")
-      ->check(CLI::IsMember({"left", "right", "centre"}))
-      ->capture_default_str();
-  view->add_option("--patch", a->patch,
-                   "--stereo: hole filler: yoro (Alg. 3 fixed, 3-row kernel), median, rays "
-                   "(re-cast the hole "
-                   "pixels against the visible set) or none")
-      ->check(CLI::IsMember({"yoro", "median", "rays", "none"}))
-      ->capture_default_str();
-  view->add_flag("--reshade", a->reshade,
-                 "--stereo: recompute each reprojected pixel for its eye from its triangle id "
-                 "(exact hit of the "
-                 "eye's ray among the neighbouring pixels' triangles, the eye's own shading)");
-  view->add_option("--max-hole-share", a->max_hole_share,
-                   "--stereo: render the second eye instead when more than this share of its "
-                   "pixels are holes "
-                   "(the paper's §14 fallback)")
-      ->check(in_range(0.0, 1.0))
-      ->capture_default_str();
-  return a;
-}
-
 json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
                      const vislib::Scene& scene, const vislib::EmbreeScene& rt,
                      const vislib::Camera& head, const std::string& output) {
@@ -237,12 +195,12 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
   }
 
   const int w = head.width, h = head.height;
-  json images = {{"left", with_suffix(output, "_stereo_left")},
-                 {"right", with_suffix(output, "_stereo_right")},
-                 {"left_truth", with_suffix(output, "_stereo_left_truth")},
-                 {"right_truth", with_suffix(output, "_stereo_right_truth")},
-                 {"side_by_side", with_suffix(output, "_stereo_sbs")},
-                 {"holes", with_suffix(output, "_stereo_holes")}};
+  json images = {{"left", sibling(output, "_stereo_left")},
+                 {"right", sibling(output, "_stereo_right")},
+                 {"left_truth", sibling(output, "_stereo_left_truth")},
+                 {"right_truth", sibling(output, "_stereo_right_truth")},
+                 {"side_by_side", sibling(output, "_stereo_sbs")},
+                 {"holes", sibling(output, "_stereo_holes")}};
   vislib::write_rgb8_image(images["left"], w, h, out_frame[0].rgb);
   vislib::write_rgb8_image(images["right"], w, h, out_frame[1].rgb);
   vislib::write_rgb8_image(images["left_truth"], w, h, truth_left.rgb);

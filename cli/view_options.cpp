@@ -1,8 +1,11 @@
-// view_options.cpp: the options of `pvs view` and their parsing (view_options.h).
+// view_options.cpp: the options of `pvs view` (--ods and --stereo included) and their parsing
+// (view_options.h, cmd_view_ods.h, cmd_view_stereo.h).
 #include "cli/view_options.h"
 
 #include <cstdio>
 
+#include "cli/cmd_view_ods.h"
+#include "cli/cmd_view_stereo.h"
 #include "cli/commands.h"
 #include "cli/options.h"
 
@@ -84,6 +87,74 @@ ViewInputs parse_view(const ViewArgs& a) {
   if (length(in.target - in.eye) == 0)
     throw CLI::ValidationError("--look", "must differ from --at");
   return in;
+}
+
+void add_ods_view_options(CLI::App* cmd, const std::shared_ptr<OdsViewArgs>& a) {
+  cmd->add_flag("--ods", a->enabled,
+                "Render omnidirectional stereo panoramas (left, right, top-bottom, anaglyph) from "
+                "--at instead of "
+                "the near-far frame; --look is then not needed (docs/ods.md)");
+  cmd->add_option("--ipd", a->ipd_m, "--ods: interpupillary distance in metres")
+      ->check(in_range(0.0, 10.0))
+      ->capture_default_str();
+  cmd->add_option(
+         "--units-per-metre", a->units_per_metre,
+         "--ods: scene units in one metre (the IPD is multiplied by it; glTF is in metres: 1)")
+      ->check(positive())
+      ->capture_default_str();
+  cmd->add_option("--ods-size", a->size, "--ods: panorama width W in pixels (height W/2), even")
+      ->check(in_range(16, 16384))
+      ->capture_default_str();
+  cmd->add_option("--pole-merge", a->pole_merge,
+                  "--ods: pole merging (Eq. 6) start,end,exponent for both poles or top:bottom, "
+                  "angles in degrees "
+                  "from the pole (e.g. 45,0,3); default none");
+  cmd->add_option("--ods-method", a->method,
+                  "--ods: rays (Embree reference), raster-paper (the paper's per-vertex Eq. 5) or "
+                  "raster-exact "
+                  "(exact tangent-ray projection), both rasterised after Alg. 1 tessellation and "
+                  "seam/pole split")
+      ->check(CLI::IsMember({"rays", "raster-paper", "raster-exact"}))
+      ->capture_default_str();
+  cmd->add_option("--ods-tessellation", a->tessellation,
+                  "--ods raster methods: 0 = dynamic (Alg. 1 + Eq. 4), k = static level k for "
+                  "every triangle")
+      ->check(in_range(0, 64))
+      ->capture_default_str();
+}
+
+std::shared_ptr<ViewStereoArgs> add_view_stereo_options(CLI::App* view) {
+  auto a = std::make_shared<ViewStereoArgs>();
+  view->add_option(
+          "--stereo", a->mode,
+          "Also build a stereo pair by single-render reprojection (YORO): yoro or true (exact "
+          "world-space splatting, holes kept open) or alg2 (the paper's Alg. 2 as printed, "
+          "parallel "
+          "eyes only); --at is the point between the eyes")
+      ->check(CLI::IsMember({"yoro", "true", "alg2"}));
+  view->add_option("--dominant", a->dominant,
+                   "--stereo: the eye that is rendered: left, right or centre (a view between the "
+                   "eyes, both "
+                   "eyes reprojected)")
+      ->check(CLI::IsMember({"left", "right", "centre"}))
+      ->capture_default_str();
+  view->add_option("--patch", a->patch,
+                   "--stereo: hole filler: yoro (Alg. 3 fixed, 3-row kernel), median, rays "
+                   "(re-cast the hole "
+                   "pixels against the visible set) or none")
+      ->check(CLI::IsMember({"yoro", "median", "rays", "none"}))
+      ->capture_default_str();
+  view->add_flag("--reshade", a->reshade,
+                 "--stereo: recompute each reprojected pixel for its eye from its triangle id "
+                 "(exact hit of the "
+                 "eye's ray among the neighbouring pixels' triangles, the eye's own shading)");
+  view->add_option("--max-hole-share", a->max_hole_share,
+                   "--stereo: render the second eye instead when more than this share of its "
+                   "pixels are holes "
+                   "(the paper's §14 fallback)")
+      ->check(in_range(0.0, 1.0))
+      ->capture_default_str();
+  return a;
 }
 
 }  // namespace pvs_cli

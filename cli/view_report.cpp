@@ -12,10 +12,8 @@ namespace pvs_cli {
 
 using nlohmann::json;
 
-json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
-                  const vislib::Frame& test) {
-  vislib::FrameQuality q = vislib::frame_quality(truth, test);
-  vislib::ObjectCompletion c = vislib::object_completion(scene, truth, test);
+json frame_error_json(const vislib::Frame& truth, const vislib::Frame& test) {
+  const vislib::FrameQuality q = vislib::frame_quality(truth, test);
   // Share of pixels showing another triangle than the truth (epsilon compares depths, and the
   // morph and the environment map change depths even where the right surface is shown).
   size_t other = 0;
@@ -24,11 +22,18 @@ json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
           {"epsilon", q.epsilon},
           {"missed_pixels", q.missed_pixels},
           {"psnr", std::isfinite(q.psnr) ? json(q.psnr) : json(nullptr)},
-          {"ssim", q.ssim},
-          {"ovc", c.ovc},
-          {"ofc", c.ofc},
-          {"ofc_eq2", c.ofc_eq2},
-          {"objects_in_truth", c.objects}};
+          {"ssim", q.ssim}};
+}
+
+json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
+                  const vislib::Frame& test) {
+  json j = frame_error_json(truth, test);
+  const vislib::ObjectCompletion c = vislib::object_completion(scene, truth, test);
+  j["ovc"] = c.ovc;
+  j["ofc"] = c.ofc;
+  j["ofc_eq2"] = c.ofc_eq2;
+  j["objects_in_truth"] = c.objects;
+  return j;
 }
 
 // "dir/name.png" -> "dir/name<suffix>.png"

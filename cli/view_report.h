@@ -12,7 +12,11 @@
 
 namespace pvs_cli {
 
-// epsilon, PSNR (null when infinite), SSIM, OVC, OFC and the share of pixels showing another
+// epsilon, missed pixels, PSNR (null when infinite), SSIM and the share of pixels showing another
+// triangle than the truth, of `test` against `truth`.
+nlohmann::json frame_error_json(const vislib::Frame& truth, const vislib::Frame& test);
+
+// frame_error_json and OVC, OFC and the share of pixels showing another
 // triangle than the truth, of `test` against `truth`.
 nlohmann::json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
                             const vislib::Frame& test);
