@@ -42,6 +42,151 @@ struct InspectArgs {
   int states = 1;
 };
 
+void run_inspect(const InspectArgs& a) {
+  if (!a.gltf.empty()) {
+    if (a.scene.empty()) throw CLI::ValidationError("--export-gltf", "needs --scene");
+    if (a.cell < 0 && a.at.empty())
+      throw CLI::ValidationError("--export-gltf", "needs --cell or --at");
+    check_output_file(a.gltf, "--export-gltf");  // before any work (issue 17 item 1)
+  }
+  if (!a.render_dir.empty()) {
+    if (a.scene.empty()) throw CLI::ValidationError("--render", "needs --scene");
+    if (a.cell < 0 && a.at.empty()) throw CLI::ValidationError("--render", "needs --cell or --at");
+    check_output_dir(a.render_dir, "--render");
+  }
+  pvs::ReadOptions opt;
+  vislib::Scene scene;
+  if (!a.scene.empty()) {
+    scene = load_scene_for_cli(a.scene, a.states);
+    opt.expected_fingerprint = vislib::scene_fingerprint(scene);
+  }
+  int fw = 0, fh = 0;
+  if (std::sscanf(a.frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
+      fh > 8192)
+    throw CLI::ValidationError("--frame",
+                               "expected WxH with 11 <= W, H <= 8192, got '" + a.frame + "'");
+  vislib::reading_pvs(a.file, [&] {
+    pvs::Reader r = pvs::Reader::from_file(a.file, opt);
+    const pvs::FileInfo& info = r.info();
+    if (!a.scene.empty()) vislib::check_universe(a.file, info, scene);
+    std::optional<uint32_t> cell;
+    if (a.cell >= 0) {
+      if (a.cell >= int64_t(r.cell_count()))
+        throw CLI::ValidationError("--cell", "the file has " + std::to_string(r.cell_count()) +
+                                                 " cells (0.." +
+                                                 std::to_string(r.cell_count() - 1) + ")");
+      cell = uint32_t(a.cell);
+    } else if (!a.at.empty()) {
+      vislib::Vec3 p = parse_vec3(a.at, "--at");
+      double q[3] = {p.x, p.y, p.z};
+      cell = info.layout.find_cell(q);
+      if (!cell) {
+        std::fprintf(stderr, "pvs: error: no cell contains %s\n", a.at.c_str());
+        throw Exit{2};
+      }
+    }
+    if (!cell) {
+      json j = summary(r);
+      j["file"] = a.file;
+      std::vector<uint32_t> enclosed;
+      if (!a.scene.empty()) {
+        // Cells whose view-region centre is enclosed by the scene (issue 17 item 6).
+        for (uint32_t k = 0; k < r.cell_count(); ++k)
+          if (vislib::point_enclosed(scene, vislib::view_region_centre(info.layout, k)))
+            enclosed.push_back(k);
+        j["enclosed_centre_cells"] = enclosed;
+      }
+      if (a.json_out) {
+        std::printf("%s\n", j.dump(1).c_str());
+      } else {
+        print_summary(a.file, j);
+        if (!a.scene.empty()) {
+          std::printf("  cells whose view-region centre is enclosed by the scene: %zu",
+                      enclosed.size());
+          for (size_t i = 0; i < enclosed.size() && int(i) < a.max_ids; ++i)
+            std::printf(" %u", enclosed[i]);
+          std::printf("\n");
+        }
+      }
+      return;
+    }
+    // One cell.
+    const uint32_t c = *cell;
+    pvs::BlockInfo b = r.block_info(c);
+    json j = {{"file", a.file},
+              {"cell", c},
+              {"box", box_json(info.layout.cell_box(c))},
+              {"view_region", box_json(info.layout.view_region(c))},
+              {"encoding", vislib::block_encoding_name(b)},
+              {"bytes", b.size}};
+    if (b.encoding == pvs::Encoding::Delta) j["reference"] = b.reference;
+    json segs = json::array();
+    for (const auto& s :
+         vislib::cell_boundary_segments(vislib::to_box3(info.layout.view_region(c))))
+      segs.push_back({{"from", {s.from.x, s.from.y, s.from.z}}, {"to", {s.to.x, s.to.y, s.to.z}}});
+    j["boundary_segments"] = segs;
+    std::vector<uint32_t> ids;
+    if (b.encoding != pvs::Encoding::Absent) ids = r.read_cell(c);
+    j["absent"] = b.encoding == pvs::Encoding::Absent;
+    j["granularity"] = info.granularity == pvs::Granularity::Object ? "object" : "triangle";
+    j["visible_count"] = ids.size();
+    j["share"] = info.universe ? double(ids.size()) / info.universe : 0.0;
+    const vislib::Granularity g = vislib::granularity_of(info);
+    vislib::CellFreeSpace free_space;
+    if (!a.scene.empty()) {
+      // Points of the view region enclosed by the scene (issue 17 item 6).
+      free_space = vislib::cell_free_space(scene, vislib::to_box3(info.layout.view_region(c)));
+      j["free_space"] = {{"samples", free_space.samples},
+                         {"enclosed", free_space.enclosed},
+                         {"centre_enclosed", free_space.centre_enclosed}};
+      if (free_space.free_point)
+        j["free_space"]["free_point"] = {free_space.free_point->x, free_space.free_point->y,
+                                         free_space.free_point->z};
+      if (free_space.enclosed > 0)
+        warn("cell " + std::to_string(c) + ": " + std::to_string(free_space.enclosed) + " of " +
+             std::to_string(free_space.samples) +
+             " samples of its view region are enclosed by the scene (it straddles a solid: "
+             "boundary segments run through it)");
+      vislib::Scene sub = vislib::scene_subset(scene, ids, g);
+      j["visible_triangles"] = sub.triangle_count();
+      j["triangle_share"] =
+          scene.triangle_count() ? double(sub.triangle_count()) / scene.triangle_count() : 0.0;
+      if (!a.gltf.empty()) {
+        // What a viewer needs besides the triangles: normals, UVs, materials, copyright.
+        vislib::LoadOptions lo;
+        lo.states = a.states;
+        std::vector<std::string> warnings;
+        vislib::SceneAppearance app = vislib::load_appearance(a.scene, lo, &warnings);
+        for (const auto& w : warnings) warn(w);
+        vislib::SceneAppearance sub_app = vislib::appearance_subset(scene, app, ids, g);
+        vislib::write_file_atomic(a.gltf, vislib::scene_to_glb(sub, &sub_app));
+        j["export_gltf"] = a.gltf;
+      }
+      if (!a.render_dir.empty()) {
+        // The viewpoint: the --at point, else the centre of the cell's view region, else (the
+        // centre is enclosed by the scene) the free sample nearest it (issue 17 item 6).
+        vislib::Vec3 eye = vislib::view_region_centre(info.layout, c);
+        if (!a.at.empty()) {
+          eye = parse_vec3(a.at, "--at");
+        } else if (free_space.centre_enclosed) {
+          if (!free_space.free_point)
+            throw vislib::InputError(a.file,
+                                     "every sample of cell " + std::to_string(c) +
+                                         "'s view region is enclosed by the scene: give --at");
+          eye = *free_space.free_point;
+        }
+        j["render"] = render_cell(scene, ids, g, eye, a.render_dir, fw, fh);
+      }
+    }
+    if (a.json_out) {
+      j["visible"] = ids;
+      std::printf("%s\n", j.dump(1).c_str());
+      return;
+    }
+    print_cell(j, ids, r.cell_count(), info, b, scene.triangle_count(), a.max_ids);
+  });
+}
+
 void add_inspect(CLI::App& app) {
   auto a = std::make_shared<InspectArgs>();
   CLI::App* cmd = app.add_subcommand(
@@ -71,152 +216,7 @@ void add_inspect(CLI::App& app) {
   cmd->add_option("--frame", a->frame, "Frame size WxH for --render")->capture_default_str();
   cmd->add_option("--max-ids", a->max_ids, "Text output: print at most this many ids of a cell")
       ->capture_default_str();
-  cmd->callback([a] {
-    if (!a->gltf.empty()) {
-      if (a->scene.empty()) throw CLI::ValidationError("--export-gltf", "needs --scene");
-      if (a->cell < 0 && a->at.empty())
-        throw CLI::ValidationError("--export-gltf", "needs --cell or --at");
-      check_output_file(a->gltf, "--export-gltf");  // before any work (issue 17 item 1)
-    }
-    if (!a->render_dir.empty()) {
-      if (a->scene.empty()) throw CLI::ValidationError("--render", "needs --scene");
-      if (a->cell < 0 && a->at.empty())
-        throw CLI::ValidationError("--render", "needs --cell or --at");
-      check_output_dir(a->render_dir, "--render");
-    }
-    pvs::ReadOptions opt;
-    vislib::Scene scene;
-    if (!a->scene.empty()) {
-      scene = load_scene_for_cli(a->scene, a->states);
-      opt.expected_fingerprint = vislib::scene_fingerprint(scene);
-    }
-    int fw = 0, fh = 0;
-    if (std::sscanf(a->frame.c_str(), "%dx%d", &fw, &fh) != 2 || fw < 11 || fh < 11 || fw > 8192 ||
-        fh > 8192)
-      throw CLI::ValidationError("--frame",
-                                 "expected WxH with 11 <= W, H <= 8192, got '" + a->frame + "'");
-    vislib::reading_pvs(a->file, [&] {
-      pvs::Reader r = pvs::Reader::from_file(a->file, opt);
-      const pvs::FileInfo& info = r.info();
-      if (!a->scene.empty()) vislib::check_universe(a->file, info, scene);
-      std::optional<uint32_t> cell;
-      if (a->cell >= 0) {
-        if (a->cell >= int64_t(r.cell_count()))
-          throw CLI::ValidationError("--cell", "the file has " + std::to_string(r.cell_count()) +
-                                                   " cells (0.." +
-                                                   std::to_string(r.cell_count() - 1) + ")");
-        cell = uint32_t(a->cell);
-      } else if (!a->at.empty()) {
-        vislib::Vec3 p = parse_vec3(a->at, "--at");
-        double q[3] = {p.x, p.y, p.z};
-        cell = info.layout.find_cell(q);
-        if (!cell) {
-          std::fprintf(stderr, "pvs: error: no cell contains %s\n", a->at.c_str());
-          throw Exit{2};
-        }
-      }
-      if (!cell) {
-        json j = summary(r);
-        j["file"] = a->file;
-        std::vector<uint32_t> enclosed;
-        if (!a->scene.empty()) {
-          // Cells whose view-region centre is enclosed by the scene (issue 17 item 6).
-          for (uint32_t k = 0; k < r.cell_count(); ++k)
-            if (vislib::point_enclosed(scene, vislib::view_region_centre(info.layout, k)))
-              enclosed.push_back(k);
-          j["enclosed_centre_cells"] = enclosed;
-        }
-        if (a->json_out) {
-          std::printf("%s\n", j.dump(1).c_str());
-        } else {
-          print_summary(a->file, j);
-          if (!a->scene.empty()) {
-            std::printf("  cells whose view-region centre is enclosed by the scene: %zu",
-                        enclosed.size());
-            for (size_t i = 0; i < enclosed.size() && int(i) < a->max_ids; ++i)
-              std::printf(" %u", enclosed[i]);
-            std::printf("\n");
-          }
-        }
-        return;
-      }
-      // One cell.
-      const uint32_t c = *cell;
-      pvs::BlockInfo b = r.block_info(c);
-      json j = {{"file", a->file},
-                {"cell", c},
-                {"box", box_json(info.layout.cell_box(c))},
-                {"view_region", box_json(info.layout.view_region(c))},
-                {"encoding", vislib::block_encoding_name(b)},
-                {"bytes", b.size}};
-      if (b.encoding == pvs::Encoding::Delta) j["reference"] = b.reference;
-      json segs = json::array();
-      for (const auto& s :
-           vislib::cell_boundary_segments(vislib::to_box3(info.layout.view_region(c))))
-        segs.push_back(
-            {{"from", {s.from.x, s.from.y, s.from.z}}, {"to", {s.to.x, s.to.y, s.to.z}}});
-      j["boundary_segments"] = segs;
-      std::vector<uint32_t> ids;
-      if (b.encoding != pvs::Encoding::Absent) ids = r.read_cell(c);
-      j["absent"] = b.encoding == pvs::Encoding::Absent;
-      j["granularity"] = info.granularity == pvs::Granularity::Object ? "object" : "triangle";
-      j["visible_count"] = ids.size();
-      j["share"] = info.universe ? double(ids.size()) / info.universe : 0.0;
-      const vislib::Granularity g = vislib::granularity_of(info);
-      vislib::CellFreeSpace free_space;
-      if (!a->scene.empty()) {
-        // Points of the view region enclosed by the scene (issue 17 item 6).
-        free_space = vislib::cell_free_space(scene, vislib::to_box3(info.layout.view_region(c)));
-        j["free_space"] = {{"samples", free_space.samples},
-                           {"enclosed", free_space.enclosed},
-                           {"centre_enclosed", free_space.centre_enclosed}};
-        if (free_space.free_point)
-          j["free_space"]["free_point"] = {free_space.free_point->x, free_space.free_point->y,
-                                           free_space.free_point->z};
-        if (free_space.enclosed > 0)
-          warn("cell " + std::to_string(c) + ": " + std::to_string(free_space.enclosed) + " of " +
-               std::to_string(free_space.samples) +
-               " samples of its view region are enclosed by the scene (it straddles a solid: "
-               "boundary segments run through it)");
-        vislib::Scene sub = vislib::scene_subset(scene, ids, g);
-        j["visible_triangles"] = sub.triangle_count();
-        j["triangle_share"] =
-            scene.triangle_count() ? double(sub.triangle_count()) / scene.triangle_count() : 0.0;
-        if (!a->gltf.empty()) {
-          // What a viewer needs besides the triangles: normals, UVs, materials, copyright.
-          vislib::LoadOptions lo;
-          lo.states = a->states;
-          std::vector<std::string> warnings;
-          vislib::SceneAppearance app = vislib::load_appearance(a->scene, lo, &warnings);
-          for (const auto& w : warnings) warn(w);
-          vislib::SceneAppearance sub_app = vislib::appearance_subset(scene, app, ids, g);
-          vislib::write_file_atomic(a->gltf, vislib::scene_to_glb(sub, &sub_app));
-          j["export_gltf"] = a->gltf;
-        }
-        if (!a->render_dir.empty()) {
-          // The viewpoint: the --at point, else the centre of the cell's view region, else (the
-          // centre is enclosed by the scene) the free sample nearest it (issue 17 item 6).
-          vislib::Vec3 eye = vislib::view_region_centre(info.layout, c);
-          if (!a->at.empty()) {
-            eye = parse_vec3(a->at, "--at");
-          } else if (free_space.centre_enclosed) {
-            if (!free_space.free_point)
-              throw vislib::InputError(a->file,
-                                       "every sample of cell " + std::to_string(c) +
-                                           "'s view region is enclosed by the scene: give --at");
-            eye = *free_space.free_point;
-          }
-          j["render"] = render_cell(scene, ids, g, eye, a->render_dir, fw, fh);
-        }
-      }
-      if (a->json_out) {
-        j["visible"] = ids;
-        std::printf("%s\n", j.dump(1).c_str());
-        return;
-      }
-      print_cell(j, ids, r.cell_count(), info, b, scene.triangle_count(), a->max_ids);
-    });
-  });
+  cmd->callback([a] { run_inspect(*a); });
 }
 
 Registration inspect_registration("inspect", add_inspect);

@@ -144,7 +144,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                   std::function<void(double)> in_cell;  // progress inside the cell
                   if (progress)
                     in_cell = [&, c](double fraction) {
-                      std::lock_guard<std::mutex> lock(progress_mutex);
+                      std::lock_guard<std::mutex> guard(progress_mutex);
                       running += fraction - partial[c];
                       partial[c] = fraction;
                       progress({done, report.shard_cells, report.resumed, elapsed(),
