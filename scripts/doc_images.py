@@ -45,6 +45,13 @@ def cell_boxes(path):
     return boxes
 
 
+def top_shades(v, f):
+    """Grey levels of top_polys(v, f), in its order: streets light, the higher the darker."""
+    tops = sorted(max(v[i][1] for i in t) for t in f)
+    lo, hi = tops[0], tops[-1]
+    return [str(0.9 - 0.45 * (h - lo) / max(1e-9, hi - lo)) for h in tops]
+
+
 def top_polys(v, f, ids=None):
     """Triangles seen from above (x right, z down), highest last so roofs cover streets."""
     tris = f if ids is None else [f[i] for i in ids]
@@ -62,14 +69,15 @@ def main(work, out):
         sys.exit("doc_images.py: city.pvs has %d cells, its summary %d" % (len(boxes), n))
     at = json.load(open(os.path.join(work, "at.json")))
     all_polys = top_polys(v, f)
+    shades = top_shades(v, f)
 
     # 1. cells coloured by PVS size over the scene's top view.
     fig, ax = plt.subplots(figsize=(5.2, 4.4), dpi=90)
-    ax.add_collection(PolyCollection(all_polys, facecolors="0.8", edgecolors="none"))
+    ax.add_collection(PolyCollection(all_polys, facecolors=shades, edgecolors="none"))
     cmap = plt.get_cmap("viridis")
     lo, hi = min(counts), max(counts)
-    for c, (lo, hi_) in enumerate(boxes):
-        x0, z0, x1, z1 = lo[0], lo[2], hi_[0], hi_[2]
+    for c, (bmin, bmax) in enumerate(boxes):
+        x0, z0, x1, z1 = bmin[0], bmin[2], bmax[0], bmax[2]
         t = (counts[c] - lo) / max(1, hi - lo)
         ax.add_patch(Rectangle((x0, z0), x1 - x0, z1 - z0, facecolor=cmap(t), alpha=0.75, edgecolor="k", lw=0.3))
     sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(lo, hi))
@@ -81,7 +89,7 @@ def main(work, out):
 
     # 2. one cell's visible set against the full scene.
     fig, ax = plt.subplots(figsize=(4.6, 4.4), dpi=90)
-    ax.add_collection(PolyCollection(all_polys, facecolors="0.85", edgecolors="none"))
+    ax.add_collection(PolyCollection(all_polys, facecolors=shades, edgecolors="none"))
     ax.add_collection(PolyCollection(top_polys(v, f, at["visible"]), facecolors="tab:red", edgecolors="none"))
     b = at["view_region"]
     ax.add_patch(Rectangle((b["min"][0], b["min"][2]), b["max"][0] - b["min"][0], b["max"][2] - b["min"][2],
@@ -108,10 +116,10 @@ def main(work, out):
     im = nf["images"]
     fig, axes = plt.subplots(1, 4, figsize=(12, 2.5), dpi=90)
     panels = (
-        ("near_far", "near-far frame: eps %.3g, SSIM %.3f" % (nf["epsilon"], nf["ssim"])),
-        ("nomorph", "without morph: eps %.3g, SSIM %.3f" % (nf["without_morph"]["epsilon"], nf["without_morph"]["ssim"])),
-        ("truth", "full scene"),
-        ("heat_map", "error heat map (near-far)"),
+        ("near_far", "near-far frame\nepsilon %.3g, SSIM %.3f" % (nf["epsilon"], nf["ssim"])),
+        ("nomorph", "without morph\nepsilon %.3g, SSIM %.3f" % (nf["without_morph"]["epsilon"], nf["without_morph"]["ssim"])),
+        ("truth", "full scene\n"),
+        ("heat_map", "error heat map\n(near-far frame)"),
     )
     for a, (key, title) in zip(axes, panels):
         a.imshow(mpimg.imread(im[key]))
