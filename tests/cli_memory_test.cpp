@@ -61,3 +61,37 @@ TEST(CliMemory, OutOfMemoryNamesTheStageAndTheRequestSizeAndWritesNothing) {
   // Nothing half-written: neither the output nor a temporary beside it.
   for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
 }
+
+// OpenImageIO (with its ~250 shared libraries, ~130 MB resident before main()) is loaded only by
+// the first image read or write (vislib/eval/image_module): `pvs info` never loads it, a bake
+// neither, `pvs view -o frame.png` does. Seen through the dynamic loader's own trace (LD_DEBUG).
+TEST(CliMemory, OpenImageIOIsLoadedOnlyByCommandsThatTouchImages) {
+  const std::string dir = temp_dir("cli_memory_oiio");
+  std::string out;
+  ASSERT_EQ(run_pvs("generate city --blocks 2,2 -q -o " + dir + "/city.glb", &out), 0) << out;
+  auto loads_oiio = [&](const std::string& args, int expected_rc) {
+    std::string trace;
+    const std::string cmd = "env LD_DEBUG=files " + std::string(VISLIB_PVS_EXE) + " " + args;
+    FILE* pipe = popen((cmd + " 2>&1").c_str(), "r");
+    EXPECT_NE(pipe, nullptr);
+    if (!pipe) return false;
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = fread(buf.data(), 1, buf.size(), pipe)) > 0) trace.append(buf.data(), n);
+    const int status = pclose(pipe);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == expected_rc) << args << "\n" << trace;
+    return trace.find("libOpenImageIO") != std::string::npos;
+  };
+  EXPECT_FALSE(loads_oiio("info " + dir + "/city.glb", 0));
+  EXPECT_FALSE(loads_oiio("bake " + dir +
+                              "/city.glb --box -20,0,-20,20,3,20 --grid 2,1,2 --eye-height 1.5,1.8 "
+                              "--res 8 -q -o " +
+                              dir + "/city.pvs",
+                          0));
+  EXPECT_TRUE(loads_oiio("view " + dir + "/city.pvs --scene " + dir +
+                             "/city.glb --at -15,1.6,-15 --look 10,1.6,0 --centre -15,1.65,-15 "
+                             "--near-far 5,10 --frame 32x24 -q -o " +
+                             dir + "/frame.png",
+                         0));
+  EXPECT_TRUE(fs::exists(dir + "/frame.png"));
+}
