@@ -30,7 +30,7 @@ bool file_exists(const std::string& path) {
 // After the bake: the checkpoint's damage, the summary, the --json report.
 void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const vislib::BakeReport& r,
                  const std::string& checkpoint) {
-  if (r.checkpoint_dropped_records)
+  if (r.checkpoint_dropped_records && show_progress())  // a warning: -q silences it
     std::fprintf(stderr,
                  "pvs bake: checkpoint %s: %zu damaged or torn record(s) dropped (%llu bytes); "
                  "their cells "
