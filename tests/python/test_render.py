@@ -1,0 +1,72 @@
+"""Frames and their metrics through pyvislib against `pvs inspect --render` (the same renderer and
+metrics driven by the CLI) and against hand-checkable cases."""
+import math
+
+import numpy as np
+import pytest
+
+import pyvislib
+from conftest import pvs_json
+
+EYE = (5.0, 2.0, 5.0)
+
+
+def test_cell_frames_metrics_equal_pvs_inspect_render(city, city_pvs, tmp_path):
+    shown = pvs_json("inspect", city_pvs, "--at", "%r,%r,%r" % EYE, "--scene", city, "--render",
+                     tmp_path / "views", "--frame", "160x120", "--json", "-q")
+    scene = pyvislib.load_scene(str(city))
+    pvs = pyvislib.Pvs(str(city_pvs))
+    ids = pvs.visible_ids(pvs.find_cell(EYE))
+    renderer = pyvislib.Renderer(scene, origin=EYE)  # inspect centres the BVH at the eye
+    views = shown["render"]["views"]
+    assert len(views) == 4
+    for v in views:
+        cam = dict(eye=EYE, forward=tuple(v["forward"]), width=160, height=120)
+        q = pyvislib.frame_quality(renderer.render(**cam), renderer.render(**cam, visible=ids))
+        assert q.missed_pixels == v["missed_pixels"]
+        assert q.epsilon == v["epsilon"]
+        assert q.ssim == pytest.approx(v["ssim"], rel=1e-12)
+        if v["psnr"] is None:
+            assert math.isinf(q.psnr)
+        else:
+            assert q.psnr == pytest.approx(v["psnr"], rel=1e-12)
+
+
+def test_frame_against_itself_is_perfect_and_against_nothing_misses_every_hit(city):
+    scene = pyvislib.load_scene(str(city))
+    renderer = pyvislib.Renderer(scene)
+    cam = dict(eye=EYE, forward=(1.0, -0.1, 0.3), width=96, height=64)
+    full = renderer.render(**cam)
+    assert full.rgb.shape == (64, 96, 3) and full.rgb.dtype == np.uint8
+    q = pyvislib.frame_quality(full, full)
+    assert q.epsilon == 0 and math.isinf(q.psnr) and q.ssim == 1.0
+    empty = renderer.render(**cam, visible=[])
+    hit = full.triangles != pyvislib.NO_HIT
+    assert hit.any() and not (empty.triangles != pyvislib.NO_HIT).any()
+    mask = pyvislib.missed_pixels(full, empty)
+    assert (mask == hit).all()
+    q = pyvislib.frame_quality(full, empty)
+    assert q.missed_pixels == int(hit.sum()) and q.epsilon == hit.mean()
+    assert q.psnr == pytest.approx(pyvislib.psnr(full.rgb, empty.rgb), rel=0, abs=0)
+    assert q.ssim == pytest.approx(pyvislib.ssim(full.rgb, empty.rgb), rel=0, abs=0)
+
+
+def test_image_metrics_on_hand_computable_images():
+    a = np.zeros((16, 16, 3), np.uint8)
+    b = a.copy()
+    b[0, 0] = (255, 255, 255)  # one pixel off by 255 in all channels: MSE = 255^2 / 256
+    assert pyvislib.psnr(a, b) == pytest.approx(10 * math.log10(256), rel=1e-12)
+    assert math.isinf(pyvislib.psnr(a, a))
+    assert pyvislib.ssim(a, a) == 1.0 and pyvislib.ssim(a, a, whole_image=True) == 1.0
+    # Whole-image SSIM of a constant image against another constant: luminance term only,
+    # (2 mu_a mu_b + C1) / (mu_a^2 + mu_b^2 + C1) with mu_a = 0, mu_b = 100 (grey), C1 = (0.01*255)^2.
+    c = np.full((16, 16, 3), 100, np.uint8)
+    c1 = (0.01 * 255) ** 2
+    assert pyvislib.ssim(a, c, whole_image=True) == pytest.approx(c1 / (100.0 ** 2 + c1), rel=1e-9)
+    with pytest.raises(ValueError):
+        pyvislib.psnr(a, np.zeros((8, 16, 3), np.uint8))
+
+
+def test_compare_sets_counts_missed_and_extra():
+    assert pyvislib.compare_sets([1, 2, 3, 7], [2, 3, 4]) == dict(size=4, reference_size=3, common=2,
+                                                                   missed=1, extra=2)
