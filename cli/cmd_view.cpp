@@ -21,6 +21,7 @@
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/eval/discontinuity.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/image_io.h"
 #include "vislib/eval/metrics.h"
@@ -40,6 +41,7 @@ struct ViewArgs {
   bool grow = false;
   int env_size = 0, rings = 8, states = 1, frames_per_ring = 4;
   double near_fraction = 0.7, tau = 0, merge_min = -1;
+  double delta_radius = vislib::kDiscontinuityRadius;
 };
 
 // The cell of the eye and its visible triangles, read from the PVS file for the scene.
@@ -147,9 +149,11 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
   vislib::EmbreeScene rt(scene, 0.0, eye);
   vislib::Frame truth = vislib::render_frame(scene, rt, cam);
   vislib::RegionCounts rc;
-  vislib::Frame morphed = vislib::render_near_far(scene, rt, tris, cam, s, &rc);
+  vislib::PixelSources morphed_sources, unmorphed_sources;
+  vislib::Frame morphed = vislib::render_near_far(scene, rt, tris, cam, s, &rc, &morphed_sources);
   s.morph = false;
-  vislib::Frame unmorphed = vislib::render_near_far(scene, rt, tris, cam, s);
+  vislib::Frame unmorphed =
+      vislib::render_near_far(scene, rt, tris, cam, s, nullptr, &unmorphed_sources);
 
   vislib::write_rgb8_image(a.output, fw, fh, morphed.rgb);
   vislib::write_rgb8_image(sibling(a.output, "_truth"), fw, fh, truth.rgb);
@@ -158,6 +162,7 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
                            vislib::error_heat_map(morphed, vislib::missed_pixels(truth, morphed)));
 
   json j = quality_json(scene, truth, morphed);
+  j.update(near_far_json(truth, morphed, morphed_sources, cam, a.delta_radius));
   j["file"] = a.file;
   j["cell"] = v.cell;
   j["eye"] = {eye.x, eye.y, eye.z};
@@ -181,6 +186,8 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
       {"far_dynamic_drawn", rc.far_dynamic},
       {"far_dynamic_shown", rc.far_dynamic_shown}};
   j["without_morph"] = quality_json(scene, truth, unmorphed);
+  j["without_morph"].update(
+      near_far_json(truth, unmorphed, unmorphed_sources, cam, a.delta_radius));
   // Baseline: the cell's visible set rendered from geometry, no near-far partition.
   vislib::Frame pvs_frame = vislib::render_frame(
       scene, rt, cam, vislib::triangle_mask(scene.triangle_count(), tris).data());
@@ -286,6 +293,11 @@ void add_view(CLI::App& app) {
       ->check(in_range(0.01, 0.99))
       ->capture_default_str();
   cmd->add_option("--frame", a->frame, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--delta-radius", a->delta_radius,
+                  "Neighbourhood radius (pixels) of the near-far paper's discontinuity metric "
+                  "delta (Eq. 8), reported with and without the morph")
+      ->check(CLI::Range(0.5, 1000.0))
+      ->capture_default_str();
   cmd->add_option("--env-size", a->env_size,
                   "Environment map face side in pixels (default: the frame height)")
       ->check(in_range(0, 8192));
