@@ -55,6 +55,7 @@ json near_far_json(const vislib::Frame& truth, const vislib::Frame& test,
           {"epsilon_env_map", double(miss[2]) / n},
           {"delta",
            {{"mean", d.mean},
+            {"mean_abs", d.mean_abs},
             {"max", d.max},
             {"share_above_half", d.share_above_half},
             {"pixels", d.pixels},
@@ -107,11 +108,13 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
       fmt_psnr(w["psnr"]).c_str(), w["ssim"].get<double>(), w["ovc"].get<double>(),
       w["ofc"].get<double>(), w["ofc_eq2"].get<double>(), w["triangle_mismatch"].get<double>());
   std::fprintf(stderr,
-               "  delta (Eqs. 7-8, radius %g px): morph %.4f, no morph %.4f\n"
+               "  delta (Eqs. 7-8, radius %g px), mean (mean |delta|): morph %.4f (%.4f), no "
+               "morph %.4f (%.4f)\n"
                "  epsilon by source (morph / no morph): geometry %.4f / %.4f, morphed %.4f (%.1f%% "
                "of pixels), environment map %.4f / %.4f (%.1f%% / %.1f%% of pixels)\n",
                j["delta"]["radius"].get<double>(), j["delta"]["mean"].get<double>(),
-               w["delta"]["mean"].get<double>(), j["epsilon_geometry"].get<double>(),
+               j["delta"]["mean_abs"].get<double>(), w["delta"]["mean"].get<double>(),
+               w["delta"]["mean_abs"].get<double>(), j["epsilon_geometry"].get<double>(),
                w["epsilon_geometry"].get<double>(), j["epsilon_morphed"].get<double>(),
                100 * j["morphed_pixels"].get<double>(), j["epsilon_env_map"].get<double>(),
                w["epsilon_env_map"].get<double>(), 100 * j["env_map_pixels"].get<double>(),

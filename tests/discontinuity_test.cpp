@@ -32,6 +32,7 @@ TEST(Discontinuity, SplitRowGivesHandComputedValues) {
   EXPECT_DOUBLE_EQ(d.delta[3], 0.0);
   EXPECT_EQ(d.pixels, 4u);
   EXPECT_DOUBLE_EQ(d.mean, 0.25);
+  EXPECT_DOUBLE_EQ(d.mean_abs, 0.25);
   EXPECT_DOUBLE_EQ(d.max, 0.5);
   EXPECT_EQ(d.share_above_half, 0.0);  // strictly above 0.5
 }
@@ -47,6 +48,11 @@ TEST(Discontinuity, ImageMagnifiedTwiceHasDeltaOneEverywhere) {
   EXPECT_EQ(d.pixels, size_t(w * h));
   for (double v : d.delta) EXPECT_NEAR(v, 1.0, 1e-12);
   EXPECT_NEAR(d.mean, 1.0, 1e-12);
+  // Shrunk twice instead (t(p) = 2p, radius 2.5: the 8 around each pixel): ratios 1/2, delta -0.5.
+  for (size_t i = 0; i < xy.size(); ++i) xy[i] *= 4;
+  const vislib::Discontinuity s = vislib::discontinuity(w, h, xy, 2.5);
+  EXPECT_NEAR(s.mean, -0.5, 1e-12);
+  EXPECT_NEAR(s.mean_abs, 0.5, 1e-12);
   EXPECT_EQ(d.share_above_half, 1.0);
 }
 

@@ -250,7 +250,7 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   for (const nlohmann::json* m : {&j, &j["without_morph"]}) {
     const nlohmann::json& q = *m;
     ASSERT_TRUE(q.contains("delta"));
-    EXPECT_GE(q["delta"]["mean"].get<double>(), 0.0);
+    EXPECT_GE(q["delta"]["mean_abs"].get<double>(), std::fabs(q["delta"]["mean"].get<double>()));
     EXPECT_GT(q["delta"]["pixels"].get<size_t>(), 0u);
     EXPECT_EQ(q["delta"]["radius"].get<double>(), 17.0);
     EXPECT_NEAR(q["epsilon_geometry"].get<double>() + q["epsilon_morphed"].get<double>() +

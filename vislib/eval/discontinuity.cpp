@@ -89,17 +89,19 @@ Discontinuity discontinuity(int width, int height, const std::vector<double>& tr
       }
   });
   size_t above = 0;
-  double total = 0;
+  double total = 0, total_abs = 0;
   for (size_t p = 0; p < n; ++p) {
     d.coincident_pairs += coincident[p];
     if (std::isnan(d.delta[p])) continue;
     ++d.pixels;
     total += d.delta[p];
+    total_abs += std::fabs(d.delta[p]);
     if (d.delta[p] > d.max) d.max = d.delta[p];
     above += d.delta[p] > 0.5;
   }
   if (d.pixels > 0) {
     d.mean = total / double(d.pixels);
+    d.mean_abs = total_abs / double(d.pixels);
     d.share_above_half = double(above) / double(d.pixels);
   }
   return d;

@@ -17,7 +17,8 @@
 //
 // The paper's figures use radius = 17 pixels (Fig. 9). It does not say how the per-pixel values
 // are summarised over an image (Fig. 10 shows the map); we report the mean over the pixels that
-// have a delta, the maximum, and the share of those pixels with delta above 0.5.
+// have a delta, the mean of |delta| (a compressed region, delta < 0, does not cancel a torn one),
+// the maximum, and the share of those pixels with delta above 0.5.
 #pragma once
 #include <array>
 #include <cstddef>
@@ -41,7 +42,9 @@ struct Discontinuity {
   // delta(p) per pixel, row-major (width * height); NaN where it is undefined (see above).
   std::vector<double> delta;
   size_t pixels = 0;            // pixels with a delta
-  double mean = 0;              // mean delta over them (0 when none)
+  double mean = 0;              // mean delta over them (0 when none); delta < 0 where the frame
+                                // compresses what the truth shows (ratios below 1)
+  double mean_abs = 0;          // mean |delta| over them (compression and tearing both count)
   double max = 0;               // largest delta (0 when none)
   double share_above_half = 0;  // share of them with delta > 0.5
   size_t coincident_pairs = 0;  // (p, q) pairs left out because t(p) = t(q) exactly
