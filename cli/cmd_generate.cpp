@@ -6,6 +6,7 @@
 
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/generate.h"
 #include "vislib/scene/write_gltf.h"
@@ -44,8 +45,10 @@ void write_and_report(const std::string& kind, const vislib::Scene& scene, const
   double gen = seconds_since(t0);
   if (gen > 2 && show_progress())
     std::fprintf(stderr, "pvs: generated in %.1f s, writing %s\n", gen, path.c_str());
-  std::string bytes = vislib::file_extension(path) == ".glb" ? vislib::scene_to_glb(scene)
-                                                             : vislib::spheres_to_text(scene);
+  std::string bytes = vislib::with_memory_stage("encoding " + path, [&] {
+    return vislib::file_extension(path) == ".glb" ? vislib::scene_to_glb(scene)
+                                                  : vislib::spheres_to_text(scene);
+  });
   vislib::write_file_atomic(path, bytes);
   std::printf(
       "%s: %zu triangles, %zu spheres, %zu objects, %zu states, %zu bytes written to %s "
@@ -107,7 +110,10 @@ void add_generate(CLI::App& app) {
       }
       auto t0 = Clock::now();
       o->progress = progress_printer("generating city", t0);
-      write_and_report("city", vislib::generate_city(*o), *out, t0);
+      write_and_report("city",
+                       vislib::with_memory_stage("generating the city scene",
+                                                 [&] { return vislib::generate_city(*o); }),
+                       *out, t0);
     });
   }
 
@@ -159,7 +165,10 @@ void add_generate(CLI::App& app) {
       check_output_file(*out, "--output");
       auto t0 = Clock::now();
       o->progress = progress_printer("generating grass", t0);
-      write_and_report("grass", vislib::generate_grass(*o), *out, t0);
+      write_and_report("grass",
+                       vislib::with_memory_stage("generating the grass scene",
+                                                 [&] { return vislib::generate_grass(*o); }),
+                       *out, t0);
     });
   }
 
@@ -199,7 +208,10 @@ void add_generate(CLI::App& app) {
       check_output_file(*out, "--output");
       if (o->area < 2 * o->radius)
         throw CLI::ValidationError("--area", "must be at least twice --radius");
-      write_and_report("spheres", vislib::generate_spheres(*o), *out, Clock::now());
+      write_and_report("spheres",
+                       vislib::with_memory_stage("generating the spheres scene",
+                                                 [&] { return vislib::generate_spheres(*o); }),
+                       *out, Clock::now());
     });
   }
 }

@@ -29,6 +29,8 @@ set(VISLIB_INSTALLED_COMPONENTS runtime)
 if(NOT VISLIB_RUNTIME_ONLY)
   list(APPEND VISLIB_INSTALLED_COMPONENTS vislib)
   install(TARGETS pvs RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # The image module that vislib::eval loads on first image I/O (vislib/CMakeLists.txt).
+  install(TARGETS vislib_image_oiio LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/vislib)
   set(_corner_targets)
   get_directory_property(_corners DIRECTORY ${PROJECT_SOURCE_DIR}/vislib DEFINITION VISLIB_CORNERS)
   foreach(name ${_corners})

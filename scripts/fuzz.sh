@@ -64,7 +64,7 @@ for t in $TARGETS; do
   "$BUILD_DIR/$t" -max_total_time="$PER_TARGET" -max_len=4096 -rss_limit_mb=2048 -malloc_limit_mb=1024 \
     -timeout=10 -print_final_stats=1 -artifact_prefix="$BUILD_DIR/$t.artifacts/" \
     "$BUILD_DIR/corpus/$t" "$seeds" > "$BUILD_DIR/$t.log" 2>&1 || status=$?
-  grep -E "^#[0-9]+ +(INITED|DONE)|^stat::number_of_executed_units" "$BUILD_DIR/$t.log" || true
+  grep -E "^#[0-9]+[[:space:]]+(INITED|DONE)|^stat::number_of_executed_units" "$BUILD_DIR/$t.log" || true
   if [[ $status != 0 ]]; then
     tail -40 "$BUILD_DIR/$t.log"
     echo "fuzz: $t: FINDING (exit $status), input in $BUILD_DIR/$t.artifacts/"

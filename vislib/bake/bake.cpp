@@ -15,6 +15,7 @@
 #include "vislib/bake/id_universe.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/kernel/segment_run_cache.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 namespace vislib {
@@ -66,6 +67,18 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
   return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
+namespace {
+
+// The from-segment runs of one cell: K per perimeter segment of each of its rectangles.
+uint64_t cell_runs(const pvs::CellLayout& layout, uint32_t cell, int runs) {
+  uint64_t segments = 0;
+  for (const Box3& rect : cell_rectangles(layout, cell))
+    segments += perimeter_segments(rect).size();
+  return segments * uint64_t(runs);
+}
+
+}  // namespace
+
 BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
                 Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
   assert(shard.count >= 1 && shard.index < shard.count);
@@ -98,6 +111,20 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     ++report.shard_cells;
     if (recovered[c]) ++report.resumed;
   }
+
+  // Shared edges: announce run 0 of every perimeter segment of the cells this run computes, so
+  // that an edge common to two cells is computed once and freed after its last use.
+  SegmentRunCache shared_runs;
+  BakeSettings run_settings = settings;
+  if (settings.share_segments) {
+    run_settings.region.shared_runs = &shared_runs;
+    for (uint32_t c = 0; c < n; ++c) {
+      if (!in_shard(c, shard) || recovered[c]) continue;
+      for (const Box3& rect : cell_rectangles(info.layout, c))
+        for (const Segment& s : perimeter_segments(rect)) shared_runs.expect(s.from, s.to);
+    }
+  }
+  std::atomic<uint64_t> runs_done{0};
 
   // Streaming: cells are baked in parallel and written in cell order as soon as every earlier
   // cell is written (a TBB pipeline whose last stage is serial and in order), so the memory held
@@ -152,8 +179,9 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                     };
                   std::vector<uint32_t> ids = with_memory_stage(
                       "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
-                        return bake_cell(scene, info.layout, c, settings, &seconds, in_cell);
+                        return bake_cell(scene, info.layout, c, run_settings, &seconds, in_cell);
                       });
+                  runs_done += cell_runs(info.layout, c, settings.region.runs);
                   if (checkpoint) checkpoint->append(c, ids);
                   *set = std::move(ids);
                   report.cell_seconds[c] = seconds;
@@ -177,6 +205,8 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     throw;
   }
   report.seconds = elapsed();
+  report.segment_runs_shared = shared_runs.runs_shared();
+  report.segment_runs_computed = runs_done.load() - report.segment_runs_shared;
   report.stats = writer.finish();
   out.commit();
   if (checkpoint) checkpoint->remove();

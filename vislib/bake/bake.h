@@ -22,6 +22,9 @@ namespace vislib {
 struct BakeSettings {
   RegionOptions region;  // resolution, near, eps_len, tile size (segment); runs K; seed
   Granularity granularity = Granularity::Triangle;
+  // Compute each world-aligned run (run 0) of an edge shared by several cells once
+  // (segment_run_cache.h). Never changes the sets; false recomputes it for every cell.
+  bool share_segments = true;
 };
 
 // Shard `index` of `count` bakes the cells c with c % count == index (round robin, so each shard
@@ -80,6 +83,10 @@ struct BakeReport {
   std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
   double seconds = 0;                // wall time of this run's baking
   pvs::WriteStats stats;             // sizes of the written file
+  // From-segment runs: computed by the kernel in this run, and served from the shared-edge cache
+  // instead (share_segments); computed + shared = runs of the baked cells.
+  uint64_t segment_runs_computed = 0;
+  uint64_t segment_runs_shared = 0;
   // Damaged records skipped (and a torn tail) when the checkpoint was reopened, and their bytes.
   size_t checkpoint_dropped_records = 0;
   uint64_t checkpoint_dropped_bytes = 0;

@@ -273,16 +273,23 @@ uint64_t cell_seed(uint64_t seed, uint32_t cell) {
   return Rng::derive(seed, cell);
 }
 
+std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell) {
+  const Box3 region = to_box3(layout.view_region(cell));
+  Box3 bottom = region, top = region;
+  bottom.max.y = region.min.y;
+  top.min.y = region.max.y;
+  if (region.max.y > region.min.y) return {bottom, top};
+  return {bottom};
+}
+
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
   Box3 region = to_box3(layout.view_region(cell));
   CellVisibility out;
   out.segments = cell_boundary_segments(region);
-  Box3 rect[2] = {region, region};
-  rect[0].max.y = region.min.y;
-  rect[1].min.y = region.max.y;
-  const int rects = region.max.y > region.min.y ? 2 : 1;
+  const std::vector<Box3> rect = cell_rectangles(layout, cell);
+  const int rects = int(rect.size());
   const uint64_t seed = cell_seed(options.seed, cell);
   for (int r = 0; r < rects; ++r) {
     RegionOptions o = options;

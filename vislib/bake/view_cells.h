@@ -101,6 +101,10 @@ struct CellVisibility {
 // Thread-safe; parallel inside (TBB). `progress(fraction)`, if given, is called after each
 // from-segment run with the fraction in (0, 1] of the cell's runs done (from the calling thread
 // or a worker; never two calls at once).
+// The rectangles whose perimeters cell_visibility runs: the bottom and top of the cell's view
+// region (one when the region is flat in y).
+std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell);
+
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress = {});

@@ -1,31 +1,112 @@
-// image_io.cpp: OpenImageIO behind the four functions of image_io.h.
+// image_io.cpp: the four functions of image_io.h over the image module (image_module/), which
+// holds every OpenImageIO call and is loaded with dlopen on first use: a process that never reads
+// or writes an image does not load OpenImageIO's ~250 shared libraries (image_module.h says why).
 #include "vislib/eval/image_io.h"
 
-#include <OpenImageIO/imageio.h>
+#include <dlfcn.h>
 #include <unistd.h>
 
 #include <cassert>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <new>
 #include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include "vislib/base/error.h"
+#include "vislib/eval/image_module/image_module.h"
 
 namespace vislib {
 
 namespace {
 
-void write_image(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
-                 const void* data) {
-  // The plugin is chosen by the final name; the pixels go to a temporary name, renamed on success.
-  auto out = OIIO::ImageOutput::create(path);
-  if (!out) throw std::runtime_error(path + ": cannot write image: " + OIIO::geterror());
+struct ImageModule {
+  vislib_image_write_fn write = nullptr;
+  vislib_image_read_fn read = nullptr;
+};
+
+// The folder of the running executable (empty if unknown).
+std::filesystem::path executable_dir() {
+  std::error_code ec;
+  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::filesystem::path() : exe.parent_path();
+}
+
+// Where the module may be, in order: $VISLIB_IMAGE_MODULE; the build tree that compiled this file;
+// the install prefix it was configured for; lib/vislib beside the executable's bin/ (a moved
+// install); the dynamic loader's own search (LD_LIBRARY_PATH, ...).
+std::vector<std::string> module_candidates() {
+  std::vector<std::string> out;
+  if (const char* env = std::getenv("VISLIB_IMAGE_MODULE"); env && *env) out.push_back(env);
+#ifdef VISLIB_IMAGE_MODULE_BUILD_PATH
+  out.push_back(VISLIB_IMAGE_MODULE_BUILD_PATH);
+#endif
+#ifdef VISLIB_IMAGE_MODULE_INSTALL_PATH
+  out.push_back(VISLIB_IMAGE_MODULE_INSTALL_PATH);
+#endif
+#ifdef VISLIB_IMAGE_MODULE_NAME
+  const auto exe_dir = executable_dir();
+  if (!exe_dir.empty()) {
+#ifdef VISLIB_IMAGE_MODULE_RELATIVE_DIR
+    out.push_back((exe_dir / ".." / VISLIB_IMAGE_MODULE_RELATIVE_DIR / VISLIB_IMAGE_MODULE_NAME)
+                      .lexically_normal()
+                      .string());
+#endif
+  }
+  out.push_back(VISLIB_IMAGE_MODULE_NAME);
+#endif
+  return out;
+}
+
+const ImageModule& image_module() {
+  static ImageModule module;
+  static std::string failure;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    std::string tried;
+    for (const std::string& path : module_candidates()) {
+      const bool bare = path.find('/') == std::string::npos;
+      if (!bare && !std::filesystem::exists(path)) {
+        tried += "\n  " + path + " (absent)";
+        continue;
+      }
+      void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+      if (!handle) {
+        const char* e = dlerror();
+        tried += "\n  " + path + " (" + (e ? e : "dlopen failed") + ")";
+        continue;
+      }
+      module.write =
+          reinterpret_cast<vislib_image_write_fn>(dlsym(handle, VISLIB_IMAGE_WRITE_SYMBOL));
+      module.read = reinterpret_cast<vislib_image_read_fn>(dlsym(handle, VISLIB_IMAGE_READ_SYMBOL));
+      if (module.write && module.read) return;  // the handle stays open for the process
+      tried += "\n  " + path + " (lacks the " VISLIB_IMAGE_WRITE_SYMBOL " / " +
+               VISLIB_IMAGE_READ_SYMBOL " functions)";
+      module = ImageModule{};
+      dlclose(handle);
+    }
+    failure =
+        "the image module (OpenImageIO) could not be loaded; set VISLIB_IMAGE_MODULE to the "
+        "path of libvislib_image_oiio.so. Tried:" +
+        tried;
+  });
+  if (!module.write) throw std::runtime_error(failure);
+  return module;
+}
+
+void write_image(const std::string& path, int width, int height, int channels, bool is_float,
+                 const char* channel_name, const void* pixels) {
+  const ImageModule& m = image_module();
   const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  bool ok = out->open(tmp, spec) && out->write_image(type, data);
-  ok = out->close() && ok;
-  if (!ok) {
-    std::string err = out->geterror();
+  char err[1024] = "";
+  if (m.write(path.c_str(), tmp.c_str(), width, height, channels, is_float ? 1 : 0, channel_name,
+              pixels, err, sizeof err) != 0) {
     std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": image write failed: " + err);
+    throw std::runtime_error(path + ": " + err);
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0) {
     std::remove(tmp.c_str());
@@ -33,15 +114,30 @@ void write_image(const std::string& path, const OIIO::ImageSpec& spec, OIIO::Typ
   }
 }
 
-std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, int& width, int& height) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw InputError(path, "cannot read image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  width = spec.width;
-  height = spec.height;
-  if (width < 1 || height < 1 || spec.nchannels < 1)
-    throw InputError(path, "image has no pixels or no channels");
-  return in;
+// The pixels of `path` (uint8 or float32, at most max_channels channels) in a vector of T.
+template <class T>
+std::vector<T> read_image(const std::string& path, int max_channels, int& width, int& height,
+                          int& channels) {
+  struct Target {
+    std::vector<T> pixels;
+    bool out_of_memory = false;
+  } target;
+  auto alloc = [](void* ctx, size_t bytes) noexcept -> void* {
+    auto* t = static_cast<Target*>(ctx);
+    try {
+      t->pixels.resize(bytes / sizeof(T));
+      return t->pixels.data();
+    } catch (const std::bad_alloc&) {
+      t->out_of_memory = true;
+      return nullptr;
+    }
+  };
+  char err[1024] = "";
+  const int rc = image_module().read(path.c_str(), std::is_same_v<T, float> ? 1 : 0, max_channels,
+                                     alloc, &target, &width, &height, &channels, err, sizeof err);
+  if (target.out_of_memory) throw std::bad_alloc();
+  if (rc != 0) throw InputError(path, err);
+  return std::move(target.pixels);
 }
 
 }  // namespace
@@ -49,25 +145,18 @@ std::unique_ptr<OIIO::ImageInput> open_input(const std::string& path, int& width
 void write_rgb8_image(const std::string& path, int width, int height,
                       const std::vector<uint8_t>& rgb) {
   assert(width >= 1 && height >= 1 && rgb.size() == 3 * size_t(width) * size_t(height));
-  write_image(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8), OIIO::TypeDesc::UINT8,
-              rgb.data());
+  write_image(path, width, height, 3, false, nullptr, rgb.data());
 }
 
 void write_float_image(const std::string& path, int width, int height,
                        const std::vector<float>& values) {
   assert(width >= 1 && height >= 1 && values.size() == size_t(width) * size_t(height));
-  OIIO::ImageSpec spec(width, height, 1, OIIO::TypeDesc::FLOAT);
-  spec.channelnames = {"Z"};
-  spec.z_channel = 0;
-  write_image(path, spec, OIIO::TypeDesc::FLOAT, values.data());
+  write_image(path, width, height, 1, true, "Z", values.data());
 }
 
 std::vector<uint8_t> read_rgb8_image(const std::string& path, int& width, int& height) {
-  auto in = open_input(path, width, height);
-  const int nc = in->spec().nchannels;
-  std::vector<uint8_t> all(size_t(width) * size_t(height) * size_t(nc));
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, all.data()))
-    throw InputError(path, "cannot decode image: " + in->geterror());
+  int nc = 0;
+  std::vector<uint8_t> all = read_image<uint8_t>(path, 0, width, height, nc);
   std::vector<uint8_t> rgb(size_t(width) * size_t(height) * 3);
   for (size_t p = 0; p < size_t(width) * size_t(height); ++p)
     for (int k = 0; k < 3; ++k)
@@ -76,11 +165,8 @@ std::vector<uint8_t> read_rgb8_image(const std::string& path, int& width, int& h
 }
 
 std::vector<float> read_float_image(const std::string& path, int& width, int& height) {
-  auto in = open_input(path, width, height);
-  std::vector<float> values(size_t(width) * size_t(height));
-  if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, values.data()))
-    throw InputError(path, "cannot decode image: " + in->geterror());
-  return values;
+  int nc = 0;
+  return read_image<float>(path, 1, width, height, nc);
 }
 
 }  // namespace vislib

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "vislib/base/random.h"
+#include "vislib/kernel/segment_run_cache.h"
 
 namespace vislib {
 
@@ -54,8 +55,18 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
       SegmentOptions so = options.segment;
       so.orientation = run_orientation(options.seed, s, k);
       so.want_pieces = false;
-      SegmentResult sr =
-          segment_visibility(scene, result.segments[s].from, result.segments[s].to, so);
+      const Segment& seg = result.segments[s];
+      SegmentResult sr;
+      bool computed = true;
+      if (options.shared_runs && k == 0) {
+        auto shared = options.shared_runs->get(
+            seg.from, seg.to, [&] { return segment_visibility(scene, seg.from, seg.to, so); },
+            &computed);
+        sr = *shared;  // a copy: the cache's result is shared with other regions
+        if (!computed) sr.stats.seconds = 0;
+      } else {
+        sr = segment_visibility(scene, seg.from, seg.to, so);
+      }
       // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
       for (size_t i = 0; i < sr.visible.size(); ++i) {
         uint32_t id = sr.visible[i];

@@ -30,12 +30,18 @@ std::vector<Segment> perimeter_segments(const Box3& box);
 // (seed, segment, run). Same arguments, same rotation on every platform.
 Mat3 run_orientation(uint64_t seed, size_t segment, int run);
 
+class SegmentRunCache;
+
 struct RegionOptions {
   // resolution, near, eps_len, tile size, want_witnesses... (orientation and want_pieces are
   // ignored)
   SegmentOptions segment;
   int runs = 1;  // K orientations per segment, >= 1
   uint64_t seed = 1;
+  // When set, run 0 (world-aligned) of every segment goes through this cache, shared with other
+  // regions using the same options (segment_run_cache.h; the bake shares cells' common edges).
+  // A run served from the cache counts 0 kernel seconds. Not part of the result's identity.
+  SegmentRunCache* shared_runs = nullptr;
 };
 
 struct RunRecord {
