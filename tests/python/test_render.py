@@ -32,12 +32,15 @@ def test_cell_frames_metrics_equal_pvs_inspect_render(city, city_pvs, tmp_path):
             assert q.psnr == pytest.approx(v["psnr"], rel=1e-12)
 
 
-def test_frame_against_itself_is_perfect_and_against_nothing_misses_every_hit(city):
+def test_frame_against_itself_is_perfect_and_against_nothing_misses_every_hit(city, tmp_path):
     scene = pyvislib.load_scene(str(city))
     renderer = pyvislib.Renderer(scene)
     cam = dict(eye=EYE, forward=(1.0, -0.1, 0.3), width=96, height=64)
     full = renderer.render(**cam)
     assert full.rgb.shape == (64, 96, 3) and full.rgb.dtype == np.uint8
+    png = tmp_path / "full.png"
+    full.save(str(png))
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     q = pyvislib.frame_quality(full, full)
     assert q.epsilon == 0 and math.isinf(q.psnr) and q.ssim == 1.0
     empty = renderer.render(**cam, visible=[])
