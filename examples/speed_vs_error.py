@@ -30,7 +30,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", default="data/city.glb")
     ap.add_argument("--from", dest="from_", type=parse_vec, default=(-60.0, 1.7, 0.0),
-                    help="segment start x,y,z (default: along the street z = 0 of data/city.glb)")
+                    help="segment start x,y,z (default: along the street z = 0 of data/city.glb; write "
+                         "--from=-1,2,3 when the first coordinate is negative)")
     ap.add_argument("--to", type=parse_vec, default=(60.0, 1.7, 0.0))
     ap.add_argument("--res", default="16,32,64,128,256", help="resolutions N to time, comma-separated")
     ap.add_argument("--ref", type=int, default=1024, help="reference resolution")
