@@ -29,6 +29,7 @@
 #include "runtime/pvs_runtime.h"
 #include "vislib/base/cubemap.h"
 #include "vislib/base/error.h"
+#include "vislib/eval/discontinuity.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/image_io.h"
 #include "vislib/eval/metrics.h"
@@ -577,6 +578,61 @@ PYBIND11_MODULE(pyvislib, m) {
       "SSIM of the luminance of two H x W x 3 uint8 images: windowed (ssim_luminance, 11 x 11 "
       "Gaussian) or with one window over the whole image (ssim_whole_image, CloVR's continuity "
       "figure).");
+  m.def(
+      "discontinuity",
+      [](const py::array_t<double, py::array::c_style | py::array::forcecast>& truth_xy,
+         double radius) {
+        if (truth_xy.ndim() != 3 || truth_xy.shape(2) != 2)
+          throw py::value_error("truth_xy must be an H x W x 2 array (NaN = no position)");
+        if (!(radius > 0)) throw py::value_error("radius must be > 0");
+        const int h = int(truth_xy.shape(0)), w = int(truth_xy.shape(1));
+        if (w < 1 || h < 1) throw py::value_error("truth_xy must be non-empty");
+        std::vector<double> xy(truth_xy.data(), truth_xy.data() + truth_xy.size());
+        vislib::Discontinuity d;
+        {
+          py::gil_scoped_release release;
+          d = vislib::discontinuity(w, h, xy, radius);
+        }
+        py::array_t<double> map({py::ssize_t(h), py::ssize_t(w)});
+        std::copy(d.delta.begin(), d.delta.end(), map.mutable_data());
+        py::dict r;
+        r["delta"] = map;
+        r["pixels"] = d.pixels;
+        r["mean"] = d.mean;
+        r["mean_abs"] = d.mean_abs;
+        r["max"] = d.max;
+        r["share_above_half"] = d.share_above_half;
+        r["coincident_pairs"] = d.coincident_pairs;
+        return r;
+      },
+      py::arg("truth_xy"), py::arg("radius") = vislib::kDiscontinuityRadius,
+      "The near-far paper's discontinuity delta (Eqs. 7-8, vislib::discontinuity): truth_xy[y, x] "
+      "is the truth-image position (column, row) of the scene point pixel (x, y) shows; returns "
+      "the per-pixel map (NaN where undefined) and its summaries.");
+  m.def(
+      "project_to_pixel",
+      [](const std::vector<double>& eye, const std::vector<double>& forward,
+         const std::vector<double>& up, const std::vector<double>& point, double vfov_degrees,
+         int width, int height) -> std::optional<py::tuple> {
+        vislib::Camera c;
+        c.eye = vec3(eye, "eye");
+        c.forward = vec3(forward, "forward");
+        c.up = vec3(up, "up");
+        if (vislib::length(vislib::cross(c.forward, c.up)) == 0)
+          throw py::value_error("forward must be non-zero and not parallel to up");
+        if (!(vfov_degrees > 0 && vfov_degrees < 180) || width < 1 || height < 1)
+          throw py::value_error("bad camera (vfov in (0, 180), width and height >= 1)");
+        c.vfov_degrees = vfov_degrees;
+        c.width = width;
+        c.height = height;
+        auto t = vislib::project_to_pixel(c, vec3(point, "point"));
+        if (!t) return std::nullopt;
+        return py::make_tuple((*t)[0], (*t)[1]);
+      },
+      py::arg("eye"), py::arg("forward"), py::arg("up"), py::arg("point"), py::kw_only(),
+      py::arg("vfov_degrees") = 90.0, py::arg("width") = 640, py::arg("height") = 480,
+      "Where `point` lands in the camera's image (column, row; pixel centres at integers), or None "
+      "behind the camera (vislib::project_to_pixel, the inverse of the renderer's pixel rays).");
   m.def(
       "compare_sets",
       [](std::vector<uint32_t> set, std::vector<uint32_t> reference) {

@@ -73,3 +73,36 @@ def test_image_metrics_on_hand_computable_images():
 def test_compare_sets_counts_missed_and_extra():
     assert pyvislib.compare_sets([1, 2, 3, 7], [2, 3, 4]) == dict(size=4, reference_size=3, common=2,
                                                                    missed=1, extra=2)
+
+
+def test_discontinuity_of_a_split_row_equals_the_hand_computed_values():
+    # Truth positions 0, 1, 1.5, 2.5 of a 4 x 1 row, radius 1.2 (tests/discontinuity_test.cpp):
+    # delta = 0, 0.5, 0.5, 0.
+    xy = np.array([[[0, 0], [1, 0], [1.5, 0], [2.5, 0]]], dtype=float)
+    d = pyvislib.discontinuity(xy, radius=1.2)
+    assert d["delta"].shape == (1, 4)
+    assert d["delta"].tolist() == [[0.0, 0.5, 0.5, 0.0]]
+    assert d["mean"] == 0.25 and d["pixels"] == 4
+
+
+def test_project_to_pixel_inverts_the_documented_pixel_rays_and_truth_has_zero_delta():
+    # render.h: d = f + sx r + sy u, sx = ((2x+1)/W - 1) tan(vfov/2) W/H, sy = (1 - (2y+1)/H) tan.
+    cam = dict(eye=EYE, forward=(1.0, -0.2, 0.4), up=(0.0, 1.0, 0.0))
+    w, h = 48, 32
+    fwd = np.array(cam["forward"]) / np.linalg.norm(cam["forward"])
+    right = np.cross(fwd, cam["up"])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, fwd)
+    t = np.tan(np.radians(45))
+    xy = np.full((h, w, 2), np.nan)
+    for y in range(0, h, 7):
+        for x in range(0, w, 5):
+            sx = ((2 * x + 1) / w - 1) * t * w / h
+            sy = (1 - (2 * y + 1) / h) * t
+            p = np.array(EYE) + 10 * (fwd + sx * right + sy * up)
+            px = pyvislib.project_to_pixel(**cam, point=tuple(p), width=w, height=h)
+            assert px == pytest.approx((x, y), abs=1e-9)
+            xy[y, x] = px
+    assert pyvislib.project_to_pixel(**cam, point=tuple(np.array(EYE) - fwd), width=w, height=h) is None
+    d = pyvislib.discontinuity(xy, radius=8.0)  # the truth's own positions: delta 0
+    assert d["pixels"] == 5 * 10 and abs(d["mean"]) < 1e-9
