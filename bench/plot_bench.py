@@ -2,7 +2,10 @@
 """Plots of `pvs bench` (docs/bench.md): reads the CSV files in DIR and writes
 DIR/found_vs_seconds.png, DIR/found_vs_runs.png and DIR/epsilon_vs_seconds.png.
 
-Usage: /usr/bin/python3 bench/plot_bench.py DIR
+Usage: /usr/bin/python3 bench/plot_bench.py [-q] DIR
+
+-q: print errors only (no "wrote" line, no warning when matplotlib is missing); `pvs bench -q`
+passes it.
 
 Needs matplotlib (Debian: apt-get install python3-matplotlib, for /usr/bin/python3). Exit codes:
 0 plots written, 2 bad usage or unreadable CSV, 3 matplotlib missing.
@@ -11,6 +14,7 @@ import csv
 import math
 import os
 import sys
+import warnings
 
 
 def read_csv(path):
@@ -19,6 +23,10 @@ def read_csv(path):
 
 
 def main(argv):
+    quiet = len(argv) == 3 and argv[1] == "-q"
+    if quiet:
+        argv = argv[:1] + argv[2:]
+        warnings.simplefilter("ignore")  # matplotlib's warnings too
     if len(argv) != 2 or argv[1] in ("-h", "--help"):
         print(__doc__, file=sys.stderr)
         return 2
@@ -29,6 +37,8 @@ def main(argv):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
+        if quiet:  # a warning (the plots are skipped, pvs bench says how to make them later)
+            return 3
         print(
             "plot_bench.py: matplotlib is not installed for %s; install it (Debian: "
             "apt-get install python3-matplotlib, then use /usr/bin/python3)" % sys.executable,
@@ -137,8 +147,9 @@ def main(argv):
     fig.tight_layout()
     fig.savefig(os.path.join(out, "epsilon_vs_seconds.png"), dpi=120)
     plt.close(fig)
-    print("plot_bench.py: wrote found_vs_seconds.png, found_vs_runs.png, epsilon_vs_seconds.png in %s" % out,
-          file=sys.stderr)
+    if not quiet:
+        print("plot_bench.py: wrote found_vs_seconds.png, found_vs_runs.png, epsilon_vs_seconds.png in %s" % out,
+              file=sys.stderr)
     return 0
 
 

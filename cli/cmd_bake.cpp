@@ -285,7 +285,7 @@ void add_bake(CLI::App& app) {
     vislib::BakeFiles files{a->output, checkpoint, a->resume, /*lock=*/false};
     vislib::BakeReport r = vislib::bake(scene, cells, s, shard, files, progress_printer());
 
-    if (r.checkpoint_dropped_records)
+    if (r.checkpoint_dropped_records && show_progress())  // a warning: -q silences it
       std::fprintf(stderr,
                    "pvs bake: checkpoint %s: %zu damaged or torn record(s) dropped (%llu bytes); "
                    "their cells "

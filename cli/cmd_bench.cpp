@@ -50,8 +50,9 @@ std::vector<std::string> make_plots(const BenchArgs& a) {
          vislib::shell_quote(script) + " " + vislib::shell_quote(a.out));
     return {};
   }
-  const std::string cmd = vislib::shell_quote(a.python) + " " + vislib::shell_quote(script) + " " +
-                          vislib::shell_quote(a.out);
+  // -q: the script prints errors only (its "wrote" line and missing-matplotlib note are not).
+  const std::string cmd = vislib::shell_quote(a.python) + " " + vislib::shell_quote(script) +
+                          (show_progress() ? " " : " -q ") + vislib::shell_quote(a.out);
   std::fflush(stderr);
   const int status = std::system(cmd.c_str());
   const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -50,11 +50,12 @@ void write_and_report(const std::string& kind, const vislib::Scene& scene, const
                                                   : vislib::spheres_to_text(scene);
   });
   vislib::write_file_atomic(path, bytes);
-  std::printf(
-      "%s: %zu triangles, %zu spheres, %zu objects, %zu states, %zu bytes written to %s "
-      "in %.2f s\n",
-      kind.c_str(), scene.triangle_count(), scene.sphere_count(), scene.objects.size(),
-      scene.state_count(), bytes.size(), path.c_str(), seconds_since(t0));
+  if (show_progress())  // a summary: -q prints errors only
+    std::printf(
+        "%s: %zu triangles, %zu spheres, %zu objects, %zu states, %zu bytes written to %s "
+        "in %.2f s\n",
+        kind.c_str(), scene.triangle_count(), scene.sphere_count(), scene.objects.size(),
+        scene.state_count(), bytes.size(), path.c_str(), seconds_since(t0));
 }
 
 void add_generate(CLI::App& app) {

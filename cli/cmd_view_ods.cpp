@@ -279,17 +279,18 @@ void run_view_ods(const OdsViewArgs& o, const ViewCommonArgs& c) {
   }
   json j = {{"file", c.file}, {"scene", c.scene}, {"tau", c.tau}, {"ods", ods}};
 
-  std::fprintf(stderr,
-               "ODS %dx%d %s, IPD %.4g m, cell %u, cells used %zu%s, visible %zu of %zu triangles\n"
-               "  left:  epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n"
-               "  right: epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n",
-               w, h, o.method.c_str(), o.ipd_m, cell, cells.size(),
-               disc_covered ? "" : " (disc NOT covered)", tris.size(),
-               size_t(scene.triangle_count()), ods["left"]["epsilon"].get<double>(),
-               ods["left"]["ssim"].get<double>(), ods["left"]["triangle_mismatch"].get<double>(),
-               seconds["left"].get<double>(), ods["right"]["epsilon"].get<double>(),
-               ods["right"]["ssim"].get<double>(), ods["right"]["triangle_mismatch"].get<double>(),
-               seconds["right"].get<double>());
+  if (show_progress())  // the summary on stderr obeys -q (the JSON has it all)
+    std::fprintf(
+        stderr,
+        "ODS %dx%d %s, IPD %.4g m, cell %u, cells used %zu%s, visible %zu of %zu triangles\n"
+        "  left:  epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n"
+        "  right: epsilon %.5f SSIM %.4f triangle mismatch %.5f (%.2f s)\n",
+        w, h, o.method.c_str(), o.ipd_m, cell, cells.size(),
+        disc_covered ? "" : " (disc NOT covered)", tris.size(), size_t(scene.triangle_count()),
+        ods["left"]["epsilon"].get<double>(), ods["left"]["ssim"].get<double>(),
+        ods["left"]["triangle_mismatch"].get<double>(), seconds["left"].get<double>(),
+        ods["right"]["epsilon"].get<double>(), ods["right"]["ssim"].get<double>(),
+        ods["right"]["triangle_mismatch"].get<double>(), seconds["right"].get<double>());
   if (c.json_path == "-") {
     std::printf("%s\n", j.dump(1).c_str());
   } else if (!c.json_path.empty()) {

@@ -266,7 +266,7 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
             {"images", images}};
   for (const char* name : {"left", "right"}) {
     const json& ej = j["eyes"][name];
-    if (ej["rendered"].get<bool>()) continue;
+    if (ej["rendered"].get<bool>() || !show_progress()) continue;  // -q: the JSON has it all
     const json& m = ej["method_error"];
     std::fprintf(stderr,
                  "stereo %s eye (cells %zu, %zu triangles): holes %.4f%s, method error PSNR %s "
@@ -278,11 +278,12 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
                  m["ssim"].get<double>(), m["triangle_mismatch"].get<double>(),
                  ej["total_error"]["ssim"].get<double>());
   }
-  std::fprintf(
-      stderr,
-      "stereo CPU time: render %.4f s + reproject %.4f s + patch %.4f s vs both eyes %.4f s; "
-      "rays %zu vs %zu\n",
-      t_render.cpu, t_reproject.cpu, t_patch.cpu, t_both.cpu, rays, 2 * pixels);
+  if (show_progress())
+    std::fprintf(
+        stderr,
+        "stereo CPU time: render %.4f s + reproject %.4f s + patch %.4f s vs both eyes %.4f s; "
+        "rays %zu vs %zu\n",
+        t_render.cpu, t_reproject.cpu, t_patch.cpu, t_both.cpu, rays, 2 * pixels);
   return j;
 }
 

@@ -11,7 +11,10 @@
 #include <regex>
 #include <sstream>
 
+#include "pvs_format/pvs_format.h"
 #include "tests/test_support.h"
+#include "vislib/bake/bake.h"
+#include "vislib/bake/checkpoint.h"
 #include "vislib/base/file_util.h"
 
 using namespace vislib_test;
@@ -156,6 +159,92 @@ TEST(CliConventions, QuietSilencesProgressAndWarnings) {
   EXPECT_EQ(run_pvs("export " + obj + " -o " + dir + "/n/flat.obj", &normal), 0) << normal;
   EXPECT_EQ(run_pvs("export -v " + obj + " -o " + dir + "/m/flat.obj", &verbose), 0) << verbose;
   EXPECT_GT(verbose.size(), normal.size()) << verbose;
+}
+
+// Issue 17 item 2 (audit of -q): every command run with -q on inputs that make it warn and report
+// progress leaves stderr empty, and commands whose results go to files leave stdout empty too;
+// each input is first run without -q to show that it does warn (so the check can fail). Errors
+// still print with -q.
+TEST(CliConventions, QuietLeavesStderrEmptyOnCommandsThatWarn) {
+  const std::string dir = temp_dir("cli_quiet_all");
+  std::string out, err;
+  // The city as OBJ plus a face of 2 vertices: every command that loads it warns (skipped face).
+  const std::string obj = dir + "/city.obj";
+  ASSERT_EQ(run_pvs("export -q " + city() + " -o " + obj, &out), 0) << out;
+  std::ofstream(obj, std::ios::app) << "f 1 2\n";
+  // With -q stdout is expected empty too (results in files) unless `results_on_stdout`.
+  auto check = [&](const std::string& what, const std::string& args, bool results_on_stdout,
+                   const std::string& warning) {
+    ASSERT_EQ(run_pvs_split(args, &out, &err), 0) << what << "\n" << out << err;
+    EXPECT_NE(err.find(warning), std::string::npos)
+        << what << ": warns without -q (" << warning << ")\n"
+        << err;
+    ASSERT_EQ(run_pvs_split(args + " -q", &out, &err), 0) << what << "\n" << out << err;
+    EXPECT_EQ(err, "") << what << " -q";
+    if (!results_on_stdout) {
+      EXPECT_EQ(out, "") << what << " -q";
+    }
+  };
+  const std::string warned = "warning";
+  check("info", "info " + obj, true, warned);
+  check("export", "export " + obj + " -o " + dir + "/e.obj", false, warned);
+  check("generate", "generate city --blocks 1,1 -o " + dir + "/g.glb", false, "");
+  check("segment",
+        "segment " + obj + " --from 0,1.6,0 --to 1,1.6,0 --res 8 --json " + dir + "/s.json", false,
+        warned);
+  check("region", "region " + obj + " --box -1,1.6,-1,1,1.6,1 --res 8 --json " + dir + "/r.json",
+        false, warned);
+  const std::string bake =
+      "bake " + obj + " --box -30,0,-30,30,3,30 --grid 2,1,2 --eye-height 1.5,1.8 --res 16 ";
+  check("bake", bake + "-o " + dir + "/a.pvs", false, warned);
+  for (const char* shard : {"0/2", "1/2"})
+    ASSERT_EQ(run_pvs(bake + "-q --shard " + shard + " -o " + dir + "/s" + shard[0] + ".pvs", &out),
+              0)
+        << out;
+  check("merge", "merge " + dir + "/s0.pvs " + dir + "/s1.pvs -o " + dir + "/m.pvs", false,
+        "pvs merge");
+  // A resumed bake whose checkpoint has a damaged record warns that it was dropped.
+  pvs::Reader baked = pvs::Reader::from_file(dir + "/a.pvs");
+  auto damaged_checkpoint = [&] {
+    const std::string ckpt = dir + "/r.pvs.ckpt";
+    {
+      vislib::Checkpoint cp(ckpt, vislib::bake_key(baked.info(), vislib::Shard{}),
+                            baked.cell_count(), false);
+      cp.append(0, baked.read_cell(0));
+      cp.append(1, baked.read_cell(1));
+    }
+    std::string bytes = vislib::read_file(ckpt);
+    bytes[bytes.size() - 6] ^= 0x10;  // inside the last record
+    vislib::write_file_atomic(ckpt, bytes);
+  };
+  damaged_checkpoint();
+  ASSERT_EQ(run_pvs_split(bake + "--resume -o " + dir + "/r.pvs", &out, &err), 0) << out << err;
+  EXPECT_NE(err.find("damaged or torn record(s) dropped"), std::string::npos) << err;
+  EXPECT_EQ(vislib::read_file(dir + "/r.pvs"), vislib::read_file(dir + "/a.pvs"));
+  damaged_checkpoint();
+  ASSERT_EQ(run_pvs_split(bake + "--resume -q -o " + dir + "/r.pvs", &out, &err), 0) << out << err;
+  EXPECT_EQ(err, "") << "bake --resume -q";
+  EXPECT_EQ(out, "") << "bake --resume -q";
+  // inspect, view (near-far, ODS, stereo) and bench on the baked file.
+  const std::string pvs = dir + "/a.pvs --scene " + obj;
+  check("inspect", "inspect " + pvs + " --at -15,1.6,-15 --frame 32x24 --render " + dir + "/i",
+        true, warned);
+  const std::string view = "view " + pvs + " --at -15,1.6,-15 ";
+  check("view", view + "--look 10,1.6,0 --frame 32x24 -o " + dir + "/v/f.png", false, warned);
+  check("view --ods", view + "--ods --ods-size 32 -o " + dir + "/o/p.png", false, warned);
+  check("view --stereo",
+        view + "--look 10,1.6,0 --frame 32x24 --stereo yoro -o " + dir + "/t/f.png", false,
+        "stereo");
+  // Bench with plots (when /usr/bin/python3 has matplotlib: its script is silenced too) and a
+  // from-point budget too small, which warns that from-point stopped.
+  check("bench",
+        "bench " + obj +
+            " --box -1,1.6,-1,1,1.6,1 --res 16 --views 2 --frame 24x16 --max-point-runs 3 --out " +
+            dir + "/b",
+        false, warned);
+  // Errors still print with -q.
+  EXPECT_EQ(run_pvs_split("info -q " + dir + "/missing.obj", &out, &err), 2);
+  EXPECT_NE(err.find("missing.obj"), std::string::npos) << err;
 }
 
 TEST(CliConventions, DashJIsThreads) {

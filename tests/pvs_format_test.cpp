@@ -456,6 +456,25 @@ TEST(PvsFormat, RunLengthWorkedExampleOfTheSpecIsExact) {
   EXPECT_EQ(decoded, ids);
 }
 
+// The whole block of the worked example (docs/pvs-format.md, RunLength) as the writer writes it in
+// a file: encoding byte, payload, and the CRC32C the doc gives (computed apart from pvs::crc32c).
+TEST(PvsFormat, RunLengthWorkedExampleIsTheBlockTheWriterWrites) {
+  pvs::FileInfo info;
+  info.universe = 256;
+  info.layout.kind = pvs::LayoutKind::Grid;
+  info.layout.grid_box = {{0, 0, 0}, {1, 1, 1}};
+  info.layout.nx = info.layout.ny = info.layout.nz = 1;
+  const std::vector<uint32_t> ids = {3, 4, 5, 9, 200, 201, 202};
+  const std::string file = pvs::write_pvs(info, {ids});
+  const std::string doc("\x01\x03\x03\x02\x02\x00\xBD\x01\x02\xBD\x22\xA2\x6C", 13);
+  ASSERT_GE(file.size(), doc.size());
+  EXPECT_EQ(file.substr(file.size() - doc.size()), doc);  // the only block ends the file
+  pvs::Reader r = pvs::Reader::from_memory(file);
+  EXPECT_EQ(r.block_info(0).encoding, pvs::Encoding::RunLength);
+  EXPECT_EQ(r.block_info(0).size, doc.size());
+  EXPECT_EQ(r.read_cell(0), ids);
+}
+
 // pvs::StreamWriter (and write_pvs, built on it) gives the bytes of the writer released before
 // streaming: the fnv1a64 of its output on two inputs that use every Delta reference (grid
 // neighbours along x, y, z; box list nearest centres up to 4096 cells back) was computed with

@@ -23,8 +23,10 @@ std::optional<std::string> shared_dir() {
   return std::nullopt;
 }
 
-int run_pvs(const std::string& args, std::string* output) {
-  std::string cmd = std::string(VISLIB_PVS_EXE) + " " + args + " 2>&1";
+namespace {
+
+// Runs `cmd` through the shell; returns its exit code and captures its stdout into `output`.
+int run_command(const std::string& cmd, std::string* output) {
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return -1;
   std::array<char, 4096> buf;
@@ -34,6 +36,31 @@ int run_pvs(const std::string& args, std::string* output) {
   int status = pclose(pipe);
   if (output) *output = out;
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+int run_pvs(const std::string& args, std::string* output) {
+  return run_command(std::string(VISLIB_PVS_EXE) + " " + args + " 2>&1", output);
+}
+
+int run_pvs_split(const std::string& args, std::string* out, std::string* err) {
+  static int serial = 0;
+  const std::string err_path =
+      (std::filesystem::temp_directory_path() /
+       ("vislib_test_stderr_" + std::to_string(::getpid()) + "_" + std::to_string(serial++)))
+          .string();
+  const int rc = run_command(std::string(VISLIB_PVS_EXE) + " " + args + " 2> " + err_path, out);
+  std::string e;
+  if (FILE* f = std::fopen(err_path.c_str(), "rb")) {
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) e.append(buf.data(), n);
+    std::fclose(f);
+  }
+  std::filesystem::remove(err_path);
+  if (err) *err = e;
+  return rc;
 }
 
 std::string temp_dir(const std::string& name) {

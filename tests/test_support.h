@@ -14,6 +14,8 @@ std::optional<std::string> shared_dir();
 // Runs the built `pvs` with `args` (a shell-quoted string); returns the exit code and captures
 // stdout+stderr into `output`.
 int run_pvs(const std::string& args, std::string* output = nullptr);
+// The same with stdout and stderr captured apart (stderr through a temporary file).
+int run_pvs_split(const std::string& args, std::string* out, std::string* err);
 // A fresh empty temporary directory for one test.
 std::string temp_dir(const std::string& name);
 
