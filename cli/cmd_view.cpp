@@ -134,9 +134,11 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
   vislib::EmbreeScene rt(scene, 0.0, eye);
   vislib::Frame truth = vislib::render_frame(scene, rt, cam);
   vislib::RegionCounts rc;
-  vislib::Frame morphed = vislib::render_near_far(scene, rt, tris, cam, s, &rc);
+  vislib::PixelSources morphed_sources, unmorphed_sources;
+  vislib::Frame morphed = vislib::render_near_far(scene, rt, tris, cam, s, &rc, &morphed_sources);
   s.morph = false;
-  vislib::Frame unmorphed = vislib::render_near_far(scene, rt, tris, cam, s);
+  vislib::Frame unmorphed =
+      vislib::render_near_far(scene, rt, tris, cam, s, nullptr, &unmorphed_sources);
 
   vislib::write_rgb8_image(a.output, fw, fh, morphed.rgb);
   vislib::write_rgb8_image(sibling(a.output, "_truth"), fw, fh, truth.rgb);
@@ -145,6 +147,7 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
                            vislib::error_heat_map(morphed, vislib::missed_pixels(truth, morphed)));
 
   json j = quality_json(scene, truth, morphed);
+  j.update(near_far_json(truth, morphed, morphed_sources, cam, a.delta_radius));
   j["file"] = a.file;
   j["cell"] = v.where.cell;
   j["eye"] = {eye.x, eye.y, eye.z};
@@ -168,6 +171,8 @@ void run_view(const ViewArgs& a, const ViewStereoArgs& stereo) {
       {"far_dynamic_drawn", rc.far_dynamic},
       {"far_dynamic_shown", rc.far_dynamic_shown}};
   j["without_morph"] = quality_json(scene, truth, unmorphed);
+  j["without_morph"].update(
+      near_far_json(truth, unmorphed, unmorphed_sources, cam, a.delta_radius));
   // Baseline: the cell's visible set rendered from geometry, no near-far partition.
   vislib::Frame pvs_frame = vislib::render_frame(
       scene, rt, cam, vislib::triangle_mask(scene.triangle_count(), tris).data());

@@ -56,6 +56,11 @@ void add_view_options(CLI::App* cmd, ViewArgs& a) {
       ->check(in_range(0.01, 0.99))
       ->capture_default_str();
   cmd->add_option("--frame", a.frame, "Frame size WxH")->capture_default_str();
+  cmd->add_option("--delta-radius", a.delta_radius,
+                  "Neighbourhood radius (pixels) of the near-far paper's discontinuity metric "
+                  "delta (Eq. 8), reported with and without the morph")
+      ->check(CLI::Range(0.5, 1000.0))
+      ->capture_default_str();
   cmd->add_option("--env-size", a.env_size,
                   "Environment map face side in pixels (default: the frame height)")
       ->check(in_range(0, 8192));

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "vislib/base/vec.h"
+#include "vislib/eval/discontinuity.h"
 
 namespace pvs_cli {
 
@@ -16,6 +17,7 @@ struct ViewArgs {
   bool grow = false;
   int env_size = 0, rings = 8, states = 1, frames_per_ring = 4;
   double near_fraction = 0.7, tau = 0, merge_min = -1;
+  double delta_radius = vislib::kDiscontinuityRadius;
 };
 
 // Adds the options of `pvs view` to `cmd`, storing into `a` (which must outlive `cmd`).

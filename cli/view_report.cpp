@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "cli/options.h"
+#include "vislib/eval/discontinuity.h"
 #include "vislib/eval/metrics.h"
 
 namespace pvs_cli {
@@ -34,6 +35,36 @@ json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
   j["ofc_eq2"] = c.ofc_eq2;
   j["objects_in_truth"] = c.objects;
   return j;
+}
+
+json near_far_json(const vislib::Frame& truth, const vislib::Frame& test,
+                   const vislib::PixelSources& sources, const vislib::Camera& camera,
+                   double radius) {
+  const std::vector<uint8_t> missed = vislib::missed_pixels(truth, test);
+  // Pixels and missed pixels per source: geometry (drawn where it is) or background, morphed
+  // geometry, environment map (dynamic far pixels count with geometry: drawn from the eye).
+  size_t count[3] = {0, 0, 0}, miss[3] = {0, 0, 0};
+  for (size_t p = 0; p < missed.size(); ++p) {
+    const int k = sources.source[p] == vislib::PixelSource::MorphedGeometry  ? 1
+                  : sources.source[p] == vislib::PixelSource::EnvironmentMap ? 2
+                                                                             : 0;
+    ++count[k];
+    miss[k] += missed[p] != 0;
+  }
+  const double n = double(missed.size());
+  const vislib::Discontinuity d = vislib::frame_discontinuity(camera, sources.point, radius);
+  return {{"morphed_pixels", double(count[1]) / n},
+          {"env_map_pixels", double(count[2]) / n},
+          {"epsilon_geometry", double(miss[0]) / n},
+          {"epsilon_morphed", double(miss[1]) / n},
+          {"epsilon_env_map", double(miss[2]) / n},
+          {"delta",
+           {{"mean", d.mean},
+            {"mean_abs", d.mean_abs},
+            {"max", d.max},
+            {"share_above_half", d.share_above_half},
+            {"pixels", d.pixels},
+            {"radius", radius}}}};
 }
 
 // "dir/name.png" -> "dir/name<suffix>.png"
@@ -81,6 +112,18 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
       j["ofc_eq2"].get<double>(), j["triangle_mismatch"].get<double>(), w["epsilon"].get<double>(),
       fmt_psnr(w["psnr"]).c_str(), w["ssim"].get<double>(), w["ovc"].get<double>(),
       w["ofc"].get<double>(), w["ofc_eq2"].get<double>(), w["triangle_mismatch"].get<double>());
+  std::fprintf(stderr,
+               "  delta (Eqs. 7-8, radius %g px), mean (mean |delta|): morph %.4f (%.4f), no "
+               "morph %.4f (%.4f)\n"
+               "  epsilon by source (morph / no morph): geometry %.4f / %.4f, morphed %.4f (%.1f%% "
+               "of pixels), environment map %.4f / %.4f (%.1f%% / %.1f%% of pixels)\n",
+               j["delta"]["radius"].get<double>(), j["delta"]["mean"].get<double>(),
+               j["delta"]["mean_abs"].get<double>(), w["delta"]["mean"].get<double>(),
+               w["delta"]["mean_abs"].get<double>(), j["epsilon_geometry"].get<double>(),
+               w["epsilon_geometry"].get<double>(), j["epsilon_morphed"].get<double>(),
+               100 * j["morphed_pixels"].get<double>(), j["epsilon_env_map"].get<double>(),
+               w["epsilon_env_map"].get<double>(), 100 * j["env_map_pixels"].get<double>(),
+               100 * w["env_map_pixels"].get<double>());
   if (dynamic)
     std::fprintf(stderr, "  tau %.4f: dynamic far triangles drawn %zu, shown %zu\n",
                  j["tau"].get<double>(), rc.far_dynamic, rc.far_dynamic_shown);

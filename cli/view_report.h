@@ -21,6 +21,15 @@ nlohmann::json frame_error_json(const vislib::Frame& truth, const vislib::Frame&
 nlohmann::json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
                             const vislib::Frame& test);
 
+// A near-far frame's epsilon split by pixel source (docs/runtime.md, "Metrics"): epsilon_geometry
+// and epsilon_env_map, shares of all pixels that are missed and drawn from geometry (or
+// background) / looked up in the environment map (they add up to epsilon), env_map_pixels, and
+// the discontinuity delta of the near-far paper (Eqs. 7-8) at `radius` pixels from each pixel's
+// scene point against the truth camera.
+nlohmann::json near_far_json(const vislib::Frame& truth, const vislib::Frame& test,
+                             const vislib::PixelSources& sources, const vislib::Camera& camera,
+                             double radius);
+
 // "dir/name.png" -> "dir/name<suffix>.png"
 std::string sibling(const std::string& out, const std::string& suffix);
 

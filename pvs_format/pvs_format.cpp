@@ -79,11 +79,6 @@ uint64_t fnv1a64(const void* data, size_t size, uint64_t hash) {
 
 // ---- Little-endian writing and bounds-checked reading -------------------------------------------
 
-namespace {
-
-void put_u8(std::string& out, uint8_t v) {
-  out.push_back(char(v));
-}
 void put_u32(std::string& out, uint32_t v) {
   for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
 }
@@ -94,6 +89,44 @@ void put_f64(std::string& out, double v) {
   uint64_t bits;
   std::memcpy(&bits, &v, 8);
   put_u64(out, bits);
+}
+
+// ---- The scene fingerprint --------------------------------------------------------------------
+
+SceneFingerprint::SceneFingerprint(uint64_t states, uint64_t vertices, uint64_t triangles,
+                                   uint64_t objects) {
+  static const char kTag[] = "vislib-scene-fingerprint-1";
+  std::string head(kTag, sizeof kTag - 1);
+  put_u64(head, states);
+  put_u64(head, vertices);
+  put_u64(head, triangles);
+  put_u64(head, objects);
+  hash_ = fnv1a64(head.data(), head.size());
+}
+
+void SceneFingerprint::add_position(double x, double y, double z) {
+  unsigned char b[24];
+  const double v[3] = {x, y, z};
+  for (int k = 0; k < 3; ++k) {
+    uint64_t bits;
+    std::memcpy(&bits, &v[k], 8);
+    for (int i = 0; i < 8; ++i) b[8 * k + i] = (unsigned char)((bits >> (8 * i)) & 0xFF);
+  }
+  hash_ = fnv1a64(b, sizeof b, hash_);
+}
+
+void SceneFingerprint::add_triangle(uint32_t a, uint32_t b, uint32_t c, uint32_t object) {
+  unsigned char bytes[16];
+  const uint32_t v[4] = {a, b, c, object};
+  for (int k = 0; k < 4; ++k)
+    for (int i = 0; i < 4; ++i) bytes[4 * k + i] = (unsigned char)((v[k] >> (8 * i)) & 0xFF);
+  hash_ = fnv1a64(bytes, sizeof bytes, hash_);
+}
+
+namespace {
+
+void put_u8(std::string& out, uint8_t v) {
+  out.push_back(char(v));
 }
 void put_varint(std::string& out, uint32_t v) {
   while (v >= 0x80) {

@@ -247,6 +247,32 @@ uint32_t crc32c(const void* data, size_t size, uint32_t crc = 0);
 constexpr uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ull;
 uint64_t fnv1a64(const void* data, size_t size, uint64_t hash = kFnvOffsetBasis);
 
+// Little-endian appenders of the format's byte streams (the file, vislib's checkpoint and the
+// scene fingerprint below).
+void put_u32(std::string& out, uint32_t v);
+void put_u64(std::string& out, uint64_t v);
+void put_f64(std::string& out, double v);  // the IEEE 754 bits, as put_u64
+
+// The scene fingerprint (docs/pvs-format.md, "The scene fingerprint"): FNV-1a 64 of the byte
+// stream "vislib-scene-fingerprint-1", the state, vertex, triangle and object counts (u64 each),
+// every vertex position (3 f64) of state 0 in vertex order, then of state 1, ..., then every
+// triangle in id order as its 3 vertex indices and its object id (u32 each). The one
+// implementation of that stream: vislib::scene_fingerprint (from a Scene) and the runtime's
+// pvs_rt_scene_fingerprint (from an engine's buffers) both feed it.
+// Usage: construct with the counts, call add_position for every position and then add_triangle
+// for every triangle, in the order above, then value(). The caller must feed exactly the counts it
+// declared (states = 0 for a scene without vertices); nothing checks it. O(1) memory.
+class SceneFingerprint {
+ public:
+  SceneFingerprint(uint64_t states, uint64_t vertices, uint64_t triangles, uint64_t objects);
+  void add_position(double x, double y, double z);
+  void add_triangle(uint32_t a, uint32_t b, uint32_t c, uint32_t object);
+  uint64_t value() const { return hash_; }
+
+ private:
+  uint64_t hash_;
+};
+
 // Appends `ids` (sorted, unique) as SortedDelta payload (count, first, gaps - 1).
 void append_sorted_delta(std::string& out, const std::vector<uint32_t>& ids);
 // Appends `ids` (sorted, unique) as RunLength payload (run count, then per run: zeros before it

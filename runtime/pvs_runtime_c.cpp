@@ -48,18 +48,6 @@ pvs_rt_status check_cell(const pvs_rt* h, uint32_t cell) {
   return PVS_RT_OK;
 }
 
-void put_u32(std::string& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
-}
-void put_u64(std::string& out, uint64_t v) {
-  for (int i = 0; i < 8; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
-}
-void put_f64(std::string& out, double v) {
-  uint64_t bits;
-  std::memcpy(&bits, &v, 8);
-  put_u64(out, bits);
-}
-
 }  // namespace
 
 namespace pvs_runtime::detail {
@@ -195,7 +183,8 @@ const char* pvs_rt_version_string(void) {
 }
 
 // The byte stream of docs/pvs-format.md, "The scene fingerprint" (the same stream as
-// vislib::scene_fingerprint, which the fingerprint test compares against), hashed in chunks.
+// vislib::scene_fingerprint, which the fingerprint test compares against), through the one
+// implementation of that stream, pvs::SceneFingerprint.
 pvs_rt_status pvs_rt_scene_fingerprint(const pvs_rt_mesh* meshes, size_t mesh_count,
                                        uint32_t state_count, uint32_t object_count,
                                        uint64_t* fingerprint) {
@@ -232,45 +221,30 @@ pvs_rt_status pvs_rt_scene_fingerprint(const pvs_rt_mesh* meshes, size_t mesh_co
   if (vertices + triangles > 0 && vertices + mesh_count > (uint64_t(1) << 32))
     return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_scene_fingerprint: more than 2^32 vertices");
   return guarded([&] {
-    static const char kTag[] = "vislib-scene-fingerprint-1";
-    std::string buf(kTag, sizeof kTag - 1);
     // A scene without vertices has no state (vislib::Scene::positions is empty).
-    put_u64(buf, vertices ? state_count : 0);
-    put_u64(buf, vertices);
-    put_u64(buf, triangles);
-    put_u64(buf, object_count);
-    uint64_t hash = pvs::fnv1a64(buf.data(), buf.size());
-    const size_t kChunk = 1 << 16;
-    auto flush = [&](bool force) {
-      if (force || buf.size() >= kChunk) {
-        hash = pvs::fnv1a64(buf.data(), buf.size(), hash);
-        buf.clear();
-      }
-    };
-    buf.clear();
-    for (uint32_t s = 0; vertices && s < state_count; ++s) {
+    pvs::SceneFingerprint f(vertices ? state_count : 0, vertices, triangles, object_count);
+    for (uint32_t s = 0; vertices && s < state_count; ++s)
       for (size_t m = 0; m < mesh_count; ++m) {
         const pvs_rt_mesh& mesh = meshes[m];
         const size_t base = 3 * size_t(s) * mesh.vertex_count;
-        for (size_t i = 0; i < 3 * mesh.vertex_count; ++i) {
-          put_f64(buf, mesh.positions_f64 ? mesh.positions_f64[base + i]
-                                          : double(mesh.positions_f32[base + i]));
-          flush(false);
+        for (size_t i = 0; i < mesh.vertex_count; ++i) {
+          double p[3];
+          for (int k = 0; k < 3; ++k)
+            p[k] = mesh.positions_f64 ? mesh.positions_f64[base + 3 * i + k]
+                                      : double(mesh.positions_f32[base + 3 * i + k]);
+          f.add_position(p[0], p[1], p[2]);
         }
       }
-    }
     uint32_t offset = 0;
     for (size_t m = 0; m < mesh_count; ++m) {
       const pvs_rt_mesh& mesh = meshes[m];
-      for (size_t t = 0; t < mesh.triangle_count; ++t) {
-        for (int k = 0; k < 3; ++k) put_u32(buf, offset + mesh.indices[3 * t + k]);
-        put_u32(buf, mesh.triangle_objects ? mesh.triangle_objects[t] : mesh.object_id);
-        flush(false);
-      }
+      for (size_t t = 0; t < mesh.triangle_count; ++t)
+        f.add_triangle(offset + mesh.indices[3 * t], offset + mesh.indices[3 * t + 1],
+                       offset + mesh.indices[3 * t + 2],
+                       mesh.triangle_objects ? mesh.triangle_objects[t] : mesh.object_id);
       offset += uint32_t(mesh.vertex_count);
     }
-    flush(true);
-    *fingerprint = hash;
+    *fingerprint = f.value();
     return PVS_RT_OK;
   });
 }

@@ -249,6 +249,19 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   EXPECT_GE(j["ssim"].get<double>(), -1.0);
   EXPECT_LE(j["ssim"].get<double>(), 1.0);
   EXPECT_TRUE(j["without_morph"].contains("ssim"));
+  // delta (Eqs. 7-8) and epsilon by pixel source, with and without the morph: the sources add up
+  // to epsilon, nothing is morphed without the morph.
+  for (const nlohmann::json* m : {&j, &j["without_morph"]}) {
+    const nlohmann::json& q = *m;
+    ASSERT_TRUE(q.contains("delta"));
+    EXPECT_GE(q["delta"]["mean_abs"].get<double>(), std::fabs(q["delta"]["mean"].get<double>()));
+    EXPECT_GT(q["delta"]["pixels"].get<size_t>(), 0u);
+    EXPECT_EQ(q["delta"]["radius"].get<double>(), 17.0);
+    EXPECT_NEAR(q["epsilon_geometry"].get<double>() + q["epsilon_morphed"].get<double>() +
+                    q["epsilon_env_map"].get<double>(),
+                q["epsilon"].get<double>(), 1e-12);
+  }
+  EXPECT_EQ(j["without_morph"]["morphed_pixels"].get<double>(), 0.0);
   // --grow: both ring sequences, merged radii a subsequence of the equal-area ones ending at r2,
   // every ring after the first injected over --frames-per-ring (default 4) frames.
   const nlohmann::json& c = j["continuity"];

@@ -20,9 +20,7 @@ namespace {
 constexpr char kCheckpointMagic[8] = {'P', 'V', 'S', 'C', 'K', 'P', 'T', '\n'};
 constexpr size_t kCheckpointHeader = 24;
 
-void put_u32(std::string& out, uint32_t v) {
-  for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xFF));
-}
+using pvs::put_u32;  // the format's little-endian appender
 uint32_t get_u32(const std::string& s, size_t at) {
   uint32_t v = 0;
   for (int i = 0; i < 4; ++i) v |= uint32_t(uint8_t(s[at + i])) << (8 * i);

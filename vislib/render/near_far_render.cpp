@@ -34,6 +34,10 @@ Vec3 to_vec(nf::Point3 p) {
   return {p.x, p.y, p.z};
 }
 
+const Vec3 kNanPoint{std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::quiet_NaN(),
+                     std::numeric_limits<double>::quiet_NaN()};
+
 uint8_t to_byte(double v) {
   double s = std::round(v * 255.0);
   return uint8_t(s < 0 ? 0 : (s > 255 ? 255 : s));
@@ -52,9 +56,11 @@ void shade(const Scene& scene, uint32_t tri, Vec3 dir, uint8_t* out) {
 
 // Renders the triangles `ids` of `scene` with vertex v displaced to displace(v) (one new vertex
 // per triangle corner), from `camera`, through render_frame; tri ids mapped back to scene ids.
+// If `original` is given, it receives per pixel the hit carried back to the undisplaced triangle
+// (same barycentric coordinates on the rest-pose corners), NaN where nothing is hit.
 template <class Displace>
 Frame render_displaced(const Scene& scene, const std::vector<uint32_t>& ids, const Camera& camera,
-                       Displace displace) {
+                       Displace displace, std::vector<Vec3>* original = nullptr) {
   Scene sub;
   sub.positions.resize(1);
   sub.objects = scene.objects;
@@ -73,18 +79,48 @@ Frame render_displaced(const Scene& scene, const std::vector<uint32_t>& ids, con
     f.rgb.assign(3 * f.pixel_count(), 0);
     f.depth.assign(f.pixel_count(), std::numeric_limits<float>::infinity());
     f.tri.assign(f.pixel_count(), kNoHit);
+    if (original) original->assign(f.pixel_count(), kNanPoint);
     return f;
   }
   EmbreeScene rt(sub, 0.0, camera.eye);
   f = render_frame(sub, rt, camera);
+  if (original) {
+    original->assign(f.pixel_count(), kNanPoint);
+    const auto& rest = scene.positions[0];
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
+          for (int y = rows.begin(); y != rows.end(); ++y)
+            for (int x = 0; x < camera.width; ++x) {
+              const size_t p = size_t(y) * size_t(camera.width) + size_t(x);
+              const uint32_t k = f.tri[p];
+              if (k == kNoHit) continue;
+              const Vec3 d = camera_ray(camera, x, y);
+              const Vec3 hit = camera.eye + d * (double(f.depth[p]) / length(d));
+              const Vec3 a = sub.positions[0][3 * size_t(k)],
+                         b = sub.positions[0][3 * size_t(k) + 1],
+                         c = sub.positions[0][3 * size_t(k) + 2];
+              const Vec3 e0 = b - a, e1 = c - a, e2 = hit - a;
+              const double d00 = dot(e0, e0), d01 = dot(e0, e1), d11 = dot(e1, e1);
+              const double d20 = dot(e2, e0), d21 = dot(e2, e1), den = d00 * d11 - d01 * d01;
+              const auto& t = scene.triangles[ids[k]];
+              if (!(den > 0)) {
+                (*original)[p] = rest[t[0]];
+                continue;
+              }
+              const double v = (d11 * d20 - d01 * d21) / den, w = (d00 * d21 - d01 * d20) / den;
+              (*original)[p] = rest[t[0]] * (1 - v - w) + rest[t[1]] * v + rest[t[2]] * w;
+            }
+        });
+  }
   for (auto& t : f.tri)
     if (t != kNoHit) t = ids[t];
   return f;
 }
 
-// Fills the pixels of `geometry` that hit nothing from `env` (see the header).
+// Fills the pixels of `geometry` that hit nothing from `env` (see the header); if `sources` is
+// given, marks them EnvironmentMap with the point the map shows along the lookup direction.
 void compose(Frame& geometry, const EnvironmentMap& env, const Camera& camera,
-             EnvironmentLookup lookup, double r2) {
+             EnvironmentLookup lookup, double r2, PixelSources* sources = nullptr) {
   const Vec3 o = env.centre, u = camera.eye;
   tbb::parallel_for(
       tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
@@ -115,6 +151,10 @@ void compose(Frame& geometry, const EnvironmentMap& env, const Camera& camera,
             geometry.tri[p] = env.tri[q];
             if (env.tri[q] == kNoHit) continue;
             const double range = env.range[q];
+            if (sources) {
+              sources->source[p] = PixelSource::EnvironmentMap;
+              sources->point[p] = o + look * (range / length(look));
+            }
             if (lookup == EnvironmentLookup::EyeDirection) {
               geometry.depth[p] = float(range);
             } else {
@@ -196,7 +236,7 @@ std::vector<uint8_t> moving_triangles(const Scene& scene) {
 
 Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
                       const std::vector<uint32_t>& visible, const Camera& camera,
-                      const NearFarSettings& s, RegionCounts* counts) {
+                      const NearFarSettings& s, RegionCounts* counts, PixelSources* sources) {
   assert(s.r1 >= 0 && s.r1 < s.r2 && s.env_size >= 1);
   const nf::Point3 o = to_point(s.centre), u = to_point(camera.eye);
   assert(nf::axis_distance(u, o) < s.r1);
@@ -223,18 +263,35 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
     for (uint32_t t : part.geometry_ids)
       if (!far_dyn[t]) geometry_ids.push_back(t);
   }
-  Frame f = render_displaced(scene, geometry_ids, camera, [&](uint32_t v) {
-    if (!s.morph) return pos[v];
-    return to_vec(nf::morph_vertex(to_point(pos[v]), u, o, s.r1, s.r2));
-  });
+  if (sources) {
+    sources->source.assign(size_t(camera.width) * size_t(camera.height), PixelSource::None);
+    sources->point.assign(sources->source.size(), kNanPoint);
+  }
+  Frame f = render_displaced(
+      scene, geometry_ids, camera,
+      [&](uint32_t v) {
+        if (!s.morph) return pos[v];
+        return to_vec(nf::morph_vertex(to_point(pos[v]), u, o, s.r1, s.r2));
+      },
+      sources ? &sources->point : nullptr);
+  if (sources) {
+    const std::vector<uint8_t> intermediate =
+        triangle_mask(scene.triangle_count(), part.intermediate_ids);
+    for (size_t p = 0; p < f.pixel_count(); ++p)
+      if (f.tri[p] != kNoHit)
+        sources->source[p] = s.morph && intermediate[f.tri[p]] ? PixelSource::MorphedGeometry
+                                                               : PixelSource::Geometry;
+  }
   const EnvironmentMap env = render_environment_map(
       scene, rt, s.centre, s.env_size,
       triangle_mask(scene.triangle_count(), part.environment_map_ids).data());
   if (!part.far_dynamic_ids.empty()) {
     // Eq. 2 displacement, then Eq. 3 against the map's range, then the depth test against geometry.
-    const Frame dyn = render_displaced(scene, part.far_dynamic_ids, camera, [&](uint32_t v) {
-      return to_vec(nf::displace_far(to_point(pos[v]), u, o));
-    });
+    std::vector<Vec3> dyn_points;
+    const Frame dyn = render_displaced(
+        scene, part.far_dynamic_ids, camera,
+        [&](uint32_t v) { return to_vec(nf::displace_far(to_point(pos[v]), u, o)); },
+        sources ? &dyn_points : nullptr);
     const nf::RangeCubeMap range{env.size, env.range.data()};
     tbb::parallel_for(
         tbb::blocked_range<int>(0, camera.height), [&](const tbb::blocked_range<int>& rows) {
@@ -248,6 +305,10 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
                 continue;
               f.tri[p] = dyn.tri[p];
               f.depth[p] = dyn.depth[p];
+              if (sources) {
+                sources->source[p] = PixelSource::DynamicFar;
+                sources->point[p] = dyn_points[p];
+              }
               for (int k = 0; k < 3; ++k) f.rgb[3 * p + size_t(k)] = dyn.rgb[3 * p + size_t(k)];
             }
         });
@@ -257,7 +318,7 @@ Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
     for (uint32_t t : part.far_dynamic_ids) rc.far_dynamic_shown += shown[t];
   }
   if (counts) *counts = rc;
-  compose(f, env, camera, s.lookup, s.r2);
+  compose(f, env, camera, s.lookup, s.r2, sources);
   return f;
 }
 

@@ -103,13 +103,39 @@ struct EnvironmentMap {
 EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt, Vec3 centre,
                                       int size, const uint8_t* allowed);
 
+// Where each pixel of a near-far frame comes from, and the scene point it stands for (for the
+// discontinuity metric delta, vislib/eval/discontinuity.h, and for epsilon per source):
+//  - Geometry: a near triangle, or an intermediate one with the morph off, drawn where it is; the
+//    point is the eye ray's hit;
+//  - MorphedGeometry: an intermediate triangle drawn displaced by Eq. 1 (morph on); the point is
+//    the hit carried back to the undisplaced triangle (same barycentric coordinates on the
+//    rest-pose corners), i.e. the scene point before the morph;
+//  - EnvironmentMap: looked up in the map; the point is O + range * (lookup direction), the scene
+//    point the map shows in that direction (its range from the nearest map pixel);
+//  - DynamicFar: a moving far triangle drawn by Eq. 2; the point is the hit minus the Eq. 2
+//    displacement (U - O), i.e. the triangle's true position;
+//  - None: background; the point is NaN.
+enum class PixelSource : uint8_t {
+  None = 0,
+  Geometry = 1,
+  MorphedGeometry = 2,
+  EnvironmentMap = 3,
+  DynamicFar = 4
+};
+struct PixelSources {
+  std::vector<PixelSource> source;  // per pixel, row-major
+  std::vector<Vec3> point;          // per pixel, world coordinates; NaN for None
+};
+
 // The near-far frame of the visible triangles `visible` (sorted unique ids < triangle_count())
 // seen by `camera`, as described above. `rt` must be built from `scene` at tau = 0 (it renders the
 // environment map). camera.eye must be strictly inside r1 of O's axis (the user is in the near
-// region). `counts`, if not null, receives the region counts.
+// region). `counts`, if not null, receives the region counts; `sources`, if not null, each pixel's
+// source and scene point (above).
 Frame render_near_far(const Scene& scene, const EmbreeScene& rt,
                       const std::vector<uint32_t>& visible, const Camera& camera,
-                      const NearFarSettings& settings, RegionCounts* counts = nullptr);
+                      const NearFarSettings& settings, RegionCounts* counts = nullptr,
+                      PixelSources* sources = nullptr);
 
 // The CloVR frame while ring `ring_radius` is injected with the near region at radius big_r
 // (object level, CloVR §3, Alg. 1): the triangles (of `visible`) of every object with a visible
