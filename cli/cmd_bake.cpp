@@ -42,10 +42,13 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
     std::fprintf(
         stderr,
         "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
-        "%llu bytes (%.1f per cell) written to %s\n",
+        "%llu bytes (%.1f per cell) written to %s; %llu from-segment runs, %llu of them shared "
+        "between neighbouring cells\n",
         r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
         static_cast<unsigned long long>(r.stats.file_bytes),
-        r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a.output.c_str());
+        r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a.output.c_str(),
+        static_cast<unsigned long long>(r.segment_runs_computed + r.segment_runs_shared),
+        static_cast<unsigned long long>(r.segment_runs_shared));
   if (a.json_out.empty()) return;
   const std::string text = vislib::bake_report_json(info, r);
   if (a.json_out == "-")
