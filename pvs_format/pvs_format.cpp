@@ -492,9 +492,11 @@ StreamWriter::StreamWriter(FileInfo info, Sink sink) : impl_(std::make_unique<Im
     if (uint64_t(L.nx) * L.ny * L.nz > 0xFFFFFFFFull)
       throw std::invalid_argument("write_pvs: grid has more than 2^32-1 cells");
     check_box(L.grid_box, "grid box");
+    const uint32_t dims[3] = {L.nx, L.ny, L.nz};
     for (int a = 0; a < 3; ++a)
-      if (!std::isfinite(L.grid_box.max[a] - L.grid_box.min[a]))
-        throw std::invalid_argument("write_pvs: grid box extent overflows a double");
+      if (!std::isfinite((L.grid_box.max[a] - L.grid_box.min[a]) * double(dims[a])))
+        throw std::invalid_argument(
+            "write_pvs: grid box extent times the cell count overflows a double");
     if (!std::isfinite(L.eye_lo) || !std::isfinite(L.eye_hi) || !(L.eye_lo <= L.eye_hi))
       throw std::invalid_argument("write_pvs: eye band must be finite with eye_lo <= eye_hi");
   } else {
@@ -825,6 +827,11 @@ void Reader::open(const ReadOptions& options) {
     L.ny = l.u32();
     L.nz = l.u32();
     if (L.nx == 0 || L.ny == 0 || L.nz == 0) throw FormatError(at, "grid dimension 0");
+    // cell_box computes min + (max - min) * i / n: the product must not overflow for i <= n.
+    const uint32_t dims[3] = {L.nx, L.ny, L.nz};
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite((L.grid_box.max[a] - L.grid_box.min[a]) * double(dims[a])))
+        throw FormatError(at, "grid box extent times the cell count overflows a double");
     if (uint64_t(L.nx) * L.ny * L.nz != n)
       throw FormatError(at, "grid " + std::to_string(L.nx) + "x" + std::to_string(L.ny) + "x" +
                                 std::to_string(L.nz) + " does not have the header's " +

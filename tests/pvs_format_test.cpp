@@ -310,6 +310,18 @@ TEST(PvsFormat, InconsistentFieldsBehindValidChecksumsAreRejected) {
   ++count;
   std::memcpy(&f[index + 12], &count, 4);
   expect_rejected(f, "the index says");
+  // A grid box whose extent is finite but whose extent times the cell count is not: cell_box's
+  // (max - min) * i would overflow to inf (found by pvs_reader_fuzz after 1M runs, 2026-11-23).
+  f = good;
+  const double lo = -5e307, hi = 5e307;  // extent 1e308 (finite); times nx = 4 overflows
+  std::memcpy(&f[64 + 0], &lo, 8);
+  std::memcpy(&f[64 + 24], &hi, 8);
+  expect_rejected(f, "extent times the cell count overflows");
+  // The writer refuses the same layout.
+  Sample w = grid_sample();
+  w.info.layout.grid_box.min[0] = lo;
+  w.info.layout.grid_box.max[0] = hi;
+  EXPECT_THROW(pvs::write_pvs(w.info, w.cells), std::invalid_argument);
 }
 
 TEST(PvsFormat, HugeClaimsAreRejectedBeforeAllocating) {
