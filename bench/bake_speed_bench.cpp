@@ -21,21 +21,16 @@
 #include <memory>
 #include <string>
 
+#include "bench/peak_memory.h"
 #include "vislib/bake/bake.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/generate.h"
 
 using namespace vislib;
+using vislib_bench::peak_mb;
+using vislib_bench::reset_peak;
 
 namespace {
-
-double peak_mb() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-  return 0;
-}
 
 // CPU seconds of the whole process (user + system): on one core the fair figure on a loaded
 // machine, where wall time also counts other processes' turns.
@@ -44,11 +39,6 @@ double process_cpu() {
   getrusage(RUSAGE_SELF, &u);
   return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
          1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
-void reset_peak() {
-  std::ofstream f("/proc/self/clear_refs");
-  if (f) f << "5";
 }
 
 }  // namespace

@@ -38,6 +38,7 @@
 #include <sstream>
 #include <string>
 
+#include "bench/peak_memory.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/point_visibility.h"
 #include "vislib/kernel/segment_visibility.h"
@@ -45,6 +46,8 @@
 #include "vislib/scene/import.h"
 
 using namespace vislib;
+using vislib_bench::peak_mb;
+using vislib_bench::reset_peak;
 
 namespace {
 
@@ -91,19 +94,6 @@ std::vector<Case> all_cases() {
                {-10, 1.7, 0},
                {10, 1.7, 0}});
   return v;
-}
-
-// Peak resident memory since the last reset (Linux; 0 elsewhere).
-void reset_peak() {
-  std::ofstream f("/proc/self/clear_refs");
-  if (f) f << "5";
-}
-double peak_mb() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
-  return 0;
 }
 
 // CPU seconds of the calling thread (what a one-thread arena's work costs, whatever else runs).
