@@ -29,6 +29,12 @@ struct ImageModule {
   vislib_image_read_fn read = nullptr;
 };
 
+#ifdef VISLIB_IMAGE_MODULE_LINKED
+const ImageModule& image_module() {
+  static const ImageModule module{&vislib_image_write, &vislib_image_read};
+  return module;
+}
+#else
 // The folder of the running executable (empty if unknown).
 std::filesystem::path executable_dir() {
   std::error_code ec;
@@ -97,6 +103,7 @@ const ImageModule& image_module() {
   if (!module.write) throw std::runtime_error(failure);
   return module;
 }
+#endif
 
 void write_image(const std::string& path, int width, int height, int channels, bool is_float,
                  const char* channel_name, const void* pixels) {

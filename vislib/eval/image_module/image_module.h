@@ -36,6 +36,15 @@ typedef int (*vislib_image_read_fn)(const char* path, int want_float, int max_ch
 #define VISLIB_IMAGE_WRITE_SYMBOL "vislib_image_write"
 #define VISLIB_IMAGE_READ_SYMBOL "vislib_image_read"
 
+// The module's two functions (image_oiio.cpp), called directly when the module is linked in
+// (sanitizer builds, VISLIB_IMAGE_MODULE_LINKED) instead of loaded.
+int vislib_image_write(const char* final_path, const char* tmp_path, int width, int height,
+                       int channels, int is_float, const char* channel_name, const void* pixels,
+                       char* err, size_t errlen);
+int vislib_image_read(const char* path, int want_float, int max_channels,
+                      void* (*alloc)(void* ctx, size_t bytes), void* ctx, int* width, int* height,
+                      int* channels, char* err, size_t errlen);
+
 #ifdef __cplusplus
 }
 #endif
