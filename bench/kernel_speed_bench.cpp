@@ -118,11 +118,13 @@ double median(std::vector<double> v) {
 }
 
 bool g_scalar = false;  // --scalar: SegmentOptions::simd = false
+int g_tile = 0;         // --tile T: SegmentOptions::tile_size (0: the default)
 
 SegmentOptions options(int n) {
   SegmentOptions o;
   o.resolution = n;
   o.simd = !g_scalar;
+  if (g_tile > 0) o.tile_size = g_tile;
   return o;
 }
 
@@ -251,12 +253,14 @@ int main(int argc, char** argv) {
       digest_file = next();
     else if (a == "--res")
       res = std::stoi(next());
+    else if (a == "--tile")
+      g_tile = std::max(1, std::stoi(next()));
     else if (a == "--scalar")
       g_scalar = true;
     else {
       std::fprintf(stderr,
                    "usage: kernel_speed_bench [--reps R] [--cases a,b] [--cores 1|all|both] "
-                   "[--digest FILE --res N] [--scalar]\n");
+                   "[--digest FILE --res N] [--scalar] [--tile T]\n");
       return 2;
     }
   }

@@ -6,6 +6,7 @@
 
 #include "tests/scene_builders.h"
 #include "vislib/base/random.h"
+#include "vislib/base/tolerances.h"
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/segment_visibility.h"
 #include "vislib/scene/generate.h"
@@ -78,6 +79,49 @@ TEST(KernelSpeed, FootprintBoundsWithoutTheHullEqualTheHullsBounds) {
     }
   }
   EXPECT_GT(nonempty, 1000);
+}
+
+// reachable_faces decides all six faces' quick frustum reject from one set of dot products. It
+// must agree face by face with the reject computed in each face's own frame (projected_points'
+// test, restated here), and the footprint must be empty on every face it excludes: under random
+// rotations, and with points on the frustum planes (x = +-y = z lies on several of them).
+TEST(KernelSpeed, ReachableFacesAgreeWithThePerFaceRejectAndExcludeOnlyEmptyFootprints) {
+  Rng rng(29);
+  int excluded = 0;
+  for (int trial = 0; trial < 6000; ++trial) {
+    const Mat3 R = trial % 4 == 0 ? Mat3{} : random_orientation(uint64_t(trial));
+    Vec3 rel[6];
+    for (Vec3& q : rel) q = {rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)};
+    if (trial % 3 == 0)  // small, far triangles: most reach one face
+      for (int i = 1; i < 6; ++i) rel[i] = rel[0] + (rel[i] - rel[0]) * 0.01;
+    if (trial % 5 == 0)  // on frustum planes of the world-aligned cube
+      for (Vec3& q : rel) q = Vec3{1, rng.uniform() < 0.5 ? 1.0 : -1.0, 1} * rng.uniform(-2, 2);
+    const double near = trial % 7 == 0 ? 0.5 : 0.05;
+    const unsigned mask = reachable_faces(rel, 6, R, near);
+    for (int face = 0; face < 6; ++face) {
+      const FaceAxes ax = face_axes(face, R);
+      const double g = 1.0 + kFrustumRejectWidening;
+      bool behind = true, right = true, left = true, up = true, down = true;
+      for (const Vec3& r : rel) {
+        const Vec3 q{dot(ax.S, r), dot(ax.T, r), dot(ax.F, r)};
+        const double z = std::fabs(q.z) * g;
+        behind = behind && q.z < near;
+        right = right && q.x > z;
+        left = left && q.x < -z;
+        up = up && q.y > z;
+        down = down && q.y < -z;
+      }
+      const bool rejected = behind || right || left || up || down;
+      ASSERT_EQ(!(mask >> face & 1), rejected) << trial << " " << face;
+      if (!rejected) continue;
+      ++excluded;
+      int b[4];
+      double z;
+      ASSERT_FALSE(footprint_bounds(rel, 6, ax, near, 64, b[0], b[1], b[2], b[3], z));
+      ASSERT_TRUE(compute_footprint(rel, 6, ax, near).empty());
+    }
+  }
+  EXPECT_GT(excluded, 5000);  // 8,746 with these seeds
 }
 
 TEST(KernelSpeed, VectorisedCoverageGivesBitIdenticalPiecesAndWitnesses) {

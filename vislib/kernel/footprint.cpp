@@ -49,6 +49,23 @@ double margin_of(const Footprint& fp) {
 
 namespace {
 
+// Quick reject: the face-frame points q (x = S.p, y = T.p, z = F.p) all lie on the outer side of
+// one plane of the face's frustum (near plane, or one of |u| <= 1, |w| <= 1 widened by
+// kFrustumRejectWidening), so their clipped hull misses the face.
+bool frustum_reject(const Vec3* q, int count, double near) {
+  const double g = 1.0 + kFrustumRejectWidening;
+  bool behind = true, right = true, left = true, up = true, down = true;
+  for (int i = 0; i < count; ++i) {
+    const double z = std::fabs(q[i].z) * g;
+    behind = behind && q[i].z < near;
+    right = right && q[i].x > z;
+    left = left && q[i].x < -z;
+    up = up && q[i].y > z;
+    down = down && q[i].y < -z;
+  }
+  return behind || right || left || up || down;
+}
+
 // The projected, clipped points of §5.1 (before the hull): at most kMaxFootprintPoints. Returns
 // -1 when the quick frustum reject applies (the footprint is empty), else the point count; zmin
 // (if given) gets the smallest view depth F.rel[i].
@@ -63,22 +80,7 @@ int projected_points(const Vec3* rel, int count, const FaceAxes& axes, double ne
     for (int i = 0; i < count; ++i) z = std::min(z, q[i].z);
     *zmin = z;
   }
-  // Quick reject: all points on the outer side of one plane of the face's frustum (near plane, or
-  // one of |u| <= 1, |w| <= 1 widened by kFrustumRejectWidening), so the clipped hull misses the
-  // face.
-  {
-    const double g = 1.0 + kFrustumRejectWidening;
-    bool behind = true, right = true, left = true, up = true, down = true;
-    for (int i = 0; i < count; ++i) {
-      const double z = std::fabs(q[i].z) * g;
-      behind = behind && q[i].z < near;
-      right = right && q[i].x > z;
-      left = left && q[i].x < -z;
-      up = up && q[i].y > z;
-      down = down && q[i].y < -z;
-    }
-    if (behind || right || left || up || down) return -1;
-  }
+  if (frustum_reject(q, count, near)) return -1;
   int n = 0;
   for (int i = 0; i < count; ++i)
     if (q[i].z >= near) pts[n++] = {q[i].x / q[i].z, q[i].y / q[i].z};
@@ -139,6 +141,50 @@ bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double n
   double m = 0;
   for (int i = 0; i < k; ++i) m = std::max({m, std::fabs(pts[i].u), std::fabs(pts[i].w)});
   return bounds_of(pts, k, kFootprintMargin + kFootprintRelativeMargin * m, n, x0, x1, y0, y1);
+}
+
+unsigned reachable_faces(const Vec3* rel, int count, const Mat3& R, double near) {
+  // World axes A_j = R e_j. Every face axis R a (a = +-e_j, face_axes) equals +-A_j component by
+  // component (up to the sign of zero components), so dot(R a, p) = +-dot(A_j, p) bit for bit
+  // (negation is exact and rounding symmetric), and frustum_reject's tests become tests on the
+  // coordinates c_j = dot(A_j, p): for a face with F = +-A_f and S or T = +-A_j, "all points right
+  // of (or all left of) the side plane" is all c_j > |c_f| g or all c_j < -|c_f| g whatever the
+  // signs, and "all behind" is all +-c_f < near.
+  const Vec3 A[3] = {R * Vec3{1, 0, 0}, R * Vec3{0, 1, 0}, R * Vec3{0, 0, 1}};
+  const double g = 1.0 + kFrustumRejectWidening;
+  bool above[3][3], below[3][3];      // [j][f]: every point has c_j > |c_f| g, resp. c_j < -|c_f| g
+  bool behind_pos[3], behind_neg[3];  // every point has c_f < near, resp. -c_f < near
+  for (int a = 0; a < 3; ++a) {
+    behind_pos[a] = behind_neg[a] = true;
+    for (int b = 0; b < 3; ++b) above[a][b] = below[a][b] = true;
+  }
+  count = std::min(count, 12);
+  for (int i = 0; i < count; ++i) {
+    const double c[3] = {dot(A[0], rel[i]), dot(A[1], rel[i]), dot(A[2], rel[i])};
+    for (int f = 0; f < 3; ++f) {
+      const double z = std::fabs(c[f]) * g;
+      behind_pos[f] = behind_pos[f] && c[f] < near;
+      behind_neg[f] = behind_neg[f] && -c[f] < near;
+      for (int j = 0; j < 3; ++j) {
+        above[j][f] = above[j][f] && c[j] > z;
+        below[j][f] = below[j][f] && c[j] < -z;
+      }
+    }
+  }
+  auto axis = [](Vec3 a, int& sign) {  // index and sign of a signed unit axis
+    sign = (a.x + a.y + a.z) > 0 ? 1 : -1;
+    return a.x != 0 ? 0 : a.y != 0 ? 1 : 2;
+  };
+  unsigned mask = 0;
+  for (int k = 0; k < kCubeFaces; ++k) {
+    const FaceAxes ax = face_axes_local(k);
+    int sf, ss, st;
+    const int f = axis(ax.F, sf), js = axis(ax.S, ss), jt = axis(ax.T, st);
+    const bool rejected = (sf > 0 ? behind_pos[f] : behind_neg[f]) || above[js][f] ||
+                          below[js][f] || above[jt][f] || below[jt][f];
+    if (!rejected) mask |= 1u << k;
+  }
+  return mask;
 }
 
 bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y0, int& y1) {

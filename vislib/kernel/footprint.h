@@ -45,6 +45,12 @@ bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y
 bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double near, int n, int& x0,
                       int& x1, int& y0, int& y1, double& zmin);
 
+// Bit k set for every cube face k (orientation R) on which footprint_bounds / compute_footprint
+// of the same points may be non-empty: the faces that their quick frustum reject does not
+// exclude, decided for all six faces from one set of dot products (bit-identical to the per-face
+// test). Lets a kernel skip the per-face work of a primitive on the faces it cannot reach.
+unsigned reachable_faces(const Vec3* rel, int count, const Mat3& R, double near);
+
 // Columns [x0, x1] of row `y` whose centres may lie in the footprint; false when none.
 bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1);
 

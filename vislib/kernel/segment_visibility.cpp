@@ -340,6 +340,17 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
 
   std::vector<int> bbox(ntri * 4);
   std::vector<float> zmin(ntri);
+  // (0) the faces each triangle may reach, for all six faces at once (issue 13, item 4: most
+  // triangles reach one face, and the per-face pass below then skips the other five).
+  std::vector<uint8_t> faces(ntri);
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t t = r.begin(); t != r.end(); ++t) {
+          auto c = scene.corners(uint32_t(t), opt.state);
+          Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
+          faces[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
+        }
+      });
   std::vector<uint32_t> bin_start(tile_count + 1);
   std::vector<FaceTriangle> bins;
 
@@ -350,9 +361,14 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     tbb::parallel_for(
         tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
           for (size_t t = r.begin(); t != r.end(); ++t) {
+            int* b = &bbox[t * 4];
+            if (!(faces[t] >> face & 1)) {
+              b[0] = 1;
+              b[1] = 0;  // empty: footprint_bounds would reject it
+              continue;
+            }
             auto c = scene.corners(uint32_t(t), opt.state);
             Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-            int* b = &bbox[t * 4];
             double z;
             if (!footprint_bounds(rel, 6, axes, opt.near, N, b[0], b[1], b[2], b[3], z)) {
               b[0] = 1;
