@@ -119,12 +119,14 @@ double median(std::vector<double> v) {
 
 bool g_scalar = false;  // --scalar: SegmentOptions::simd = false
 int g_tile = 0;         // --tile T: SegmentOptions::tile_size (0: the default)
+bool g_first = false;   // --coplanar first: CoplanarRule::First (default: both, as pvs segment)
 
 SegmentOptions options(int n) {
   SegmentOptions o;
   o.resolution = n;
   o.simd = !g_scalar;
   if (g_tile > 0) o.tile_size = g_tile;
+  if (g_first) o.coplanar = CoplanarRule::First;
   return o;
 }
 
@@ -255,12 +257,14 @@ int main(int argc, char** argv) {
       res = std::stoi(next());
     else if (a == "--tile")
       g_tile = std::max(1, std::stoi(next()));
+    else if (a == "--coplanar")
+      g_first = next() == "first";
     else if (a == "--scalar")
       g_scalar = true;
     else {
       std::fprintf(stderr,
                    "usage: kernel_speed_bench [--reps R] [--cases a,b] [--cores 1|all|both] "
-                   "[--digest FILE --res N] [--scalar] [--tile T]\n");
+                   "[--digest FILE --res N] [--scalar] [--tile T] [--coplanar first|both]\n");
       return 2;
     }
   }

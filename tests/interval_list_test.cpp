@@ -135,3 +135,63 @@ TEST(IntervalList, ValidityCheckRejectsOverlapsUnmergedNeighboursAndEmptyPieces)
   EXPECT_FALSE(is_valid(PieceList{Piece{0.5, 0.5, 1, {}}}));
   EXPECT_TRUE(is_valid(PieceList{Piece{0, 0.5, 1, {}}, Piece{0.5, 1, 2, {}}}));
 }
+
+// The read-only pass of insert_piece decides crossings, the nearer piece and the tie test for
+// linear depths from products instead of quotients (issue 13). Wherever those decide, the answer
+// must be the one the divisions give; checked on random depths and on near-equal ones (the same
+// plane scaled, depths one rounding apart, crossings at the interval ends), where they must mostly
+// stay undecided rather than guess.
+TEST(IntervalList, DivisionFreeDecisionsAgreeWithTheQuotients) {
+  Rng rng(41);
+  auto random_depth = [&rng]() {
+    return LinearDepth{rng.uniform(-50, 50), rng.uniform(-50, 50),
+                       (rng.uniform() < 0.5 ? -1 : 1) * rng.uniform(0.01, 3)};
+  };
+  int decided_near = 0, decided_cross = 0, decided_tie = 0, undecided = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    LinearDepth a = random_depth(), b = random_depth();
+    const int kind = trial % 4;
+    if (kind == 1) {  // the same depth function scaled: equal quotients up to rounding
+      const double s = rng.uniform(0.5, 2);
+      b = LinearDepth{a.n0 * s, a.n1 * s, a.dn * s};
+    } else if (kind == 2) {  // within the tie tolerance
+      b = LinearDepth{a.n0 * (1 + rng.uniform(-2e-6, 2e-6)), a.n1, a.dn};
+    }
+    double lo = rng.uniform(0, 1), hi = rng.uniform(0, 1);
+    if (lo > hi) std::swap(lo, hi);
+    if (kind == 3) {  // an interval end at the crossing of a and b
+      double c[kMaxCrossings];
+      if (depth_crossings(a, b, 0, 1, c) == 1) (rng.uniform() < 0.5 ? lo : hi) = c[0];
+    }
+    if (!(lo < hi)) continue;
+    const double t = 0.5 * (lo + hi);
+    double x, y;
+    const int near = detail::linear_nearer(a, b, t, x, y);
+    const double da = a.at(t), db = b.at(t);
+    if (near != 0) {
+      ++decided_near;
+      ASSERT_EQ(near < 0, da < db) << trial;
+      ASSERT_EQ(near > 0, db < da) << trial;
+    }
+    const int cross = detail::linear_crossing(a, b, lo, hi);
+    double c[kMaxCrossings];
+    const int n = depth_crossings(a, b, lo, hi, c);
+    if (cross >= 0) {
+      ++decided_cross;
+      ASSERT_EQ(cross, n > 0 ? 1 : 0) << trial;
+    } else {
+      ++undecided;
+    }
+    if (near < 0) {  // a wins: the tie test is record_tie's first one, at t
+      const double eps = trial % 8 < 4 ? 1e-6 : 0.0;
+      if (detail::linear_not_tied(x, y, eps)) {
+        ++decided_tie;
+        ASSERT_FALSE(std::fabs(db - da) <= eps * std::fabs(da)) << trial;
+      }
+    }
+  }
+  EXPECT_GT(decided_near, 100000);
+  EXPECT_GT(decided_cross, 100000);
+  EXPECT_GT(decided_tie, 50000);
+  EXPECT_GT(undecided, 100);  // the constructed near-ties do reach the fallback
+}

@@ -248,8 +248,8 @@ INSTANTIATE_TEST_SUITE_P(StaticScenes, SharedSceneOracle,
                                            "godot_occlusion_room/room.glb",
                                            "gk_dream_apartment/dream-apartment.glb",
                                            "khronos_boxanimated/BoxAnimated.gltf"),
-                         [](const auto& info) {
-                           std::string s = info.param;
+                         [](const auto& param_info) {
+                           std::string s = param_info.param;
                            std::string out;
                            for (char c : s.substr(0, s.find('/')))
                              out += std::isalnum((unsigned char)c) ? c : '_';

@@ -25,6 +25,7 @@
 #include <cmath>
 #include <cstdint>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 namespace vislib {
@@ -96,6 +97,59 @@ void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& l
   rule.sink->push_back(TieRecord{t0, t1, loser.id, winner.id});
 }
 
+// ---- Division-free decisions for linear depths (issue 13, item 2) ---------------------------
+// The read-only pass of insert_piece asks, per overlapped piece, three questions whose answers
+// come from rounded quotients: is there a depth crossing in (lo, hi) (depth_crossings), which
+// piece is in front at the midpoint (front), and is the loser within eps_z there (record_tie).
+// Each quotient q = num/den is compared here through products instead: when the difference is
+// large against the rounding of the products (relative 2^-50), the rounded quotients keep the
+// same strict order, so the answer is the one the division would give. Otherwise (near-equal,
+// tiny or non-finite magnitudes) the answer is "undecided" and the caller divides as before.
+
+// Sign of q - c for q = num/den, den != 0: 1 or -1 when decided with the margin above, else 0.
+// When it returns 1, fl(num/den) > c; when -1, fl(num/den) < c (c a double).
+inline int quotient_vs(double num, double den, double c) {
+  const double cd = c * den, e = num - cd;
+  const double mag = std::fabs(num) + std::fabs(cd);
+  if (!(mag < INFINITY) || !(mag > 0x1p-900) || !(std::fabs(e) > 0x1p-50 * mag)) return 0;
+  return (e > 0) == (den > 0) ? 1 : -1;
+}
+
+// depth_crossings(i, j, lo, hi) > 0 for linear depths (i, j in id order): 1 yes, 0 no, -1
+// undecided.
+inline int linear_crossing(const LinearDepth& i, const LinearDepth& j, double lo, double hi) {
+  const double den = i.n1 * j.dn - j.n1 * i.dn;  // as depth_crossings computes them
+  if (den == 0) return 0;
+  const double num = i.n0 * j.dn - j.n0 * i.dn;
+  const int a = quotient_vs(num, den, lo);
+  if (a < 0) return 0;
+  const int b = quotient_vs(num, den, hi);
+  if (b > 0) return 0;
+  return a > 0 && b < 0 ? 1 : -1;
+}
+
+// Which of a, b is nearer at t (a.at(t) < b.at(t): -1; b.at(t) < a.at(t): 1; 0 undecided, which
+// includes equal depths). x and y get the products na*b.dn and nb*a.dn of at()'s numerators, for
+// linear_not_tied.
+inline int linear_nearer(const LinearDepth& a, const LinearDepth& b, double t, double& x,
+                         double& y) {
+  const double na = a.n0 - a.n1 * t, nb = b.n0 - b.n1 * t;  // at()'s numerators, bit for bit
+  x = na * b.dn;
+  y = nb * a.dn;
+  const double d = x - y, mag = std::fabs(x) + std::fabs(y);
+  if (!(mag < INFINITY) || !(mag > 0x1p-900) || !(std::fabs(d) > 0x1p-50 * mag)) return 0;
+  // a.at - b.at = (x - y) / (a.dn b.dn) up to the rounding decided away above.
+  return (d < 0) == ((a.dn > 0) == (b.dn > 0)) ? -1 : 1;
+}
+
+// True when record_tie's first test (|l - w| <= eps |w| at t) certainly fails for the winner w and
+// the loser l whose products linear_nearer returned (x for w, y for l); false: undecided.
+inline bool linear_not_tied(double x, double y, double eps) {
+  const double mag = std::fabs(x) + std::fabs(y);
+  if (!(mag < INFINITY) || !(mag > 0x1p-900)) return false;
+  return std::fabs(x - y) > eps * std::fabs(x) * (1 + 0x1p-30) + 0x1p-48 * mag;
+}
+
 template <class D>
 int crossings(const PieceT<D>& a, const PieceT<D>& b, double lo, double hi, double* out) {
   return a.id < b.id ? depth_crossings(a.depth, b.depth, lo, hi, out)
@@ -159,9 +213,30 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
         break;
       }
       double lo = std::max(cur, I.t0), hi = std::min(f, I.t1);
-      changes =
-          detail::crossings(I, p, lo, hi, cuts) > 0 || &detail::front(I, p, 0.5 * (lo + hi)) == &p;
-      if (!changes && ties.sink) detail::record_tie(ties, I, p, lo, hi);
+      bool tie_checked = false;
+      if constexpr (std::is_same_v<D, LinearDepth>) {
+        // The same answers without divisions where the products decide them (see above).
+        double x, y;
+        const int near = detail::linear_nearer(I.depth, p.depth, 0.5 * (lo + hi), x, y);
+        if (near > 0) {
+          changes = true;  // p in front at the midpoint
+        } else {
+          const int cross = I.id < p.id ? detail::linear_crossing(I.depth, p.depth, lo, hi)
+                                        : detail::linear_crossing(p.depth, I.depth, lo, hi);
+          if (cross < 0)
+            changes = detail::crossings(I, p, lo, hi, cuts) > 0;
+          else
+            changes = cross > 0;
+          if (!changes && near == 0) changes = &detail::front(I, p, 0.5 * (lo + hi)) == &p;
+          // I in front at the midpoint (decided): record_tie's first test, on the same products.
+          tie_checked =
+              !changes && near < 0 && ties.sink && detail::linear_not_tied(x, y, ties.eps_z);
+        }
+      } else {
+        changes = detail::crossings(I, p, lo, hi, cuts) > 0 ||
+                  &detail::front(I, p, 0.5 * (lo + hi)) == &p;
+      }
+      if (!changes && ties.sink && !tie_checked) detail::record_tie(ties, I, p, lo, hi);
       cur = hi;
     }
     if (!changes && cur >= f) return false;
@@ -236,10 +311,13 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
     uint32_t id;
     double t0, t1;
   };
-  std::vector<Stretch> vis;
-  vis.reserve(list.size() + ties.size());
+  // Scratch kept per thread: this runs for every pixel with ties (millions in a street), and two
+  // allocations per pixel cost more than the search itself.
+  thread_local std::vector<Stretch> vis;
+  thread_local std::vector<size_t> scanned;  // per record: stretches already intersected
+  vis.clear();
   for (const PieceT<D>& p : list) vis.push_back({p.id, p.t0, p.t1});
-  std::vector<size_t> scanned(ties.size(), 0);  // per record: stretches already intersected
+  scanned.assign(ties.size(), 0);
   for (bool grew = true; grew;) {
     grew = false;
     const size_t n = vis.size();
