@@ -311,31 +311,41 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
     uint32_t id;
     double t0, t1;
   };
-  // Scratch kept per thread: this runs for every pixel with ties (millions in a street), and two
-  // allocations per pixel cost more than the search itself.
-  thread_local std::vector<Stretch> vis;
-  thread_local std::vector<size_t> scanned;  // per record: stretches already intersected
-  vis.clear();
-  for (const PieceT<D>& p : list) vis.push_back({p.id, p.t0, p.t1});
-  scanned.assign(ties.size(), 0);
-  for (bool grew = true; grew;) {
-    grew = false;
-    const size_t n = vis.size();
-    for (size_t r = 0; r < ties.size(); ++r) {
-      const TieRecord& tr = ties[r];
-      for (size_t e = scanned[r]; e < n; ++e) {
-        if (vis[e].id != tr.front) continue;
-        double a = std::max(tr.t0, vis[e].t0), b = std::min(tr.t1, vis[e].t1);
-        if (!(a < b)) continue;
-        bool known = false;
-        for (const Stretch& v : vis) known = known || (v.id == tr.hidden && v.t0 == a && v.t1 == b);
-        if (known) continue;
-        vis.push_back({tr.hidden, a, b});
-        f(tr.hidden, a, b);
-        grew = true;
-      }
-      scanned[r] = n;
+  // Stretches added by the records, kept per thread (this runs for every pixel with ties, millions
+  // in a street). Every record is intersected once with every stretch of the list and of `added`
+  // (the closure does not depend on the order); the list is sorted and disjoint, so a record meets
+  // only the pieces over its own [t0, t1).
+  thread_local std::vector<Stretch> added;
+  added.clear();
+  auto known = [&](uint32_t id, double a, double b) {
+    for (const PieceT<D>& p : list) {
+      if (p.t0 > a) break;
+      if (p.t0 == a) return p.id == id && p.t1 == b;
     }
+    for (const Stretch& v : added)
+      if (v.id == id && v.t0 == a && v.t1 == b) return true;
+    return false;
+  };
+  auto meet = [&](const TieRecord& tr, uint32_t id, double t0, double t1) {
+    if (id != tr.front) return;
+    const double a = std::max(tr.t0, t0), b = std::min(tr.t1, t1);
+    if (!(a < b) || known(tr.hidden, a, b)) return;
+    added.push_back({tr.hidden, a, b});
+    f(tr.hidden, a, b);
+  };
+  for (const TieRecord& tr : ties) {
+    size_t e = 0;
+    while (e < list.size() && !(tr.t0 < list[e].t1)) ++e;
+    for (; e < list.size() && list[e].t0 < tr.t1; ++e) meet(tr, list[e].id, list[e].t0, list[e].t1);
+  }
+  for (size_t done = 0; done < added.size();) {  // then the stretches each round added
+    const size_t n = added.size();
+    for (const TieRecord& tr : ties)
+      for (size_t e = done; e < n; ++e) {
+        const Stretch v = added[e];  // a copy: meet() may grow `added`
+        meet(tr, v.id, v.t0, v.t1);
+      }
+    done = n;
   }
 }
 
