@@ -29,6 +29,7 @@
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
 #include "vislib/kernel/static_coverage.h"
+#include "vislib/kernel/tile_driver.h"
 
 namespace vislib {
 
@@ -399,240 +400,209 @@ struct Run {
   bool diagonal;      // part of the Diagonal mode (its pieces map onto t)
 };
 
-void run_kernel(const Scene& scene, const Run& run, const SegmentOptions& opt,
-                tbb::enumerable_thread_specific<FoundMarks>& found_by_thread,
-                std::vector<std::vector<GeneralPiece>>* pieces,
-                std::vector<SegmentStats>& all_stats) {
-  const int N = opt.resolution, TS = opt.tile_size;
-  const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
-  const size_t ntri = scene.triangle_count(), nsph = scene.sphere_count(), nprim = ntri + nsph;
-  const auto& P0 = scene.positions.empty()
-                       ? std::vector<Vec3>{}
-                       : scene.positions[std::min(run.k0, scene.positions.size() - 1)];
-  const auto& P1 = scene.positions.empty()
-                       ? std::vector<Vec3>{}
-                       : scene.positions[std::min(run.k1, scene.positions.size() - 1)];
-  const auto& C0 = scene.sphere_centers.empty()
-                       ? std::vector<Vec3>{}
-                       : scene.sphere_centers[std::min(run.k0, scene.sphere_centers.size() - 1)];
-  const auto& C1 = scene.sphere_centers.empty()
-                       ? std::vector<Vec3>{}
-                       : scene.sphere_centers[std::min(run.k1, scene.sphere_centers.size() - 1)];
-  auto tri_corners = [&](const std::vector<Vec3>& P, size_t t) {
-    const auto& ix = scene.triangles[t];
-    return std::array<Vec3, 3>{P[ix[0]], P[ix[1]], P[ix[2]]};
-  };
-  std::vector<int> bbox(nprim * 4);
-  // Bounds of the view depth of every primitive over the run on this face: any hit of it at any s
-  // has zmin <= lambda <= zmax (the eye-relative triangle lies in the hull of its six eye-relative
-  // vertices; the sphere within r of its eye-relative centre, which moves linearly).
-  std::vector<double> zmin(nprim), zmax(nprim);
-  std::vector<uint32_t> bin_start(tile_count + 1);
-  struct Binned {
-    uint32_t id;
-    double zmin;
-  };
-  std::vector<Binned> bins;
+// One run of moving triangles and spheres for the tile driver (tile_driver.h): footprints of the
+// six eye-relative corners (triangles) or of the swept sphere, coverage as intervals with general
+// depths, exact depth culling with each piece's primitive's farthest depth over the run.
+class DynamicKind {
+ public:
   struct Scratch {
     std::vector<std::vector<GeneralPiece>> lists;
     std::vector<double> far;  // per pixel: farthest zmax over its pieces once they cover [0,1]
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
-  tbb::enumerable_thread_specific<Scratch> scratch([TS] {
-    return Scratch{std::vector<std::vector<GeneralPiece>>(size_t(TS) * TS),
-                   std::vector<double>(size_t(TS) * TS),
-                   std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
-  });
-  const bool keep_ties = opt.coplanar == CoplanarRule::Both;
-  const double far_scale = keep_ties ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
 
-  for (int face = 0; face < 6; ++face) {
-    const FaceAxes axes = face_axes(face, opt.orientation);
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, nprim, 512), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t p = r.begin(); p != r.end(); ++p) {
-            int* b = &bbox[p * 4];
-            bool ok;
-            if (p < ntri) {
-              auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
-              Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0,
-                             a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
-              ok = footprint_pixel_bounds(compute_footprint(rel, 6, axes, opt.near), N, b[0], b[1],
-                                          b[2], b[3]);
-              double lo = INFINITY, hi = -INFINITY;
-              for (const Vec3& q : rel) {
-                lo = std::min(lo, dot(axes.F, q));
-                hi = std::max(hi, dot(axes.F, q));
-              }
-              zmin[p] = lo;
-              zmax[p] = hi;
-            } else {
-              size_t s = p - ntri;
-              const double radius = scene.sphere_radius[s];
-              ok = sphere_pixel_bounds(C0[s] - run.e0, C1[s] - run.e1, radius, axes, opt.near, N,
-                                       b[0], b[1], b[2], b[3]);
-              double z0 = dot(axes.F, C0[s] - run.e0), z1 = dot(axes.F, C1[s] - run.e1);
-              zmin[p] = std::min(z0, z1) - radius;
-              zmax[p] = std::max(z0, z1) + radius;
-            }
-            if (!ok) b[0] = 1, b[1] = 0;
-          }
-        });
-    bin_by_tile(bbox, nprim, TS, tiles_x, bin_start, bins, [&](size_t p) {
-      return Binned{uint32_t(p), zmin[p]};
-    });
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-          Scratch& sc = scratch.local();
-          auto& lists = sc.lists;
-          FoundMarks& found = found_by_thread.local();
-          for (int tile = r.begin(); tile != r.end(); ++tile) {
-            SegmentStats& stats = all_stats[size_t(face) * tile_count + tile];
-            const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
-            const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
-            const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
-            for (auto& l : lists) l.clear();
-            for (auto& l : sc.ties) l.clear();
-            std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-            Binned* tb = bins.data() + bin_start[tile];
-            Binned* te = bins.data() + bin_start[tile + 1];
-            // Front to back by nearest possible depth (ties by id); exact depth culling as in the
-            // static kernel, with each piece's primitive's zmax as its farthest depth.
-            std::sort(tb, te, [](const Binned& a, const Binned& b) {
-              return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
-            });
-            auto update_far = [&](size_t k) {
-              const auto& l = lists[k];
-              if (!covers_segment(l)) return;
-              double f = -INFINITY;
-              for (const GeneralPiece& pc : l) f = std::max(f, zmax[pc.id]);
-              sc.far[k] = f * far_scale;
-            };
-            Interval iv[kMaxIntervals];
-            double tile_far = INFINITY;
-            int since_check = 0;
-            for (Binned* bp = tb; bp != te; ++bp) {
-              const uint32_t p = bp->id;
-              ++stats.triangle_tiles;
-              if (opt.depth_culling) {
-                if (++since_check >= 16 || bp == tb) {
-                  since_check = 0;
-                  double f = -INFINITY;
-                  for (int yy = 0; yy < th && f < INFINITY; ++yy)
-                    for (int xx = 0; xx < tw; ++xx) f = std::max(f, sc.far[size_t(yy) * TS + xx]);
-                  tile_far = f;
-                }
-                if (bp->zmin > tile_far) {
-                  stats.culled_triangle_tiles += uint64_t(te - bp);
-                  stats.triangle_tiles += uint64_t(te - bp) - 1;
-                  break;
-                }
-              }
-              const int* b = &bbox[size_t(p) * 4];
-              const int y0 = std::max(ty0, b[2]), y1 = std::min(ty1, b[3]);
-              if (p < ntri) {
-                auto a0 = tri_corners(P0, p), a1 = tri_corners(P1, p);
-                MovingTriangle mt = prepare_moving(a0, a1, run.e0, run.e1);
-                if (!mt.moving && mt.lin.n == Vec3{0, 0, 0}) continue;  // degenerate (H5)
-                Vec3 rel[6] = {a0[0] - run.e0, a0[1] - run.e0, a0[2] - run.e0,
-                               a1[0] - run.e1, a1[1] - run.e1, a1[2] - run.e1};
-                Footprint fp = compute_footprint(rel, 6, axes, opt.near);
-                for (int y = y0; y <= y1; ++y) {
-                  int x0, x1;
-                  if (!footprint_row_span(fp, N, y, x0, x1)) continue;
-                  x0 = std::max(x0, tx0);
-                  x1 = std::min(x1, tx1);
-                  for (int x = x0; x <= x1; ++x) {
-                    const size_t k = size_t(y - ty0) * TS + (x - tx0);
-                    if (opt.depth_culling && bp->zmin > sc.far[k]) {
-                      ++stats.culled_pairs;
-                      continue;
-                    }
-                    ++stats.pair_tests;
-                    int n = moving_coverage(mt, pixel_direction(axes, x, y, N), axes.S, axes.T,
-                                            opt.near, iv);
-                    if (n) ++stats.covered_pairs;
-                    bool changed = false;
-                    const TieRule tie{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
-                    for (int i = 0; i < n; ++i)
-                      changed |= insert_piece(
-                          lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth}, tie);
-                    if (changed && opt.depth_culling) update_far(k);
-                  }
-                }
-              } else {
-                size_t s = p - ntri;
-                MovingSphere sp{run.e0 - C0[s], (run.e1 - run.e0) - (C1[s] - C0[s]),
-                                scene.sphere_radius[s]};
-                for (int y = y0; y <= y1; ++y)
-                  for (int x = std::max(tx0, b[0]); x <= std::min(tx1, b[1]); ++x) {
-                    const size_t k = size_t(y - ty0) * TS + (x - tx0);
-                    if (opt.depth_culling && bp->zmin > sc.far[k]) {
-                      ++stats.culled_pairs;
-                      continue;
-                    }
-                    ++stats.pair_tests;
-                    int n = sphere_coverage(sp, pixel_direction(axes, x, y, N), opt.near, iv);
-                    if (n) ++stats.covered_pairs;
-                    bool changed = false;
-                    const TieRule tie{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
-                    for (int i = 0; i < n; ++i)
-                      changed |= insert_piece(
-                          lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth}, tie);
-                    if (changed && opt.depth_culling) update_far(k);
-                  }
-              }
-            }
-            size_t bytes = 0;
-            for (int y = ty0; y <= ty1; ++y)
-              for (int x = tx0; x <= tx1; ++x) {
-                auto& l = lists[size_t(y - ty0) * TS + (x - tx0)];
-                bytes += l.capacity() * sizeof(GeneralPiece);
-                if (l.empty()) continue;
-                ++stats.pixels_with_pieces;
-                stats.final_pieces += l.size();
-                stats.max_pieces_per_pixel =
-                    std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-                const auto& ties = sc.ties[size_t(y - ty0) * TS + (x - tx0)];
-                for_each_visible(l, ties, [&](uint32_t id, double t0, double t1) {
-                  // Length in the segment parameter (Diagonal) or in animation time (eye fixed).
-                  double span =
-                      std::max(std::fabs(run.t1 - run.t0), std::fabs(run.tau1 - run.tau0));
-                  double len = (t1 - t0) * span;
-                  if (!(len > opt.eps_len)) return;
-                  double sm = 0.5 * (t0 + t1);
-                  bool sph = id >= ntri;
-                  Witness w;
-                  w.tri = sph ? uint32_t(id - ntri) : id;
-                  w.is_sphere = sph;
-                  w.face = face;
-                  w.x = x;
-                  w.y = y;
-                  w.t = run.t0 + sm * (run.t1 - run.t0);
-                  w.tau = run.tau0 + sm * (run.tau1 - run.tau0);
-                  found.mark(id, len, w);
-                });
-                if (pieces && run.diagonal) {
-                  auto& dst = (*pieces)[(size_t(face) * N + y) * N + x];
-                  for (GeneralPiece pc : l) {
-                    pc.t0 = run.t0 + pc.t0 * (run.t1 - run.t0);
-                    pc.t1 = pc.t1 == 1.0 ? run.t1 : run.t0 + pc.t1 * (run.t1 - run.t0);
-                    if (!(pc.t0 < pc.t1)) continue;
-                    // Depth functions stay in the run's local parameter; callers that evaluate them
-                    // map t back with (t - run.t0) / (run.t1 - run.t0).
-                    if (!dst.empty() && dst.back().id == pc.id && dst.back().t1 == pc.t0 &&
-                        pc.t0 == run.t0)
-                      dst.back().t1 = pc.t1;
-                    else
-                      dst.push_back(pc);
-                  }
-                }
-              }
-            stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
-          }
-        });
+  DynamicKind(const Scene& scene, const Run& run, const SegmentOptions& opt,
+              std::vector<std::vector<GeneralPiece>>* pieces)
+      : scene_(scene),
+        run_(run),
+        opt_(opt),
+        pieces_(pieces),
+        ntri_(scene.triangle_count()),
+        P0_(state_of(scene.positions, run.k0)),
+        P1_(state_of(scene.positions, run.k1)),
+        C0_(state_of(scene.sphere_centers, run.k0)),
+        C1_(state_of(scene.sphere_centers, run.k1)) {
+    const size_t nprim = count();
+    zmax_.resize(nprim);
+    keep_ties_ = opt.coplanar == CoplanarRule::Both;
+    far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
+    // The faces each triangle may reach over the run (reachable_faces, as the static kernel).
+    faces_.resize(ntri_);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ntri_, 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t t = r.begin(); t != r.end(); ++t) {
+                          Vec3 rel[6];
+                          relative_corners(t, rel);
+                          faces_[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
+                        }
+                      });
   }
-}
+
+  size_t count() const { return ntri_ + scene_.sphere_count(); }
+
+  Scratch make_scratch(int ts) const {
+    const size_t n = size_t(ts) * size_t(ts);
+    return Scratch{std::vector<std::vector<GeneralPiece>>(n), std::vector<double>(n),
+                   std::vector<std::vector<TieRecord>>(n)};
+  }
+
+  // Bounds of the view depth of every primitive over the run on this face: any hit of it at any s
+  // has zmin <= lambda <= zmax (the eye-relative triangle lies in the hull of its six eye-relative
+  // vertices; the sphere within r of its eye-relative centre, which moves linearly).
+  bool bounds(size_t p, int face, const FaceAxes& axes, int* b, double& zmin) {
+    if (p < ntri_) {
+      if (!(faces_[p] >> face & 1)) return false;
+      Vec3 rel[6];
+      relative_corners(p, rel);
+      double lo = INFINITY, hi = -INFINITY;
+      for (const Vec3& q : rel) {
+        lo = std::min(lo, dot(axes.F, q));
+        hi = std::max(hi, dot(axes.F, q));
+      }
+      zmin = lo;
+      zmax_[p] = hi;
+      double z;  // footprint_bounds: the hull's rectangle without the hull (bit-identical)
+      return footprint_bounds(rel, 6, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], z);
+    }
+    const size_t s = p - ntri_;
+    const double radius = scene_.sphere_radius[s];
+    const double z0 = dot(axes.F, C0_[s] - run_.e0), z1 = dot(axes.F, C1_[s] - run_.e1);
+    zmin = std::min(z0, z1) - radius;
+    zmax_[p] = std::max(z0, z1) + radius;
+    return sphere_pixel_bounds(C0_[s] - run_.e0, C1_[s] - run_.e1, radius, axes, opt_.near,
+                               opt_.resolution, b[0], b[1], b[2], b[3]);
+  }
+
+  void begin_tile(Scratch& sc) const {
+    for (auto& l : sc.lists) l.clear();
+    for (auto& l : sc.ties) l.clear();
+  }
+
+  void cover(Scratch& sc, const TileItem& item, const int* b, const TileRect& rect,
+             const FaceAxes& axes, SegmentStats& stats) const {
+    const int N = opt_.resolution;
+    const uint32_t p = item.id;
+    const double tz = double(item.zmin);
+    const int y0 = std::max(rect.y0, b[2]), y1 = std::min(rect.y1, b[3]);
+    Interval iv[kMaxIntervals];
+    // Culling, coverage and insertion at pixel (x, y) with coverage(d, iv) -> interval count.
+    auto pixel = [&](int x, int y, auto&& coverage) {
+      const size_t k = rect.index(x, y);
+      if (opt_.depth_culling && tz > sc.far[k]) {
+        ++stats.culled_pairs;
+        return;
+      }
+      ++stats.pair_tests;
+      const int n = coverage(pixel_direction(axes, x, y, N), iv);
+      if (n) ++stats.covered_pairs;
+      bool changed = false;
+      const TieRule tie{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
+      for (int i = 0; i < n; ++i)
+        changed |= insert_piece(sc.lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth}, tie);
+      if (changed && opt_.depth_culling) update_far(sc, k);
+    };
+    if (p < ntri_) {
+      auto a0 = corners(P0_, p), a1 = corners(P1_, p);
+      MovingTriangle mt = prepare_moving(a0, a1, run_.e0, run_.e1);
+      if (!mt.moving && mt.lin.n == Vec3{0, 0, 0}) return;  // degenerate (H5)
+      Vec3 rel[6];
+      relative_corners(p, rel);
+      Footprint fp = compute_footprint(rel, 6, axes, opt_.near);
+      auto coverage = [&](Vec3 d, Interval* out) {
+        return moving_coverage(mt, d, axes.S, axes.T, opt_.near, out);
+      };
+      for (int y = y0; y <= y1; ++y) {
+        int x0, x1;
+        if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+        for (int x = std::max(x0, rect.x0); x <= std::min(x1, rect.x1); ++x) pixel(x, y, coverage);
+      }
+    } else {
+      const size_t s = p - ntri_;
+      MovingSphere sp{run_.e0 - C0_[s], (run_.e1 - run_.e0) - (C1_[s] - C0_[s]),
+                      scene_.sphere_radius[s]};
+      auto coverage = [&](Vec3 d, Interval* out) { return sphere_coverage(sp, d, opt_.near, out); };
+      for (int y = y0; y <= y1; ++y)
+        for (int x = std::max(rect.x0, b[0]); x <= std::min(rect.x1, b[1]); ++x)
+          pixel(x, y, coverage);
+    }
+  }
+
+  void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found,
+                    SegmentStats& stats, size_t& bytes) const {
+    auto& l = sc.lists[k];
+    bytes += l.capacity() * sizeof(GeneralPiece);
+    if (l.empty()) return;
+    ++stats.pixels_with_pieces;
+    stats.final_pieces += l.size();
+    stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+    // Length in the segment parameter (Diagonal) or in animation time (eye fixed).
+    const double span = std::max(std::fabs(run_.t1 - run_.t0), std::fabs(run_.tau1 - run_.tau0));
+    for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
+      double len = (t1 - t0) * span;
+      if (!(len > opt_.eps_len)) return;
+      double sm = 0.5 * (t0 + t1);
+      bool sph = id >= ntri_;
+      Witness w;
+      w.tri = sph ? uint32_t(id - ntri_) : id;
+      w.is_sphere = sph;
+      w.face = face;
+      w.x = x;
+      w.y = y;
+      w.t = run_.t0 + sm * (run_.t1 - run_.t0);
+      w.tau = run_.tau0 + sm * (run_.tau1 - run_.tau0);
+      found.mark(id, len, w);
+    });
+    if (!pieces_ || !run_.diagonal) return;
+    const int N = opt_.resolution;
+    auto& dst = (*pieces_)[(size_t(face) * N + y) * N + x];
+    for (GeneralPiece pc : l) {
+      pc.t0 = run_.t0 + pc.t0 * (run_.t1 - run_.t0);
+      pc.t1 = pc.t1 == 1.0 ? run_.t1 : run_.t0 + pc.t1 * (run_.t1 - run_.t0);
+      if (!(pc.t0 < pc.t1)) continue;
+      // Depth functions stay in the run's local parameter; callers that evaluate them map t back
+      // with (t - run.t0) / (run.t1 - run.t0).
+      if (!dst.empty() && dst.back().id == pc.id && dst.back().t1 == pc.t0 && pc.t0 == run_.t0)
+        dst.back().t1 = pc.t1;
+      else
+        dst.push_back(pc);
+    }
+  }
+
+ private:
+  static const std::vector<Vec3>& state_of(const std::vector<std::vector<Vec3>>& states, size_t k) {
+    static const std::vector<Vec3> none;
+    return states.empty() ? none : states[std::min(k, states.size() - 1)];
+  }
+  std::array<Vec3, 3> corners(const std::vector<Vec3>& P, size_t t) const {
+    const auto& ix = scene_.triangles[t];
+    return {P[ix[0]], P[ix[1]], P[ix[2]]};
+  }
+  void relative_corners(size_t t, Vec3* rel) const {
+    auto a0 = corners(P0_, t), a1 = corners(P1_, t);
+    const Vec3 r[6] = {a0[0] - run_.e0, a0[1] - run_.e0, a0[2] - run_.e0,
+                       a1[0] - run_.e1, a1[1] - run_.e1, a1[2] - run_.e1};
+    std::copy(r, r + 6, rel);
+  }
+  // A covered pixel's far: the largest zmax over the primitives of its pieces.
+  void update_far(Scratch& sc, size_t k) const {
+    const auto& l = sc.lists[k];
+    if (!covers_segment(l)) return;
+    double f = -INFINITY;
+    for (const GeneralPiece& pc : l) f = std::max(f, zmax_[pc.id]);
+    sc.far[k] = f * far_scale_;
+  }
+
+  const Scene& scene_;
+  const Run& run_;
+  const SegmentOptions& opt_;
+  std::vector<std::vector<GeneralPiece>>* pieces_;
+  size_t ntri_;
+  const std::vector<Vec3>&P0_, &P1_, &C0_, &C1_;
+  std::vector<double> zmax_;  // per primitive, on the current face (bounds() writes it)
+  std::vector<uint8_t> faces_;
+  bool keep_ties_ = false;
+  double far_scale_ = 1.0;
+};
 
 }  // namespace
 
@@ -667,9 +637,10 @@ SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
       [&] { return FoundMarks(nprim, opt.want_witnesses); });
   const int tiles_x = (opt.resolution + opt.tile_size - 1) / opt.tile_size;
   std::vector<SegmentStats> stats(size_t(6) * tiles_x * tiles_x);
-  for (const Run& run : runs)
-    run_kernel(scene, run, opt, found_by_thread, opt.want_pieces ? &result.general_pieces : nullptr,
-               stats);
+  for (const Run& run : runs) {
+    DynamicKind kind(scene, run, opt, opt.want_pieces ? &result.general_pieces : nullptr);
+    run_tiles(kind, opt, found_by_thread, stats);
+  }
   for (const SegmentStats& ts : stats) result.stats.add(ts);
   std::vector<uint8_t> seen;
   std::vector<Witness> best;

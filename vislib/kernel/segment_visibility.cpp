@@ -2,12 +2,11 @@
 // Paper: "Complex VEs on All-In-One VR Headsets Through Continuous From-Segment Visibility
 // Computation", §3.1, Alg. 1. Math: shared/design/visibility-math.md §1, §2, §5.1, §6, §7.
 //
-// Structure (per cube face): (1) every triangle's footprint bounding box and nearest possible
-// depth; (2) counting-sort binning into tiles of tile_size^2 pixels; (3) tiles in parallel: the
-// tile's triangles front to back, coverage interval per pixel of the footprint's row spans,
-// lower-envelope insertion; triangles whose nearest depth lies behind everything in a fully
-// covered tile are skipped (exact: they cannot be first anywhere there); (4) per-tile results
-// reduced in tile order, so nothing depends on scheduling.
+// The faces, tiles, front-to-back order and per-tile culling are the tile driver's
+// (tile_driver.h, shared with the dynamic kernel). This file is the static kind: the faces each
+// triangle can reach (classified once), its footprint bounds there, coverage 4 pixels at a time
+// (AVX2 when the CPU has it, bit-identical to the scalar path), lower-envelope insertion of linear
+// depths, and exact per-pixel culling (plane depth, and the depth envelope over t-bins).
 #include "vislib/kernel/segment_visibility.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -28,6 +27,7 @@
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
 #include "vislib/kernel/static_coverage.h"
+#include "vislib/kernel/tile_driver.h"
 
 namespace vislib {
 
@@ -287,9 +287,176 @@ bool cpu_has_avx2() {
 #endif
 }
 
-struct FaceTriangle {
-  uint32_t id;
-  float zmin;  // nearest possible view depth over the segment (rounded down)
+// The static triangles of one segment for the tile driver (tile_driver.h): footprint bounds on
+// the faces each triangle can reach, coverage 4 pixels at a time, exact depth culling with the
+// per-pixel depth envelope, lists of linear depths.
+class StaticKind {
+ public:
+  struct Scratch {
+    std::vector<PieceList> lists;
+    std::vector<double> env;  // kEnvBins per pixel: the depth envelope
+    std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
+    std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
+  };
+
+  StaticKind(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt,
+             std::vector<PieceList>* pieces)
+      : scene_(scene), v0_(v0), v1_(v1), opt_(opt), pieces_(pieces) {
+    const size_t ntri = scene.triangle_count();
+    const int N = opt.resolution;
+    keep_ties_ = opt.coplanar == CoplanarRule::Both;
+    // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of
+    // it, so only triangles beyond far * (1 + eps_z) are skipped (2 eps_z covers the rounding).
+    far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;
+    // Pixel-centre coordinates (pixel_center), padded so that 4 lanes can always be loaded.
+    pixel_centers_.assign(size_t(N) + 4, 0.0);
+    for (int i = 0; i < N; ++i) pixel_centers_[size_t(i)] = pixel_center(i, N);
+#ifdef VISLIB_HAVE_AVX2_PATH
+    coverage4_ = opt.simd && cpu_has_avx2() ? coverage4_avx2 : coverage4_scalar;
+#else
+    coverage4_ = coverage4_scalar;
+#endif
+    // The faces each triangle may reach, for all six faces at once (issue 13, item 4: most
+    // triangles reach one face, and bounds() skips the other five).
+    faces_.resize(ntri);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ntri, 1024),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t t = r.begin(); t != r.end(); ++t) {
+                          Vec3 rel[6];
+                          relative_corners(t, rel);
+                          faces_[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
+                        }
+                      });
+  }
+
+  size_t count() const {
+    return scene_.triangle_count();
+  }
+
+  Scratch make_scratch(int ts) const {
+    const size_t n = size_t(ts) * size_t(ts);
+    return Scratch{std::vector<PieceList>(n), std::vector<double>(n * kEnvBins),
+                   std::vector<double>(n), std::vector<std::vector<TieRecord>>(n)};
+  }
+
+  // The pixel rectangle of the footprint (footprint_bounds: the hull's rectangle without the
+  // hull) and the nearest depth, on the faces the triangle can reach.
+  bool bounds(size_t t, int face, const FaceAxes& axes, int* b, double& zmin) const {
+    if (!(faces_[t] >> face & 1)) return false;
+    Vec3 rel[6];
+    relative_corners(t, rel);
+    return footprint_bounds(rel, 6, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], zmin);
+  }
+
+  void begin_tile(Scratch& sc) const {
+    for (auto& l : sc.lists) l.clear();
+    for (auto& l : sc.ties) l.clear();
+    // sc.env is not reset: a pixel's bins are read only while far < inf, and are all written
+    // when its list first covers [0, 1].
+  }
+
+  void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
+             const FaceAxes& axes, SegmentStats& stats) const {
+    const int N = opt_.resolution;
+    const double tz = double(item.zmin);
+    auto c = scene_.corners(item.id, opt_.state);
+    Vec3 corners[3] = {c[0], c[1], c[2]};
+    StaticTriangle st = prepare_static_triangle(corners, v0_, v1_);
+    if (st.n == Vec3{0, 0, 0}) return;  // degenerate: never covers (H5)
+    Vec3 rel[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
+    Footprint fp = compute_footprint(rel, 6, axes, opt_.near);
+    const int y0 = std::max(rect.y0, box[2]), y1 = std::min(rect.y1, box[3]);
+    for (int y = y0; y <= y1; ++y) {
+      int x0, x1;
+      if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+      x0 = std::max(x0, rect.x0);
+      x1 = std::min(x1, rect.x1);
+      const double tc = pixel_centers_[size_t(y)];
+      for (int xb = x0; xb <= x1; xb += 4) {
+        const int lanes = std::min(4, x1 - xb + 1);
+        const size_t kb = rect.index(xb, y);
+        bool any = false;
+        for (int i = 0; i < lanes; ++i) any |= !(opt_.depth_culling && tz > sc.far[kb + i]);
+        if (!any) {
+          stats.culled_pairs += uint64_t(lanes);
+          continue;
+        }
+        Coverage4 cov;
+        coverage4_(st, axes, &pixel_centers_[size_t(xb)], tc, lanes, opt_.near, cov);
+        for (int i = 0; i < lanes; ++i) {
+          const size_t k = kb + size_t(i);
+          if (opt_.depth_culling &&
+              (tz > sc.far[k] ||
+               (sc.far[k] < INFINITY && plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
+            ++stats.culled_pairs;
+            continue;
+          }
+          ++stats.pair_tests;
+          if (!cov.ok[i]) continue;
+          ++stats.covered_pairs;
+          const double lo = cov.lo[i], hi = cov.hi[i];
+          const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
+          double* env = &sc.env[k * kEnvBins];
+          if (opt_.depth_culling && sc.far[k] < INFINITY &&
+              envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_)) {
+            ++stats.hidden_pairs;
+            continue;
+          }
+          PieceList& l = sc.lists[k];
+          // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
+          // until then every bin stays infinite): recomputed whole when the list first covers,
+          // then over the bins each insertion touches.
+          TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
+          if (insert_piece(l, Piece{lo, hi, item.id, depth}, rule) && opt_.depth_culling) {
+            if (sc.far[k] < INFINITY)
+              sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
+            else if (covers_segment(l))
+              sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
+          }
+        }
+      }
+    }
+  }
+
+  void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found,
+                    SegmentStats& stats, size_t& bytes) const {
+    PieceList& l = sc.lists[k];
+    bytes += l.capacity() * sizeof(Piece);
+    if (l.empty()) return;
+    ++stats.pixels_with_pieces;
+    stats.final_pieces += l.size();
+    stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+    for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
+      double len = t1 - t0;
+      if (!(len > opt_.eps_len)) return;
+      Witness w;
+      w.tri = id;
+      w.face = face;
+      w.x = x;
+      w.y = y;
+      w.t = 0.5 * (t0 + t1);
+      found.mark(id, len, w);
+    });
+    const int N = opt_.resolution;
+    if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
+  }
+
+ private:
+  void relative_corners(size_t t, Vec3* rel) const {
+    auto c = scene_.corners(uint32_t(t), opt_.state);
+    const Vec3 r[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
+    std::copy(r, r + 6, rel);
+  }
+
+  const Scene& scene_;
+  Vec3 v0_, v1_;
+  const SegmentOptions& opt_;
+  std::vector<PieceList>* pieces_;
+  bool keep_ties_ = false;
+  double far_scale_ = 1.0;
+  std::vector<double> pixel_centers_;
+  decltype(&coverage4_scalar) coverage4_ = nullptr;
+  std::vector<uint8_t> faces_;
 };
 
 }  // namespace
@@ -300,226 +467,18 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     return dynamic_segment_visibility(scene, v0, v1, opt);
   auto start = std::chrono::steady_clock::now();
   const int N = opt.resolution;
-  const int TS = opt.tile_size;
-  const int tiles_x = (N + TS - 1) / TS;
-  const int tile_count = tiles_x * tiles_x;
+  const int tiles_x = (N + opt.tile_size - 1) / opt.tile_size;
   const size_t ntri = scene.triangle_count();
 
   SegmentResult result;
   if (opt.want_pieces) result.pieces.resize(size_t(6) * N * N);
-  std::vector<SegmentStats> tile_stats(size_t(6) * tile_count);
-
-  // Scratch per thread: the pixel lists of one tile (capacity kept between tiles), and for each
-  // pixel whether its list covers [0,1] and its farthest depth (for depth culling).
-  struct TileScratch {
-    std::vector<PieceList> lists;
-    std::vector<double> env;  // kEnvBins per pixel: the depth envelope
-    std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
-    std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
-  };
-  tbb::enumerable_thread_specific<TileScratch> scratch([TS] {
-    return TileScratch{
-        std::vector<PieceList>(size_t(TS) * TS), std::vector<double>(size_t(TS) * TS * kEnvBins),
-        std::vector<double>(size_t(TS) * TS), std::vector<std::vector<TieRecord>>(size_t(TS) * TS)};
-  });
-  const bool keep_ties = opt.coplanar == CoplanarRule::Both;
-  // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of it,
-  // so only triangles beyond far * (1 + eps_z) are skipped (2 eps_z covers the rounding).
-  const double far_scale = keep_ties ? 1 + 2 * opt.eps_z : 1.0;
+  std::vector<SegmentStats> tile_stats(size_t(6) * tiles_x * tiles_x);
   tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
       [&] { return FoundMarks(ntri, opt.want_witnesses); });
+  StaticKind kind(scene, v0, v1, opt, opt.want_pieces ? &result.pieces : nullptr);
+  run_tiles(kind, opt, found_by_thread, tile_stats);
 
-  // Pixel-centre coordinates (pixel_center), padded so that 4 lanes can always be loaded.
-  std::vector<double> pixel_centers(size_t(N) + 4, 0.0);
-  for (int i = 0; i < N; ++i) pixel_centers[size_t(i)] = pixel_center(i, N);
-#ifdef VISLIB_HAVE_AVX2_PATH
-  const auto coverage4 = opt.simd && cpu_has_avx2() ? coverage4_avx2 : coverage4_scalar;
-#else
-  const auto coverage4 = coverage4_scalar;
-#endif
-
-  std::vector<int> bbox(ntri * 4);
-  std::vector<float> zmin(ntri);
-  // (0) the faces each triangle may reach, for all six faces at once (issue 13, item 4: most
-  // triangles reach one face, and the per-face pass below then skips the other five).
-  std::vector<uint8_t> faces(ntri);
-  tbb::parallel_for(
-      tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t t = r.begin(); t != r.end(); ++t) {
-          auto c = scene.corners(uint32_t(t), opt.state);
-          Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-          faces[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
-        }
-      });
-  std::vector<uint32_t> bin_start(tile_count + 1);
-  std::vector<FaceTriangle> bins;
-
-  for (int face = 0; face < 6; ++face) {
-    const FaceAxes axes = face_axes(face, opt.orientation);
-    // (1) footprint bounds and nearest depth of every triangle on this face (the bounds alone,
-    // without the hull: footprint_bounds gives the rectangle of the hull bit for bit).
-    tbb::parallel_for(
-        tbb::blocked_range<size_t>(0, ntri, 1024), [&](const tbb::blocked_range<size_t>& r) {
-          for (size_t t = r.begin(); t != r.end(); ++t) {
-            int* b = &bbox[t * 4];
-            if (!(faces[t] >> face & 1)) {
-              b[0] = 1;
-              b[1] = 0;  // empty: footprint_bounds would reject it
-              continue;
-            }
-            auto c = scene.corners(uint32_t(t), opt.state);
-            Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-            double z;
-            if (!footprint_bounds(rel, 6, axes, opt.near, N, b[0], b[1], b[2], b[3], z)) {
-              b[0] = 1;
-              b[1] = 0;  // empty
-              continue;
-            }
-            float zf = float(z);
-            if (double(zf) > z) zf = std::nextafter(zf, -INFINITY);
-            zmin[t] = zf;
-          }
-        });
-    // (2) bin by tile (counting sort, in id order).
-    bin_by_tile(bbox, ntri, TS, tiles_x, bin_start, bins, [&](size_t t) {
-      return FaceTriangle{uint32_t(t), zmin[t]};
-    });
-
-    // (3) tiles in parallel.
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-          TileScratch& sc = scratch.local();
-          auto& lists = sc.lists;
-          FoundMarks& found = found_by_thread.local();
-          for (int tile = r.begin(); tile != r.end(); ++tile) {
-            SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
-            const int tx0 = (tile % tiles_x) * TS, ty0 = (tile / tiles_x) * TS;
-            const int tx1 = std::min(N, tx0 + TS) - 1, ty1 = std::min(N, ty0 + TS) - 1;
-            const int tw = tx1 - tx0 + 1, th = ty1 - ty0 + 1;
-            for (auto& l : lists) l.clear();
-            for (auto& l : sc.ties) l.clear();
-            // sc.env is not reset: a pixel's bins are read only while far < inf, and are all
-            // written when its list first covers [0, 1].
-            std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-            FaceTriangle* tb = bins.data() + bin_start[tile];
-            FaceTriangle* te = bins.data() + bin_start[tile + 1];
-            // Front to back (nearest possible depth), ties by id: the order only affects speed.
-            std::sort(tb, te, [](const FaceTriangle& a, const FaceTriangle& b) {
-              return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
-            });
-            stats.triangle_tiles += uint64_t(te - tb);
-            // Depth culling (exact): a pixel whose list covers [0,1] with every piece nearer than a
-            // triangle's nearest possible depth cannot show that triangle; when that holds for
-            // every pixel of the tile, no later triangle (sorted by that depth) can show anywhere
-            // in it.
-            double tile_far = INFINITY;
-            int since_check = 0;
-            for (FaceTriangle* ft = tb; ft != te; ++ft) {
-              const double tz = double(ft->zmin);
-              if (opt.depth_culling) {
-                if (++since_check >= 16 || ft == tb) {
-                  since_check = 0;
-                  double far = -INFINITY;
-                  for (int k = 0; k < th && far < INFINITY; ++k)
-                    for (int i = 0; i < tw; ++i) far = std::max(far, sc.far[size_t(k) * TS + i]);
-                  tile_far = far;
-                }
-                if (tz > tile_far) {
-                  stats.culled_triangle_tiles += uint64_t(te - ft);
-                  break;
-                }
-              }
-              auto c = scene.corners(ft->id, opt.state);
-              Vec3 corners[3] = {c[0], c[1], c[2]};
-              StaticTriangle st = prepare_static_triangle(corners, v0, v1);
-              if (st.n == Vec3{0, 0, 0}) continue;  // degenerate: never covers (H5)
-              Vec3 rel[6] = {c[0] - v0, c[1] - v0, c[2] - v0, c[0] - v1, c[1] - v1, c[2] - v1};
-              Footprint fp = compute_footprint(rel, 6, axes, opt.near);
-              int y0 = std::max(ty0, bbox[size_t(ft->id) * 4 + 2]);
-              int y1 = std::min(ty1, bbox[size_t(ft->id) * 4 + 3]);
-              for (int y = y0; y <= y1; ++y) {
-                int x0, x1;
-                if (!footprint_row_span(fp, N, y, x0, x1)) continue;
-                x0 = std::max(x0, tx0);
-                x1 = std::min(x1, tx1);
-                const double tc = pixel_centers[size_t(y)];
-                for (int xb = x0; xb <= x1; xb += 4) {
-                  const int lanes = std::min(4, x1 - xb + 1);
-                  const size_t kb = size_t(y - ty0) * TS + (xb - tx0);
-                  bool any = false;
-                  for (int i = 0; i < lanes; ++i)
-                    any |= !(opt.depth_culling && tz > sc.far[kb + i]);
-                  if (!any) {
-                    stats.culled_pairs += uint64_t(lanes);
-                    continue;
-                  }
-                  Coverage4 cov;
-                  coverage4(st, axes, &pixel_centers[size_t(xb)], tc, lanes, opt.near, cov);
-                  for (int i = 0; i < lanes; ++i) {
-                    const size_t k = kb + size_t(i);
-                    if (opt.depth_culling &&
-                        (tz > sc.far[k] || (sc.far[k] < INFINITY &&
-                                            plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
-                      ++stats.culled_pairs;
-                      continue;
-                    }
-                    ++stats.pair_tests;
-                    if (!cov.ok[i]) continue;
-                    ++stats.covered_pairs;
-                    const double lo = cov.lo[i], hi = cov.hi[i];
-                    const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
-                    double* env = &sc.env[k * kEnvBins];
-                    if (opt.depth_culling && sc.far[k] < INFINITY &&
-                        envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale)) {
-                      ++stats.hidden_pairs;
-                      continue;
-                    }
-                    PieceList& l = lists[k];
-                    // The envelope is kept only once the list covers [0, 1] (a covered list
-                    // stays covered; until then every bin stays infinite): recomputed whole when
-                    // the list first covers, then over the bins each insertion touches.
-                    TieRule rule{opt.eps_z, keep_ties ? &sc.ties[k] : nullptr};
-                    if (insert_piece(l, Piece{lo, hi, ft->id, depth}, rule) && opt.depth_culling) {
-                      if (sc.far[k] < INFINITY)
-                        sc.far[k] = update_envelope(l, env, lo, hi) * far_scale;
-                      else if (covers_segment(l))
-                        sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale;
-                    }
-                  }
-                }
-              }
-            }
-            // Tile results: marks, witnesses, statistics.
-            size_t bytes = 0;
-            for (int y = ty0; y <= ty1; ++y)
-              for (int x = tx0; x <= tx1; ++x) {
-                PieceList& l = lists[size_t(y - ty0) * TS + (x - tx0)];
-                bytes += l.capacity() * sizeof(Piece);
-                if (l.empty()) continue;
-                ++stats.pixels_with_pieces;
-                stats.final_pieces += l.size();
-                stats.max_pieces_per_pixel =
-                    std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
-                const auto& ties = sc.ties[size_t(y - ty0) * TS + (x - tx0)];
-                for_each_visible(l, ties, [&](uint32_t id, double t0, double t1) {
-                  double len = t1 - t0;
-                  if (!(len > opt.eps_len)) return;
-                  Witness w;
-                  w.tri = id;
-                  w.face = face;
-                  w.x = x;
-                  w.y = y;
-                  w.t = 0.5 * (t0 + t1);
-                  found.mark(id, len, w);
-                });
-                if (opt.want_pieces) result.pieces[(size_t(face) * N + y) * N + x] = l;
-              }
-            stats.peak_tile_bytes = double(bytes);
-          }
-        });
-  }
-
-  // (4) reduce: statistics in tile order; marks and witnesses over threads by a total order.
+  // Reduce: statistics in tile order; marks and witnesses over threads by a total order.
   for (const SegmentStats& ts : tile_stats) result.stats.add(ts);
   std::vector<uint8_t> seen;
   std::vector<Witness> best;
