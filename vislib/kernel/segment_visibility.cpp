@@ -107,24 +107,29 @@ namespace {
 constexpr int kEnvBins = 16;
 
 // Bins overlapped by [lo, hi), 0 <= lo < hi <= 1 (scaling by a power of two is exact).
+// (ceil by hand: without SSE4.1 std::ceil is a library call, and this runs for every insertion.)
 inline void bins_of(double lo, double hi, int& b0, int& b1) {
   b0 = std::min(kEnvBins - 1, int(lo * kEnvBins));
-  b1 = std::max(b0, std::min(kEnvBins - 1, int(std::ceil(hi * kEnvBins)) - 1));
+  const double x = hi * kEnvBins;
+  int c = int(x);  // x >= 0: truncation is floor
+  c += double(c) < x;
+  b1 = std::max(b0, std::min(kEnvBins - 1, c - 1));
 }
 
 // Bounds of LinearDepth::at(t) = (n0 - n1 t) / dn without its division: the same numerator times
 // inv = 1/dn is within 3 units in the last place of the quotient (one rounding for inv, one for the
 // product, one of the quotient), so widening it by 2^-50 relative (8 units) bounds at(t) from
 // above or below. Non-finite products (dn near 0) fall back to the division.
+// (Branch-free widening: v * (1 +- 2^-50) with the sign of v; v = +-0 stays +-0 either way.)
 inline double depth_upper(const LinearDepth& z, double inv, double t) {
   const double num = z.n0 - z.n1 * t, v = num * inv;
-  if (!std::isfinite(v)) return z.at(t);
-  return v > 0 ? v * (1 + 0x1p-50) : v * (1 - 0x1p-50);
+  if (!(std::fabs(v) < INFINITY)) return z.at(t);
+  return v * (1 + std::copysign(0x1p-50, v));
 }
 inline double depth_lower(const LinearDepth& z, double inv, double t) {
   const double num = z.n0 - z.n1 * t, v = num * inv;
-  if (!std::isfinite(v)) return z.at(t);
-  return v > 0 ? v * (1 - 0x1p-50) : v * (1 + 0x1p-50);
+  if (!(std::fabs(v) < INFINITY)) return z.at(t);
+  return v * (1 - std::copysign(0x1p-50, v));
 }
 
 // `scale` (>= 1) widens the envelope so that an interval within the tie tolerance of the list
