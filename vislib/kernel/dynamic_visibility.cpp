@@ -426,16 +426,8 @@ class DynamicKind {
     zmax_.resize(nprim);
     keep_ties_ = opt.coplanar == CoplanarRule::Both;
     far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
-    // The faces each triangle may reach over the run (reachable_faces, as the static kernel).
-    faces_.resize(ntri_);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ntri_, 1024),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t t = r.begin(); t != r.end(); ++t) {
-                          Vec3 rel[6];
-                          relative_corners(t, rel);
-                          faces_[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
-                        }
-                      });
+    // The faces each triangle can reach (issue 13, item 4).
+    faces_ = classify_faces(ntri_, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
   }
 
   size_t count() const { return ntri_ + scene_.sphere_count(); }
@@ -471,11 +463,6 @@ class DynamicKind {
     zmax_[p] = std::max(z0, z1) + radius;
     return sphere_pixel_bounds(C0_[s] - run_.e0, C1_[s] - run_.e1, radius, axes, opt_.near,
                                opt_.resolution, b[0], b[1], b[2], b[3]);
-  }
-
-  void begin_tile(Scratch& sc) const {
-    for (auto& l : sc.lists) l.clear();
-    for (auto& l : sc.ties) l.clear();
   }
 
   void cover(Scratch& sc, const TileItem& item, const int* b, const TileRect& rect,
@@ -527,14 +514,8 @@ class DynamicKind {
     }
   }
 
-  void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found,
-                    SegmentStats& stats, size_t& bytes) const {
-    auto& l = sc.lists[k];
-    bytes += l.capacity() * sizeof(GeneralPiece);
-    if (l.empty()) return;
-    ++stats.pixels_with_pieces;
-    stats.final_pieces += l.size();
-    stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+  void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found) const {
+    const auto& l = sc.lists[k];
     // Length in the segment parameter (Diagonal) or in animation time (eye fixed).
     const double span = std::max(std::fabs(run_.t1 - run_.t0), std::fabs(run_.tau1 - run_.tau0));
     for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {

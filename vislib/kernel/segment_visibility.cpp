@@ -299,7 +299,9 @@ class StaticKind {
  public:
   struct Scratch {
     std::vector<PieceList> lists;
-    std::vector<double> env;  // kEnvBins per pixel: the depth envelope
+    std::vector<double> env;  // kEnvBins per pixel: the depth envelope (not reset per tile: a
+                              // pixel's bins are read only while far < inf, and are all written
+                              // when its list first covers [0, 1])
     std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
@@ -321,17 +323,8 @@ class StaticKind {
 #else
     coverage4_ = coverage4_scalar;
 #endif
-    // The faces each triangle may reach, for all six faces at once (issue 13, item 4: most
-    // triangles reach one face, and bounds() skips the other five).
-    faces_.resize(ntri);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ntri, 1024),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t t = r.begin(); t != r.end(); ++t) {
-                          Vec3 rel[6];
-                          relative_corners(t, rel);
-                          faces_[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
-                        }
-                      });
+    // The faces each triangle can reach (issue 13, item 4).
+    faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
   }
 
   size_t count() const {
@@ -351,13 +344,6 @@ class StaticKind {
     Vec3 rel[6];
     relative_corners(t, rel);
     return footprint_bounds(rel, 6, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], zmin);
-  }
-
-  void begin_tile(Scratch& sc) const {
-    for (auto& l : sc.lists) l.clear();
-    for (auto& l : sc.ties) l.clear();
-    // sc.env is not reset: a pixel's bins are read only while far < inf, and are all written
-    // when its list first covers [0, 1].
   }
 
   void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
@@ -423,14 +409,8 @@ class StaticKind {
     }
   }
 
-  void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found,
-                    SegmentStats& stats, size_t& bytes) const {
-    PieceList& l = sc.lists[k];
-    bytes += l.capacity() * sizeof(Piece);
-    if (l.empty()) return;
-    ++stats.pixels_with_pieces;
-    stats.final_pieces += l.size();
-    stats.max_pieces_per_pixel = std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+  void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found) const {
+    const PieceList& l = sc.lists[k];
     for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
       double len = t1 - t0;
       if (!(len > opt_.eps_len)) return;

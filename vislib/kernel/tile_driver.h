@@ -13,18 +13,19 @@
 // caller, so nothing depends on scheduling.
 //
 // What a kind provides (see StaticKind and DynamicKind):
-//   using Scratch = ...;   per-thread tile state, with `std::vector<double> far`: per pixel, a
-//                          depth that its list covers [0, 1] nearer than (inf until it does)
+//   using Scratch = ...;   per-thread tile state with, per pixel of a tile: `lists` (its pieces),
+//                          `ties` (its tie records) and `far` (a depth that its list covers
+//                          [0, 1] nearer than; inf until it does); the driver resets all three
+//                          for every tile
 //   Scratch make_scratch(int tile_size) const;
 //   size_t count() const;  primitives
 //   bool bounds(size_t p, int face, const FaceAxes&, int* box, double& zmin);
 //                          pixel rectangle (x0, x1, y0, y1) and nearest depth; false when empty.
 //                          Called in parallel for different p.
-//   void begin_tile(Scratch&) const;        empty lists, culling data reset
 //   void cover(Scratch&, const TileItem&, const int* box, const TileRect&, const FaceAxes&,
 //              SegmentStats&) const;         coverage and compositing of one primitive
-//   void finish_pixel(Scratch&, size_t k, int face, int x, int y, FoundMarks&, SegmentStats&,
-//                     size_t& bytes) const;  report pixel k = (y - y0) * stride + (x - x0)
+//   void finish_pixel(Scratch&, size_t k, int face, int x, int y, FoundMarks&) const;
+//                          report the non-empty list of pixel k = (y - y0) * stride + (x - x0)
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -36,6 +37,7 @@
 #include <vector>
 
 #include "vislib/base/cubemap.h"
+#include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
 #include "vislib/kernel/segment_visibility.h"
 
@@ -59,6 +61,23 @@ inline float round_down_to_float(double z) {
   float f = float(z);
   if (double(f) > z) f = std::nextafter(f, -INFINITY);
   return f;
+}
+
+// The faces each of n triangles can reach (bit k: face k), for all six faces at once
+// (reachable_faces); relative(t, rel) writes triangle t's six eye-relative corners. Most
+// triangles reach one face, and a kind's bounds() skips the other five.
+template <class Relative>
+std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const Relative& relative) {
+  std::vector<uint8_t> faces(n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t t = r.begin(); t != r.end(); ++t) {
+                        Vec3 rel[6];
+                        relative(t, rel);
+                        faces[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
+                      }
+                    });
+  return faces;
 }
 
 // Runs the six faces of one from-segment run of `kind`. tile_stats has 6 * tiles^2 entries
@@ -99,55 +118,67 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
     });
 
     // (3) tiles in parallel.
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tile_count, 1), [&](const tbb::blocked_range<int>& r) {
-          auto& sc = scratch.local();
-          FoundMarks& found = found_by_thread.local();
-          for (int tile = r.begin(); tile != r.end(); ++tile) {
-            SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
-            TileRect rect;
-            rect.x0 = (tile % tiles_x) * TS;
-            rect.y0 = (tile / tiles_x) * TS;
-            rect.x1 = std::min(N, rect.x0 + TS) - 1;
-            rect.y1 = std::min(N, rect.y0 + TS) - 1;
-            rect.stride = TS;
-            const int tw = rect.x1 - rect.x0 + 1, th = rect.y1 - rect.y0 + 1;
-            kind.begin_tile(sc);
-            std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-            TileItem* tb = bins.data() + bin_start[tile];
-            TileItem* te = bins.data() + bin_start[tile + 1];
-            // Front to back (nearest possible depth), ties by id: the order only affects speed.
-            std::sort(tb, te, [](const TileItem& a, const TileItem& b) {
-              return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
-            });
-            stats.triangle_tiles += uint64_t(te - tb);
-            double tile_far = INFINITY;
-            int since_check = 0;
-            for (TileItem* it = tb; it != te; ++it) {
-              if (opt.depth_culling) {
-                // Every 16 primitives: the farthest `far` over the tile's pixels.
-                if (++since_check >= 16 || it == tb) {
-                  since_check = 0;
-                  double f = -INFINITY;
-                  for (int k = 0; k < th && f < INFINITY; ++k)
-                    for (int i = 0; i < tw; ++i) f = std::max(f, sc.far[size_t(k) * TS + i]);
-                  tile_far = f;
-                }
-                if (double(it->zmin) > tile_far) {
-                  stats.culled_triangle_tiles += uint64_t(te - it);
-                  break;
-                }
-              }
-              kind.cover(sc, *it, &bbox[size_t(it->id) * 4], rect, axes, stats);
-            }
-            // Tile results: marks, witnesses, pieces, statistics.
-            size_t bytes = 0;
-            for (int y = rect.y0; y <= rect.y1; ++y)
-              for (int x = rect.x0; x <= rect.x1; ++x)
-                kind.finish_pixel(sc, rect.index(x, y), face, x, y, found, stats, bytes);
-            stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1),
+                      [&](const tbb::blocked_range<int>& r) {
+                        auto& sc = scratch.local();
+                        FoundMarks& found = found_by_thread.local();
+                        for (int tile = r.begin(); tile != r.end(); ++tile) {
+                          SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
+                          TileRect rect;
+                          rect.x0 = (tile % tiles_x) * TS;
+                          rect.y0 = (tile / tiles_x) * TS;
+                          rect.x1 = std::min(N, rect.x0 + TS) - 1;
+                          rect.y1 = std::min(N, rect.y0 + TS) - 1;
+                          rect.stride = TS;
+                          const int tw = rect.x1 - rect.x0 + 1, th = rect.y1 - rect.y0 + 1;
+                          for (auto& l : sc.lists) l.clear();
+                          for (auto& l : sc.ties) l.clear();
+                          std::fill(sc.far.begin(), sc.far.end(), INFINITY);
+                          TileItem* tb = bins.data() + bin_start[tile];
+                          TileItem* te = bins.data() + bin_start[tile + 1];
+                          // Front to back (nearest possible depth), ties by id: the order only
+                          // affects speed.
+                          std::sort(tb, te, [](const TileItem& a, const TileItem& b) {
+                            return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
+                          });
+                          stats.triangle_tiles += uint64_t(te - tb);
+                          double tile_far = INFINITY;
+                          int since_check = 0;
+                          for (TileItem* it = tb; it != te; ++it) {
+                            if (opt.depth_culling) {
+                              // Every 16 primitives: the farthest `far` over the tile's pixels.
+                              if (++since_check >= 16 || it == tb) {
+                                since_check = 0;
+                                double f = -INFINITY;
+                                for (int k = 0; k < th && f < INFINITY; ++k)
+                                  for (int i = 0; i < tw; ++i)
+                                    f = std::max(f, sc.far[size_t(k) * TS + i]);
+                                tile_far = f;
+                              }
+                              if (double(it->zmin) > tile_far) {
+                                stats.culled_triangle_tiles += uint64_t(te - it);
+                                break;
+                              }
+                            }
+                            kind.cover(sc, *it, &bbox[size_t(it->id) * 4], rect, axes, stats);
+                          }
+                          // Tile results: marks, witnesses, pieces, statistics.
+                          size_t bytes = 0;
+                          for (int y = rect.y0; y <= rect.y1; ++y)
+                            for (int x = rect.x0; x <= rect.x1; ++x) {
+                              const size_t k = rect.index(x, y);
+                              const auto& l = sc.lists[k];
+                              bytes += l.capacity() * sizeof(l[0]);
+                              if (l.empty()) continue;
+                              ++stats.pixels_with_pieces;
+                              stats.final_pieces += l.size();
+                              stats.max_pieces_per_pixel =
+                                  std::max<uint64_t>(stats.max_pieces_per_pixel, l.size());
+                              kind.finish_pixel(sc, k, face, x, y, found);
+                            }
+                          stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
+                        }
+                      });
   }
 }
 
