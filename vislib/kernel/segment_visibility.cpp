@@ -185,6 +185,17 @@ inline double update_envelope(const PieceList& l, double* env, double lo, double
   return double(far);
 }
 
+// An upper bound of a list's depth over all its pieces (depth_upper at each piece's ends: the
+// depth is monotone on a piece), without the envelope's bins.
+inline double upper_depth(const PieceList& l) {
+  double far = -INFINITY;
+  for (const Piece& p : l) {
+    const double inv = 1.0 / p.depth.dn;
+    far = std::max({far, depth_upper(p.depth, inv, p.t0), depth_upper(p.depth, inv, p.t1)});
+  }
+  return far;
+}
+
 // True when the triangle's plane lies behind `far` along the pixel ray for every t in [0, 1]: its
 // depth there is at(t) of LinearDepth{N0, N1, Dn} (as static_coverage would give), monotone in t,
 // so at(0) and at(1) bound it. Exact culling of a pair whose pixel list covers [0, 1] below `far`.
@@ -299,10 +310,11 @@ class StaticKind {
  public:
   struct Scratch {
     std::vector<PieceList> lists;
-    std::vector<double> env;  // kEnvBins per pixel: the depth envelope (not reset per tile: a
-                              // pixel's bins are read only while far < inf, and are all written
-                              // when its list first covers [0, 1])
-    std::vector<double> far;  // per pixel: max of its envelope (inf unless [0,1] is covered)
+    std::vector<double> env;      // kEnvBins per pixel: the depth envelope (not reset per tile: a
+                                  // pixel's bins are read only while far < inf, and are all written
+                                  // when its list first covers [0, 1])
+    std::vector<double> far;      // per pixel: max of its envelope (inf unless [0,1] is covered)
+    std::vector<uint8_t> env_ok;  // per pixel with far < inf: its envelope is built
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
   };
 
@@ -334,7 +346,8 @@ class StaticKind {
   Scratch make_scratch(int ts) const {
     const size_t n = size_t(ts) * size_t(ts);
     return Scratch{std::vector<PieceList>(n), std::vector<double>(n * kEnvBins),
-                   std::vector<double>(n), std::vector<std::vector<TieRecord>>(n)};
+                   std::vector<double>(n), std::vector<uint8_t>(n),
+                   std::vector<std::vector<TieRecord>>(n)};
   }
 
   // The pixel rectangle of the footprint (footprint_bounds: the hull's rectangle without the
@@ -388,6 +401,11 @@ class StaticKind {
           const double lo = cov.lo[i], hi = cov.hi[i];
           const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
           double* env = &sc.env[k * kEnvBins];
+          if (opt_.depth_culling && sc.far[k] < INFINITY && !sc.env_ok[k]) {
+            // First use of this covered pixel's envelope: built from the list now.
+            sc.far[k] = update_envelope(sc.lists[k], env, 0.0, 1.0) * far_scale_;
+            sc.env_ok[k] = 1;
+          }
           if (opt_.depth_culling && sc.far[k] < INFINITY &&
               envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_)) {
             ++stats.hidden_pairs;
@@ -399,10 +417,14 @@ class StaticKind {
           // then over the bins each insertion touches.
           TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
           if (insert_piece(l, Piece{lo, hi, item.id, depth}, rule) && opt_.depth_culling) {
-            if (sc.far[k] < INFINITY)
-              sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
-            else if (covers_segment(l))
-              sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
+            if (sc.far[k] < INFINITY) {
+              // The list only got nearer: the old far stays a bound; the envelope (if built)
+              // is recomputed over the bins this insertion touched.
+              if (sc.env_ok[k]) sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
+            } else if (covers_segment(l)) {
+              sc.far[k] = upper_depth(l) * far_scale_;  // the envelope waits for its first use
+              sc.env_ok[k] = 0;
+            }
           }
         }
       }
