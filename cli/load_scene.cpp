@@ -27,8 +27,8 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states) {
   info(buf);
   vislib::Box3 b = scene.bounds();
   if (vislib::far_from_origin(b)) {
-    char buf[512];
-    std::snprintf(buf, sizeof buf,
+    char far_msg[512];
+    std::snprintf(far_msg, sizeof far_msg,
                   "%s: the scene lies far from the origin (centre %g away, %g times its size): "
                   "vislib works in "
                   "double and is not affected, but float32 consumers (the Embree baseline, "
@@ -36,7 +36,7 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states) {
                   "lose precision there; consider re-centring it",
                   path.c_str(), length((b.min + b.max) * 0.5),
                   length((b.min + b.max) * 0.5) / length(b.max - b.min));
-    warn(buf);
+    warn(far_msg);
   }
   return scene;
 }

@@ -112,7 +112,9 @@ TEST(NearFarRender, SourcePointsOfAnAllNearFrameGiveZeroDiscontinuity) {
   for (size_t p = 0; p < nf.pixel_count(); ++p) {
     EXPECT_EQ(src.source[p] == vislib::PixelSource::Geometry, nf.tri[p] != vislib::kNoHit);
     geometry += src.source[p] == vislib::PixelSource::Geometry;
-    if (nf.tri[p] != vislib::kNoHit) EXPECT_NEAR(src.point[p].y, 0.0, 1e-5);  // on the ground
+    if (nf.tri[p] != vislib::kNoHit) {
+      EXPECT_NEAR(src.point[p].y, 0.0, 1e-5);  // on the ground
+    }
   }
   EXPECT_GT(geometry, nf.pixel_count() / 2);
   const vislib::Discontinuity d = vislib::frame_discontinuity(cam, src.point, 5.0);

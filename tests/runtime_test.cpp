@@ -386,8 +386,11 @@ TEST(RuntimeC, InfiniteMarginMakesEveryOtherCellANeighbour) {
                 PVS_RT_OK)
           << pvs_rt_last_error();
       ASSERT_EQ(count, size_t(info.cell_count - 1)) << path << " cell " << c;
-      for (uint32_t i = 0, k = 0; i < info.cell_count; ++i)
-        if (i != c) EXPECT_EQ(out[k++], i);
+      for (uint32_t i = 0, k = 0; i < info.cell_count; ++i) {
+        if (i != c) {
+          EXPECT_EQ(out[k++], i);
+        }
+      }
       // A huge finite margin reaches every cell too; NaN is an invalid argument.
       ASSERT_EQ(pvs_rt_neighbours(h, c, 1e308, out.data(), out.size(), &count), PVS_RT_OK);
       EXPECT_EQ(count, size_t(info.cell_count - 1));
