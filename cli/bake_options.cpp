@@ -134,6 +134,7 @@ vislib::BakeSettings settings_of(const BakeArgs& a) {
   s.region.segment.near = a.near;
   s.region.segment.eps_len = a.eps_len;
   s.region.segment.tile_size = a.tile;
+  s.long_segments = a.long_segments;
   s.region.runs = a.runs;
   s.region.seed = a.seed;
   s.granularity =
@@ -180,6 +181,11 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->capture_default_str();
   cmd->add_option("--tile", a.tile, "Kernel tile side in pixels")
       ->check(in_range(1, 4096))
+      ->capture_default_str();
+  cmd->add_option("--long-segments", a.long_segments,
+                  "Run the world-aligned pass of up to this many cell edges lying end to end as "
+                  "one long segment, split per edge (1 = off; static scenes; see docs/bake.md)")
+      ->check(in_range(1, int(vislib::kMaxSplitParts)))
       ->capture_default_str();
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")

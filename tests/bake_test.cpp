@@ -447,6 +447,7 @@ TEST(BakeSharedSegments, SetsEqualBakingEachCellAloneWithFewerRuns) {
   s.region.segment.resolution = 16;
   s.region.runs = 2;  // run 1 is a per-cell random orientation: never shared
   s.region.seed = 5;
+  s.long_segments = 1;  // edges only (BakeLongSegments tests the chains)
   const std::string dir = temp_dir("bake_shared_segments");
   tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
 
@@ -495,7 +496,7 @@ TEST(SegmentRunCache, ConcurrentCallersComputeOnceAndTheEntryIsFreedAfterItsLast
   const Vec3 a{0, 1.5, 0}, b{1, 1.5, 0};
   for (int i = 0; i < 3; ++i) cache.expect(a, b);
   std::atomic<int> computations{0};
-  auto compute = [&] {
+  auto compute = [&](Vec3, Vec3, const std::vector<double>&) {
     ++computations;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));  // others arrive meanwhile
     SegmentResult r;
@@ -531,8 +532,78 @@ TEST(SegmentRunCache, AnExceptionReachesEveryWaitingCaller) {
   const Vec3 a{0, 0, 0}, b{0, 0, 1};
   cache.expect(a, b);
   cache.expect(a, b);
-  auto failing = []() -> SegmentResult { throw std::runtime_error("kernel failed"); };
+  auto failing = [](Vec3, Vec3, const std::vector<double>&) -> SegmentResult {
+    throw std::runtime_error("kernel failed");
+  };
   EXPECT_THROW(cache.get(a, b, failing), std::runtime_error);
   EXPECT_THROW(cache.get(a, b, failing), std::runtime_error);
   EXPECT_EQ(cache.entries_held(), 0u);
+}
+
+// Long segments (issue 13 item 5): end-to-end edges on one line form chains of at most max_parts;
+// one computation per chain, split at the junctions, each edge gets its part.
+TEST(SegmentRunCache, ChainsOfEdgesEndToEndRunOnceAndHandEachEdgeItsPart) {
+  SegmentRunCache cache;
+  std::vector<std::pair<Vec3, Vec3>> segs;
+  for (int i = 0; i < 5; ++i) segs.push_back({{double(i), 1.5, 2}, {double(i + 1), 1.5, 2}});
+  segs.push_back({{0, 1.5, 7}, {1, 1.5, 7}});   // alone on its line: no chain
+  segs.push_back({{9, 1.5, 2}, {10, 1.5, 2}});  // same line, not touching: no chain
+  cache.plan_chains(segs, 3);
+  EXPECT_EQ(cache.chains_planned(), 2u);  // [0, 3] and [3, 5]
+  for (const auto& [a, b] : segs) cache.expect(a, b);
+  std::vector<std::pair<Vec3, Vec3>> runs;
+  std::vector<std::vector<double>> splits;
+  auto compute = [&](Vec3 a, Vec3 b, const std::vector<double>& s) {
+    runs.push_back({a, b});
+    splits.push_back(s);
+    SegmentResult r;
+    if (s.empty()) r.visible = {uint32_t(10 * a.x)};
+    for (size_t i = 0; !s.empty() && i <= s.size(); ++i)
+      r.visible_parts.push_back({uint32_t(10 * a.x + i)});
+    return r;
+  };
+  std::vector<uint32_t> got;
+  for (const auto& [a, b] : segs) got.push_back(cache.get(a, b, compute)->visible.at(0));
+  EXPECT_EQ(got, (std::vector<uint32_t>{0, 1, 2, 30, 31, 0, 90}));
+  ASSERT_EQ(runs.size(), 4u);
+  EXPECT_EQ(runs[0].first.x, 0.0);
+  EXPECT_EQ(runs[0].second.x, 3.0);
+  EXPECT_EQ(splits[0], (std::vector<double>{1.0 / 3, 2.0 / 3}));
+  EXPECT_EQ(splits[1], (std::vector<double>{0.5}));
+  EXPECT_TRUE(splits[2].empty());
+  EXPECT_EQ(cache.runs_computed(), 4u);
+  EXPECT_EQ(cache.runs_shared(), 3u);
+  EXPECT_EQ(cache.entries_held(), 0u);
+}
+
+TEST(BakeLongSegments, SetsEqualBakingEachCellAloneWithFarFewerRuns) {
+  const Scene scene = small_city();
+  Box3 box;
+  box.extend({-32, 0, -32});
+  box.extend({32, 3, 32});
+  const ViewCells cells = grid_cells(box, 8, 1, 8, EyeBand{1.5, 1.75});
+  BakeSettings s;
+  s.region.segment.resolution = 16;
+  s.long_segments = 4;
+  const std::string dir = temp_dir("bake_long_segments");
+  tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+  const BakeReport r = bake(scene, cells, s, {}, {dir + "/long.pvs", "", false});
+  // 64 cells x 8 edges = 512 uses; 2 levels x 2 directions x 9 lines x 2 chains of 4 = 72 runs.
+  EXPECT_EQ(r.segment_runs_computed, 72u);
+  EXPECT_EQ(r.segment_runs_shared, 512u - 72u);
+  BakeSettings alone = s;
+  alone.share_segments = false;
+  pvs::Reader long_file = pvs::Reader::from_file(dir + "/long.pvs");
+  EXPECT_NE(long_file.info().metadata.find("\"long_segments\":4"), std::string::npos);
+  for (uint32_t c = 0; c < 64; ++c)
+    EXPECT_EQ(long_file.read_cell(c), bake_cell(scene, long_file.info().layout, c, alone))
+        << "cell " << c;
+  // Shards plan the same chains (from every cell of the layout), so they merge to the same bytes.
+  std::vector<pvs::Reader> shards;
+  for (uint32_t i = 0; i < 3; ++i) {
+    const std::string path = dir + "/s" + std::to_string(i) + ".pvs";
+    bake(scene, cells, s, {i, 3}, {path, "", false});
+    shards.push_back(pvs::Reader::from_file(path));
+  }
+  EXPECT_EQ(pvs::merge_pvs(shards), read_file(dir + "/long.pvs"));
 }

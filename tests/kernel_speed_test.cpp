@@ -2,7 +2,9 @@
 // per-pixel depth envelope, and the vectorised coverage are checked against the plain paths.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <stdexcept>
 
 #include "tests/scene_builders.h"
 #include "vislib/base/random.h"
@@ -162,4 +164,48 @@ TEST(KernelSpeed, DepthEnvelopeSkipsHiddenIntervalsAndChangesNoPiece) {
   EXPECT_GT(with.stats.hidden_pairs, 0u);
   EXPECT_EQ(without.stats.hidden_pairs, 0u);
   EXPECT_LT(with.stats.pair_tests, without.stats.pair_tests);
+}
+
+// Issue 13 item 5, long segments: one run along a segment split at s_1 < s_2 < ... gives, for
+// each part, the set of a run over that part alone. The end points are chosen so that every
+// junction v0 + s (v1 - v0) is exactly representable (dyadic s, integer coordinates).
+TEST(SplitSegment, EachPartGivesTheSetOfARunOverThatPartAlone) {
+  const Scene scene = street_scene();
+  for (Vec3 dir : {Vec3{1, 0, 0}, Vec3{0, 0, 1}}) {
+    const Vec3 v0 = Vec3{-8, 1.625, -8} + dir * 0.0, v1 = v0 + dir * 16.0;
+    SegmentOptions o;
+    o.resolution = 24;
+    o.splits = {0.125, 0.25, 0.5, 0.75};
+    const SegmentResult whole = segment_visibility(scene, v0, v1, o);
+    ASSERT_EQ(whole.visible_parts.size(), 5u);
+    std::vector<double> bounds = {0, 0.125, 0.25, 0.5, 0.75, 1};
+    std::vector<uint32_t> uni;
+    SegmentOptions alone = o;
+    alone.splits.clear();
+    for (size_t i = 0; i + 1 < bounds.size(); ++i) {
+      const Vec3 a = v0 + (v1 - v0) * bounds[i], b = v0 + (v1 - v0) * bounds[i + 1];
+      const SegmentResult part = segment_visibility(scene, a, b, alone);
+      EXPECT_FALSE(part.visible.empty());
+      EXPECT_EQ(whole.visible_parts[i], part.visible) << "part " << i;
+      uni.insert(uni.end(), part.visible.begin(), part.visible.end());
+    }
+    std::sort(uni.begin(), uni.end());
+    uni.erase(std::unique(uni.begin(), uni.end()), uni.end());
+    // The union of the parts is the unsplit run's set.
+    EXPECT_EQ(whole.visible, uni);
+    EXPECT_EQ(segment_visibility(scene, v0, v1, alone).visible, uni);
+  }
+}
+
+TEST(SplitSegment, BadSplitPointsAreRefused) {
+  const Scene scene = street_scene();
+  SegmentOptions o;
+  o.resolution = 4;
+  for (std::vector<double> bad : {std::vector<double>{0.0},
+                                  {1.0},
+                                  {0.5, 0.5},
+                                  {0.6, 0.4},
+                                  {0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8}})
+    EXPECT_THROW(segment_visibility(scene, {0, 1, 0}, {1, 1, 0}, (o.splits = bad, o)),
+                 std::invalid_argument);
 }

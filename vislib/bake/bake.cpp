@@ -45,8 +45,14 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
       {"coplanar", s.coplanar == CoplanarRule::First ? "first" : "both"},
       {"eps_z", s.eps_z},
       {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
+  if (uses_long_segments(scene, settings)) m["long_segments"] = settings.long_segments;
   info.metadata = m.dump();
   return info;
+}
+
+bool uses_long_segments(const Scene& scene, const BakeSettings& settings) {
+  return settings.share_segments && settings.long_segments > 1 && !scene.is_dynamic() &&
+         scene.sphere_count() == 0 && !settings.region.segment.want_witnesses;
 }
 
 uint64_t bake_key(const pvs::FileInfo& info, Shard shard) {
@@ -118,6 +124,15 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   BakeSettings run_settings = settings;
   if (settings.share_segments) {
     run_settings.region.shared_runs = &shared_runs;
+    if (uses_long_segments(scene, settings)) {
+      // The plan covers every cell of the layout, so that it does not depend on the shard or on
+      // the cells recovered from a checkpoint.
+      std::vector<std::pair<Vec3, Vec3>> all;
+      for (uint32_t c = 0; c < n; ++c)
+        for (const Box3& rect : cell_rectangles(info.layout, c))
+          for (const Segment& s : perimeter_segments(rect)) all.emplace_back(s.from, s.to);
+      shared_runs.plan_chains(all, settings.long_segments);
+    }
     for (uint32_t c = 0; c < n; ++c) {
       if (!in_shard(c, shard) || recovered[c]) continue;
       for (const Box3& rect : cell_rectangles(info.layout, c))

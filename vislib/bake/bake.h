@@ -25,7 +25,16 @@ struct BakeSettings {
   // Compute each world-aligned run (run 0) of an edge shared by several cells once
   // (segment_run_cache.h). Never changes the sets; false recomputes it for every cell.
   bool share_segments = true;
+  // Long segments (issue 13 item 5; with share_segments, static scenes without spheres): run 0 of
+  // up to this many cell edges lying end to end on one line runs as one segment whose per-pixel
+  // lists are split per edge (segment_run_cache.h); at most kMaxSplitParts. 1 = off. Recorded in
+  // the file's metadata when on: a set can differ from the per-edge runs where an event falls
+  // within rounding of a junction (none seen in the tests and benchmarks, docs/performance.md).
+  int long_segments = int(kMaxSplitParts);
 };
+
+// Whether `settings` run long segments on `scene` (long_segments > 1 applies).
+bool uses_long_segments(const Scene& scene, const BakeSettings& settings);
 
 // Shard `index` of `count` bakes the cells c with c % count == index (round robin, so each shard
 // gets a share of every part of the scene and similar work). 0 <= index < count.

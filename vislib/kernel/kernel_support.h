@@ -45,7 +45,7 @@ inline bool better_witness(double len_a, const Witness& a, double len_b, const W
 
 // What one thread found: a mark per visible primitive and, if wanted, its best witness so far.
 struct FoundMarks {
-  std::vector<uint8_t> seen;        // per primitive
+  std::vector<uint8_t> seen;        // per primitive: 1, or a bit per part of a split segment
   std::vector<double> witness_len;  // per primitive: length of the witness piece (-1 = none)
   std::vector<Witness> witness;     // per primitive
 
@@ -64,6 +64,19 @@ struct FoundMarks {
     }
   }
 };
+
+// Marks primitive p visible from the parts of a split segment (SegmentOptions::splits) that the
+// stretch [t0, t1) overlaps by more than eps_len times the part's length: bit i of seen[p] for
+// part i. `bounds` holds 0, the splits, 1.
+inline void mark_parts(FoundMarks& found, const std::vector<double>& bounds, double eps_len,
+                       uint32_t p, double t0, double t1) {
+  for (size_t i = 0; i + 1 < bounds.size(); ++i) {
+    if (!(bounds[i] < t1)) break;
+    const double a = t0 > bounds[i] ? t0 : bounds[i];
+    const double b = t1 < bounds[i + 1] ? t1 : bounds[i + 1];
+    if ((b - a) / (bounds[i + 1] - bounds[i]) > eps_len) found.seen[p] |= uint8_t(1u << i);
+  }
+}
 
 // Unites the marks of all threads (`found` iterates FoundMarks): seen[p] and the best witness of
 // every primitive (empty `best` when no witnesses were kept).

@@ -58,9 +58,16 @@ RegionResult region_visibility(const Scene& scene, const Box3& box, const Region
       const Segment& seg = result.segments[s];
       SegmentResult sr;
       bool computed = true;
-      if (options.shared_runs && k == 0) {
+      // A planned long segment keeps no witnesses per part: such regions compute their own.
+      if (options.shared_runs && k == 0 &&
+          !(witnesses && options.shared_runs->chains_planned() > 0)) {
         auto shared = options.shared_runs->get(
-            seg.from, seg.to, [&] { return segment_visibility(scene, seg.from, seg.to, so); },
+            seg.from, seg.to,
+            [&](Vec3 a, Vec3 b, const std::vector<double>& splits) {
+              SegmentOptions o = so;
+              o.splits = splits;
+              return segment_visibility(scene, a, b, o);
+            },
             &computed);
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;

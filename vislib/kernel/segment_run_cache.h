@@ -5,9 +5,17 @@
 // it. The sets are those of baking each cell alone, byte for byte (test
 // BakeSharedSegments.SetsEqualBakingEachCellAlone).
 //
-// Use: expect() every use before the work starts (the bake registers the runs of the cells it will
-// compute), then get() from any thread. An entry is freed after its last expected use, so memory
-// holds only results still awaited (in a grid baked in cell order, about one row of cells).
+// Long segments (optional, plan_chains): where up to `max_parts` expected segments lie end to end
+// on one line (cells in a row), one run covers the whole chain and its exact per-pixel lists are
+// split by t at the junctions (SegmentOptions::splits), each part standing for one segment. The
+// part's set is the one a run over that part alone gives, but the part's end points are points of
+// the chain's parametrisation (v0 + s (v1 - v0)), so sets can differ from the per-edge runs where
+// a visibility event falls within rounding of a junction; docs/performance.md measures how often.
+//
+// Use: plan_chains() (optional), then expect() every use before the work starts (the bake
+// registers the runs of the cells it will compute), then get() from any thread. An entry is freed
+// after its last expected use, so memory holds only results still awaited (in a grid baked in
+// cell order, about one row of cells; with chains, up to max_parts rows of the edges across rows).
 #pragma once
 
 #include <array>
@@ -18,6 +26,8 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <utility>
+#include <vector>
 
 #include "vislib/kernel/segment_visibility.h"
 
@@ -25,32 +35,59 @@ namespace vislib {
 
 class SegmentRunCache {
  public:
+  // Computes the world-aligned run on (from, to), split at `splits` when not empty.
+  using RunFn = std::function<SegmentResult(Vec3 from, Vec3 to, const std::vector<double>& splits)>;
+
+  // Plans long segments over `segments`: maximal chains of segments along one axis (from and to
+  // differ in that coordinate only, from < to) that meet end to end bit for bit, cut into runs of
+  // at most `max_parts` (<= kMaxSplitParts) segments from the chain's low end. Pass every segment
+  // the bake could ask for, not only those it will compute, so that the plan (hence the sets)
+  // does not depend on the shard or on a resumed checkpoint. Call before expect().
+  void plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segments, int max_parts);
+
   // Registers one future get() of the world-aligned run on (from, to). Not thread-safe with get().
   void expect(Vec3 from, Vec3 to);
 
-  // The result of the world-aligned run on (from, to): `compute()` runs on the first call (inside
+  // The result of the world-aligned run on (from, to): `compute` runs on the first call (inside
   // a TBB isolated region, so that the computing thread never picks up a task that waits for this
   // very entry), concurrent callers for the same segment wait for it, later callers get the stored
-  // result. `*computed` says whether this call ran compute(). A segment that was not expect()ed
-  // twice or more is computed and not stored. An exception from compute() reaches every caller.
-  std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to,
-                                           const std::function<SegmentResult()>& compute,
+  // result. A segment of a planned chain gets its part of the chain's run. `*computed` says
+  // whether this call ran compute(). A segment that was not expect()ed twice or more, and is in no
+  // chain, is computed and not stored. An exception from compute() reaches every caller.
+  std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to, const RunFn& compute,
                                            bool* computed = nullptr);
 
   uint64_t runs_computed() const { return computed_.load(); }
   uint64_t runs_shared() const { return shared_.load(); }  // get() calls served from the cache
   size_t entries_held() const;                             // results awaiting a later use
+  size_t chains_planned() const { return chains_.size(); }
 
  private:
   using Key = std::array<uint64_t, 6>;  // the bits of from and to
   static Key key_of(Vec3 from, Vec3 to);
+  using Parts = std::vector<std::shared_ptr<const SegmentResult>>;
   struct Entry {
     uint32_t remaining = 0;  // expected get() calls still to come
     bool started = false;
     std::shared_future<std::shared_ptr<const SegmentResult>> result;
   };
+  struct Chain {
+    Vec3 from, to;
+    std::vector<double> splits;       // the junctions' parameters on from -> to
+    std::vector<uint32_t> remaining;  // per part: expected get() calls still to come
+    bool started = false;
+    // The parts; a part is released after its last expected use (the mutex guards the vector).
+    std::shared_future<std::shared_ptr<Parts>> result;
+  };
+  struct ChainRef {
+    uint32_t chain, part;
+  };
+  std::shared_ptr<Parts> run_chain(const Chain& c, const RunFn& compute);
+
   mutable std::mutex mutex_;
   std::map<Key, Entry> entries_;
+  std::vector<Chain> chains_;
+  std::map<Key, ChainRef> chain_of_;  // fixed after plan_chains
   std::atomic<uint64_t> computed_{0}, shared_{0};
 };
 

@@ -17,6 +17,8 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
@@ -327,6 +329,11 @@ class StaticKind {
     // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of
     // it, so only triangles beyond far * (1 + eps_z) are skipped (2 eps_z covers the rounding).
     far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;
+    if (!opt.splits.empty()) {
+      part_bounds_.push_back(0.0);
+      part_bounds_.insert(part_bounds_.end(), opt.splits.begin(), opt.splits.end());
+      part_bounds_.push_back(1.0);
+    }
     // Pixel-centre coordinates (pixel_center), padded so that 4 lanes can always be loaded.
     pixel_centers_.assign(size_t(N) + 4, 0.0);
     for (int i = 0; i < N; ++i) pixel_centers_[size_t(i)] = pixel_center(i, N);
@@ -433,6 +440,14 @@ class StaticKind {
 
   void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found) const {
     const PieceList& l = sc.lists[k];
+    if (!part_bounds_.empty()) {  // a split segment: marks per part, no witnesses
+      for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
+        mark_parts(found, part_bounds_, opt_.eps_len, id, t0, t1);
+      });
+      const int N = opt_.resolution;
+      if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
+      return;
+    }
     for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
       double len = t1 - t0;
       if (!(len > opt_.eps_len)) return;
@@ -459,6 +474,7 @@ class StaticKind {
   Vec3 v0_, v1_;
   const SegmentOptions& opt_;
   std::vector<PieceList>* pieces_;
+  std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
   bool keep_ties_ = false;
   double far_scale_ = 1.0;
   std::vector<double> pixel_centers_;
@@ -470,6 +486,16 @@ class StaticKind {
 
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
   assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
+  if (!opt.splits.empty()) {
+    bool ok = opt.splits.size() < kMaxSplitParts && opt.splits.front() > 0 && opt.splits.back() < 1;
+    for (size_t i = 1; i < opt.splits.size(); ++i) ok = ok && opt.splits[i - 1] < opt.splits[i];
+    if (!ok)
+      throw std::invalid_argument(
+          "segment split points must increase strictly inside (0, 1), at most " +
+          std::to_string(kMaxSplitParts - 1));
+    if (scene.sphere_count() > 0 || scene.is_dynamic())
+      throw std::invalid_argument("a segment can be split only in a static scene without spheres");
+  }
   if (scene.sphere_count() > 0 || scene.is_dynamic())
     return dynamic_segment_visibility(scene, v0, v1, opt);
   auto start = std::chrono::steady_clock::now();
@@ -493,8 +519,14 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   for (size_t t = 0; t < ntri; ++t)
     if (seen[t]) {
       result.visible.push_back(uint32_t(t));
-      if (opt.want_witnesses) result.witnesses.push_back(best[t]);
+      if (opt.want_witnesses && opt.splits.empty()) result.witnesses.push_back(best[t]);
     }
+  if (!opt.splits.empty()) {
+    result.visible_parts.resize(opt.splits.size() + 1);
+    for (uint32_t t : result.visible)
+      for (size_t i = 0; i < result.visible_parts.size(); ++i)
+        if (seen[t] >> i & 1) result.visible_parts[i].push_back(t);
+  }
   result.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;

@@ -56,7 +56,16 @@ struct SegmentOptions {
   DynamicMode mode = DynamicMode::Diagonal;    // dynamic scenes (moving vertices or spheres)
   CoplanarRule coplanar = CoplanarRule::Both;  // depth ties: both visible, or the first (lower id)
   double eps_z = kDefaultEpsZ;                 // tie tolerance, relative to the front depth; >= 0
+  // Split points of a long segment (issue 13 item 5; static scenes only): 0 < s_1 < ... < 1, at
+  // most kMaxSplitParts - 1 of them. Part i is [s_i, s_i+1] (s_0 = 0, s_m = 1); a triangle is
+  // visible from part i when it owns a final piece whose overlap with the part is longer than
+  // eps_len times the part's length, the test a run over that part alone makes. The result then
+  // holds visible_parts; witnesses are not kept per part (want_witnesses gives the whole
+  // segment's).
+  std::vector<double> splits;
 };
+
+constexpr size_t kMaxSplitParts = 8;
 
 struct SegmentStats {
   uint64_t pair_tests = 0;     // (triangle, pixel) coverage evaluations
@@ -93,6 +102,8 @@ struct SegmentResult {
   std::vector<uint32_t> visible;          // sorted triangle ids
   std::vector<uint32_t> visible_spheres;  // sorted sphere indices (dynamic kernel)
   std::vector<Witness> witnesses;         // if requested: one per visible id, in id order
+  // With options.splits: the sorted triangle ids visible from each part (visible is their union).
+  std::vector<std::vector<uint32_t>> visible_parts;
   // If requested: final list of pixel (face, x, y) at index (face * N + y) * N + x.
   std::vector<PieceList> pieces;
   // If requested, for dynamic scenes in Diagonal mode (instead of `pieces`): same indexing; ids
