@@ -42,8 +42,8 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
     std::fprintf(
         stderr,
         "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
-        "%llu bytes (%.1f per cell) written to %s; %llu from-segment runs, %llu of them shared "
-        "between neighbouring cells\n",
+        "%llu bytes (%.1f per cell) written to %s; %llu from-segment runs, %llu of them served "
+        "by shared edges and long segments\n",
         r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
         static_cast<unsigned long long>(r.stats.file_bytes),
         r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a.output.c_str(),

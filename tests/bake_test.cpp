@@ -35,11 +35,16 @@ Scene small_city() {
   return generate_city(o);
 }
 
-ViewCells small_grid() {
+// A grid of nx x 1 x nz cells over the square [-half, half]^2 (y 0..3), eye band `band`.
+ViewCells city_grid(double half, int nx, int nz, EyeBand band = EyeBand{1.5, 1.8}) {
   Box3 box;
-  box.extend({-30, 0, -30});
-  box.extend({30, 3, 30});
-  return grid_cells(box, 3, 1, 3, EyeBand{1.5, 1.8});
+  box.extend({-half, 0, -half});
+  box.extend({half, 3, half});
+  return grid_cells(box, nx, 1, nz, band);
+}
+
+ViewCells small_grid() {
+  return city_grid(30, 3, 3);
 }
 
 BakeSettings settings() {
@@ -439,10 +444,7 @@ TEST(CellSet, UnionOfSetsIsEveryTriangleOfAnySetAscending) {
 // (segment_run_cache.h), and the file is byte-identical to a bake that computes every cell alone.
 TEST(BakeSharedSegments, SetsEqualBakingEachCellAloneWithFewerRuns) {
   const Scene scene = small_city();
-  Box3 box;
-  box.extend({-30, 0, -30});
-  box.extend({30, 3, 30});
-  const ViewCells cells = grid_cells(box, 3, 1, 3, EyeBand{1.5, 1.8});
+  const ViewCells cells = small_grid();
   BakeSettings s;
   s.region.segment.resolution = 16;
   s.region.runs = 2;  // run 1 is a per-cell random orientation: never shared
@@ -471,10 +473,7 @@ TEST(BakeSharedSegments, SetsEqualBakingEachCellAloneWithFewerRuns) {
 
 TEST(BakeSharedSegments, ShardsShareOnlyTheirOwnCellsAndMergeToTheSameBytes) {
   const Scene scene = small_city();
-  Box3 box;
-  box.extend({-30, 0, -30});
-  box.extend({30, 3, 30});
-  const ViewCells cells = grid_cells(box, 4, 1, 1, EyeBand{1.5, 1.8});
+  const ViewCells cells = city_grid(30, 4, 1);
   BakeSettings s;
   s.region.segment.resolution = 16;
   s.long_segments = 1;  // edges only (BakeLongSegments merges shards of long segments)
@@ -579,10 +578,7 @@ TEST(SegmentRunCache, ChainsOfEdgesEndToEndRunOnceAndHandEachEdgeItsPart) {
 
 TEST(BakeLongSegments, SetsEqualBakingEachCellAloneWithFarFewerRuns) {
   const Scene scene = small_city();
-  Box3 box;
-  box.extend({-32, 0, -32});
-  box.extend({32, 3, 32});
-  const ViewCells cells = grid_cells(box, 8, 1, 8, EyeBand{1.5, 1.75});
+  const ViewCells cells = city_grid(32, 8, 8, EyeBand{1.5, 1.75});
   BakeSettings s;
   s.region.segment.resolution = 16;
   s.long_segments = 4;

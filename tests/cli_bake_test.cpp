@@ -16,6 +16,7 @@
 #include <regex>
 #include <thread>
 
+#include "pvs_format/pvs_format.h"
 #include "tests/test_support.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/import.h"
@@ -366,4 +367,25 @@ TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
   size_t brace = out.find('{');
   ASSERT_NE(brace, std::string::npos);
   EXPECT_TRUE(json::parse(out.substr(brace))["far_from_origin"].get<bool>());
+}
+
+// Long segments (issue 13 item 5) are on by default: the summary counts the kernel runs, the
+// metadata records the setting, the sets equal those of --long-segments 1, and an out-of-range
+// value is refused naming the option.
+TEST(CliBake, LongSegmentsRunFewerSegmentsForTheSameSets) {
+  std::string dir = temp_dir("cli_bake_long");
+  std::string out;
+  ASSERT_EQ(run_pvs(grid_bake(dir + "/long.pvs"), &out), 0) << out;
+  // 16 cells x 8 edges = 128 runs; 2 levels x 2 directions x 5 lines x 1 chain of 4 = 20 kernel
+  // runs, 108 served.
+  EXPECT_NE(out.find("128 from-segment runs, 108 of them served"), std::string::npos) << out;
+  ASSERT_EQ(run_pvs(grid_bake(dir + "/edges.pvs") + " --long-segments 1", &out), 0) << out;
+  EXPECT_NE(out.find("128 from-segment runs, 48 of them served"), std::string::npos) << out;
+  pvs::Reader a = pvs::Reader::from_file(dir + "/long.pvs"),
+              b = pvs::Reader::from_file(dir + "/edges.pvs");
+  EXPECT_NE(a.info().metadata.find("\"long_segments\":8"), std::string::npos);
+  EXPECT_EQ(b.info().metadata.find("long_segments"), std::string::npos);
+  for (uint32_t c = 0; c < 16; ++c) EXPECT_EQ(a.read_cell(c), b.read_cell(c)) << "cell " << c;
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/bad.pvs") + " --long-segments 9", &out), 2) << out;
+  EXPECT_NE(out.find("--long-segments"), std::string::npos) << out;
 }
