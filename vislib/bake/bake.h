@@ -92,8 +92,10 @@ struct BakeReport {
   std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
   double seconds = 0;                // wall time of this run's baking
   pvs::WriteStats stats;             // sizes of the written file
-  // From-segment runs: computed by the kernel in this run, and served from the shared-edge cache
-  // instead (share_segments); computed + shared = runs of the baked cells.
+  // From-segment runs: computed by the kernel in this run (a long segment counts once), and
+  // served from the shared-edge cache or a long segment's part instead (share_segments,
+  // long_segments); computed + shared = runs of the baked cells. A long segment's kernel seconds
+  // count for the cell that computed it.
   uint64_t segment_runs_computed = 0;
   uint64_t segment_runs_shared = 0;
   // Damaged records skipped (and a torn tail) when the checkpoint was reopened, and their bytes.
