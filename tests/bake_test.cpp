@@ -604,3 +604,38 @@ TEST(BakeLongSegments, SetsEqualBakingEachCellAloneWithFarFewerRuns) {
   }
   EXPECT_EQ(pvs::merge_pvs(shards), read_file(dir + "/long.pvs"));
 }
+
+TEST(SegmentRunCache, ConcurrentUsesOfAChainComputeItOnceAndReleaseEveryPart) {
+  SegmentRunCache cache;
+  std::vector<std::pair<Vec3, Vec3>> segs;
+  for (int i = 0; i < 3; ++i) segs.push_back({{0, 1.5, double(i)}, {0, 1.5, double(i + 1)}});
+  cache.plan_chains(segs, 8);
+  ASSERT_EQ(cache.chains_planned(), 1u);
+  for (int k = 0; k < 2; ++k)
+    for (const auto& [a, b] : segs) cache.expect(a, b);
+  std::atomic<int> computations{0};
+  auto compute = [&](Vec3, Vec3, const std::vector<double>& s) {
+    ++computations;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // others arrive meanwhile
+    SegmentResult r;
+    for (size_t i = 0; i <= s.size(); ++i) r.visible_parts.push_back({uint32_t(i)});
+    return r;
+  };
+  std::atomic<int> right{0};
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 6; ++k)
+    threads.emplace_back([&, k] {
+      const auto& [a, b] = segs[size_t(k % 3)];
+      if (cache.get(a, b, compute)->visible == std::vector<uint32_t>{uint32_t(k % 3)}) ++right;
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(computations.load(), 1);
+  EXPECT_EQ(right.load(), 6);
+  EXPECT_EQ(cache.entries_held(), 0u);
+  // A seventh use, not announced, runs the chain again.
+  bool computed = false;
+  EXPECT_EQ(cache.get(segs[1].first, segs[1].second, compute, &computed)->visible,
+            std::vector<uint32_t>{1});
+  EXPECT_TRUE(computed);
+  EXPECT_EQ(computations.load(), 2);
+}

@@ -156,15 +156,21 @@ std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, co
       parts = future.get();
     } catch (...) {
       lock.lock();
-      --c.remaining[part];
+      if (c.remaining[part] > 0) --c.remaining[part];
       throw;
     }
     lock.lock();
     std::shared_ptr<const SegmentResult> mine = (*parts)[part];
-    if (--c.remaining[part] == 0) (*parts)[part].reset();  // its last use: release it
+    if (c.remaining[part] > 0 && --c.remaining[part] == 0)
+      (*parts)[part].reset();  // its last use: release it
     bool done = true;
     for (uint32_t r : c.remaining) done = done && r == 0;
     if (done) c.result = {};
+    if (!mine) {
+      // Released by a concurrent use beyond those announced: run the chain again for this one.
+      lock.unlock();
+      return (*run_chain(c, compute))[part];
+    }
     return mine;
   }
   auto it = entries_.find(key);
