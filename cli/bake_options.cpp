@@ -184,7 +184,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->capture_default_str();
   cmd->add_option("--long-segments", a.long_segments,
                   "Run the world-aligned pass of up to this many cell edges lying end to end as "
-                  "one long segment, split per edge (1 = off; static scenes; see docs/bake.md)")
+                  "one long segment, split per edge (1 = off; static scenes; pays for many small "
+                  "cells over a large scene, see docs/bake.md)")
       ->check(in_range(1, int(vislib::kMaxSplitParts)))
       ->capture_default_str();
   cmd->add_option("--states", a.states,

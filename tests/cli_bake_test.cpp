@@ -369,17 +369,17 @@ TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
   EXPECT_TRUE(json::parse(out.substr(brace))["far_from_origin"].get<bool>());
 }
 
-// Long segments (issue 13 item 5) are on by default: the summary counts the kernel runs, the
-// metadata records the setting, the sets equal those of --long-segments 1, and an out-of-range
-// value is refused naming the option.
+// Long segments (issue 13 item 5, --long-segments L): the summary counts the kernel runs, the
+// metadata records the setting, the sets equal those of the default (edges only), and an
+// out-of-range value is refused naming the option.
 TEST(CliBake, LongSegmentsRunFewerSegmentsForTheSameSets) {
   std::string dir = temp_dir("cli_bake_long");
   std::string out;
-  ASSERT_EQ(run_pvs(grid_bake(dir + "/long.pvs"), &out), 0) << out;
+  ASSERT_EQ(run_pvs(grid_bake(dir + "/long.pvs") + " --long-segments 8", &out), 0) << out;
   // 16 cells x 8 edges = 128 runs; 2 levels x 2 directions x 5 lines x 1 chain of 4 = 20 kernel
   // runs, 108 served.
   EXPECT_NE(out.find("128 from-segment runs, 108 of them served"), std::string::npos) << out;
-  ASSERT_EQ(run_pvs(grid_bake(dir + "/edges.pvs") + " --long-segments 1", &out), 0) << out;
+  ASSERT_EQ(run_pvs(grid_bake(dir + "/edges.pvs"), &out), 0) << out;
   EXPECT_NE(out.find("128 from-segment runs, 48 of them served"), std::string::npos) << out;
   pvs::Reader a = pvs::Reader::from_file(dir + "/long.pvs"),
               b = pvs::Reader::from_file(dir + "/edges.pvs");

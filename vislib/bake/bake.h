@@ -30,7 +30,10 @@ struct BakeSettings {
   // lists are split per edge (segment_run_cache.h); at most kMaxSplitParts. 1 = off. Recorded in
   // the file's metadata when on: a set can differ from the per-edge runs where an event falls
   // within rounding of a junction (none seen in the tests and benchmarks, docs/performance.md).
-  int long_segments = int(kMaxSplitParts);
+  // Off by default: they pay where a run's fixed cost dominates (many small cells over a large
+  // scene: 3.5x on the 1M-triangle city's 2 m cells) and cost where the length does (24 m cells
+  // over the 20K-triangle default scene: 2x slower); docs/bake.md.
+  int long_segments = 1;
 };
 
 // Whether `settings` run long segments on `scene` (long_segments > 1 applies).
