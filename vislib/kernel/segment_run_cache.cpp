@@ -19,6 +19,7 @@ void SegmentRunCache::plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segm
                                   int max_parts) {
   chains_.clear();
   chain_of_.clear();
+  planned_ = 0;
   if (max_parts < 2) return;
   max_parts = std::min<int>(max_parts, int(kMaxSplitParts));
   // Group the axis-parallel segments by line: (axis, the bits of the two other coordinates).
@@ -72,6 +73,7 @@ void SegmentRunCache::plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segm
             chain_of_[key_of(items[m].from, items[m].to)] = {uint32_t(chains_.size()),
                                                              uint32_t(m - i)};
           chains_.push_back(std::move(c));
+          ++planned_;
         }
       }
       i = j;
@@ -82,18 +84,24 @@ void SegmentRunCache::plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segm
 void SegmentRunCache::expect(Vec3 from, Vec3 to) {
   std::lock_guard<std::mutex> lock(mutex_);
   const Key key = key_of(from, to);
-  auto c = chain_of_.find(key);
-  if (c != chain_of_.end())
-    ++chains_[c->second.chain].remaining[c->second.part];
-  else
-    ++entries_[key].remaining;
+  auto ref = chain_of_.find(key);
+  if (ref == chain_of_.end()) {
+    // A segment in no planned chain: a run of one part.
+    Chain c;
+    c.from = from;
+    c.to = to;
+    c.remaining.assign(1, 0);
+    ref = chain_of_.emplace(key, ChainRef{uint32_t(chains_.size()), 0}).first;
+    chains_.push_back(std::move(c));
+  }
+  ++chains_[ref->second.chain].remaining[ref->second.part];
 }
 
 size_t SegmentRunCache::entries_held() const {
   std::lock_guard<std::mutex> lock(mutex_);
-  size_t held = entries_.size();
+  size_t held = 0;
   for (const Chain& c : chains_)
-    for (uint32_t r : c.remaining) held += c.started && r > 0 ? 1 : 0;
+    for (uint32_t r : c.remaining) held += r > 0 ? 1 : 0;
   return held;
 }
 
@@ -102,6 +110,10 @@ std::shared_ptr<SegmentRunCache::Parts> SegmentRunCache::run_chain(const Chain& 
   auto parts = std::make_shared<Parts>();
   tbb::this_task_arena::isolate([&] {
     SegmentResult whole = compute(c.from, c.to, c.splits);
+    if (c.splits.empty()) {
+      parts->push_back(std::make_shared<const SegmentResult>(std::move(whole)));
+      return;
+    }
     for (size_t i = 0; i < whole.visible_parts.size(); ++i) {
       auto part = std::make_shared<SegmentResult>();
       part->visible = std::move(whole.visible_parts[i]);
@@ -115,94 +127,64 @@ std::shared_ptr<SegmentRunCache::Parts> SegmentRunCache::run_chain(const Chain& 
 
 std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, const RunFn& compute,
                                                           bool* computed) {
-  auto run = [&] {
-    std::shared_ptr<const SegmentResult> r;
-    tbb::this_task_arena::isolate(
-        [&] { r = std::make_shared<const SegmentResult>(compute(from, to, {})); });
-    computed_.fetch_add(1);
-    return r;
-  };
-  const Key key = key_of(from, to);
+  if (computed) *computed = true;
   std::unique_lock<std::mutex> lock(mutex_);
-  if (auto ref = chain_of_.find(key); ref != chain_of_.end()) {
-    Chain& c = chains_[ref->second.chain];
-    const uint32_t part = ref->second.part;
-    if (c.remaining[part] == 0) {
-      // A use not announced (or beyond those announced): run the chain again for it.
-      lock.unlock();
-      if (computed) *computed = true;
-      return (*run_chain(c, compute))[part];
-    }
-    const bool first = !c.started;
-    std::promise<std::shared_ptr<Parts>> promise;
-    if (first) {
-      c.started = true;
-      c.result = promise.get_future().share();
-    }
-    auto future = c.result;
+  auto ref = chain_of_.find(key_of(from, to));
+  if (ref == chain_of_.end()) {
+    // Never announced: nothing to share.
     lock.unlock();
-    if (computed) *computed = first;
-    if (first) {
-      try {
-        promise.set_value(run_chain(c, compute));
-      } catch (...) {
-        promise.set_exception(std::current_exception());
-      }
-    } else {
-      shared_.fetch_add(1);
-    }
-    std::shared_ptr<Parts> parts;
-    try {
-      parts = future.get();
-    } catch (...) {
-      lock.lock();
-      if (c.remaining[part] > 0) --c.remaining[part];
-      throw;
-    }
-    lock.lock();
-    std::shared_ptr<const SegmentResult> mine = (*parts)[part];
-    if (c.remaining[part] > 0 && --c.remaining[part] == 0)
-      (*parts)[part].reset();  // its last use: release it
-    bool done = true;
-    for (uint32_t r : c.remaining) done = done && r == 0;
-    if (done) c.result = {};
-    if (!mine) {
-      // Released by a concurrent use beyond those announced: run the chain again for this one.
-      lock.unlock();
-      return (*run_chain(c, compute))[part];
-    }
-    return mine;
+    Chain alone;
+    alone.from = from;
+    alone.to = to;
+    return (*run_chain(alone, compute))[0];
   }
-  auto it = entries_.find(key);
-  if (it == entries_.end() || (it->second.remaining <= 1 && !it->second.started)) {
-    // Used once (or never announced): nothing to share.
-    if (it != entries_.end()) entries_.erase(it);
+  Chain& c = chains_[ref->second.chain];
+  const uint32_t part = ref->second.part;
+  if (c.remaining[part] == 0) {
+    // A use beyond those announced: run it again for this one.
     lock.unlock();
-    if (computed) *computed = true;
-    return run();
+    return (*run_chain(c, compute))[part];
   }
-  Entry& e = it->second;
-  const bool first = !e.started;
-  std::promise<std::shared_ptr<const SegmentResult>> promise;
+  const bool first = !c.started;
+  std::promise<std::shared_ptr<Parts>> promise;
   if (first) {
-    e.started = true;
-    e.result = promise.get_future().share();
+    c.started = true;
+    c.result = promise.get_future().share();
   }
-  auto future = e.result;
-  if (e.remaining > 0) --e.remaining;
-  if (e.remaining == 0) entries_.erase(it);  // the future copy keeps the result alive
+  auto future = c.result;
   lock.unlock();
   if (computed) *computed = first;
   if (first) {
     try {
-      promise.set_value(run());
+      promise.set_value(run_chain(c, compute));
     } catch (...) {
       promise.set_exception(std::current_exception());
     }
   } else {
     shared_.fetch_add(1);
   }
-  return future.get();
+  std::shared_ptr<Parts> parts;
+  try {
+    parts = future.get();
+  } catch (...) {
+    lock.lock();
+    if (c.remaining[part] > 0) --c.remaining[part];
+    throw;
+  }
+  lock.lock();
+  std::shared_ptr<const SegmentResult> mine = (*parts)[part];
+  if (c.remaining[part] > 0 && --c.remaining[part] == 0)
+    (*parts)[part].reset();  // its last use: release it
+  bool done = true;
+  for (uint32_t r : c.remaining) done = done && r == 0;
+  if (done) c.result = {};
+  if (!mine) {
+    // Released by a concurrent use beyond those announced: run it again for this one.
+    lock.unlock();
+    if (computed) *computed = true;
+    return (*run_chain(c, compute))[part];
+  }
+  return mine;
 }
 
 }  // namespace vislib

@@ -52,25 +52,22 @@ class SegmentRunCache {
   // a TBB isolated region, so that the computing thread never picks up a task that waits for this
   // very entry), concurrent callers for the same segment wait for it, later callers get the stored
   // result. A segment of a planned chain gets its part of the chain's run. `*computed` says
-  // whether this call ran compute(). A segment that was not expect()ed twice or more, and is in no
-  // chain, is computed and not stored. An exception from compute() reaches every caller.
+  // whether this call ran compute(). A use that was not announced is computed and not stored. An
+  // exception from compute() reaches every caller.
   std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to, const RunFn& compute,
                                            bool* computed = nullptr);
 
   uint64_t runs_computed() const { return computed_.load(); }
   uint64_t runs_shared() const { return shared_.load(); }  // get() calls served from the cache
   size_t entries_held() const;                             // results awaiting a later use
-  size_t chains_planned() const { return chains_.size(); }
+  size_t chains_planned() const { return planned_; }
 
  private:
   using Key = std::array<uint64_t, 6>;  // the bits of from and to
   static Key key_of(Vec3 from, Vec3 to);
   using Parts = std::vector<std::shared_ptr<const SegmentResult>>;
-  struct Entry {
-    uint32_t remaining = 0;  // expected get() calls still to come
-    bool started = false;
-    std::shared_future<std::shared_ptr<const SegmentResult>> result;
-  };
+  // One kernel run: a planned chain of segments (split at the junctions), or a single segment
+  // (no splits, one part) announced by expect().
   struct Chain {
     Vec3 from, to;
     std::vector<double> splits;       // the junctions' parameters on from -> to
@@ -85,9 +82,9 @@ class SegmentRunCache {
   std::shared_ptr<Parts> run_chain(const Chain& c, const RunFn& compute);
 
   mutable std::mutex mutex_;
-  std::map<Key, Entry> entries_;
   std::vector<Chain> chains_;
-  std::map<Key, ChainRef> chain_of_;  // fixed after plan_chains
+  std::map<Key, ChainRef> chain_of_;  // every segment announced or planned
+  size_t planned_ = 0;                // chains of two or more segments
   std::atomic<uint64_t> computed_{0}, shared_{0};
 };
 
