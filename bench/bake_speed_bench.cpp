@@ -14,7 +14,9 @@
 // byte-identical (checked; exit 1 otherwise).
 //
 //   bake_speed_bench [--triangles T] [--sample S] [--res N] [--runs K] [--long L]
-//                    [--cores 1|all|both]
+//                    [--cores 1|all|both] [--no-bvh]
+// --no-bvh: the runs bin every triangle on every face instead of walking the BVH (BakeSettings::
+// bvh); the file hashes printed must equal those of a run without it.
 #include <sys/resource.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
@@ -56,12 +58,17 @@ int main(int argc, char** argv) {
   double sample = 16;
   int res = 512, runs = 1, long_parts = 8;
   std::string cores = "both";
+  bool bvh = true;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
+    if (a == "--no-bvh") {
+      bvh = false;
+      continue;
+    }
     if (i + 1 >= argc) {
       std::fprintf(stderr,
                    "usage: bake_speed_bench [--triangles T] [--sample S] [--res N] [--runs K] "
-                   "[--long L] [--cores 1|all|both]\n");
+                   "[--long L] [--cores 1|all|both] [--no-bvh]\n");
       return 2;
     }
     const std::string v = argv[++i];
@@ -101,8 +108,9 @@ int main(int argc, char** argv) {
       "bake_speed_bench: city of %zu triangles; %u walkable 2 m cells in the %.0f x %.0f m "
       "sample at the centre of the 200 x 200 m block; N = %d, K = %d\n",
       scene.triangle_count(), n, sample, sample, res, runs);
-  std::printf("%-6s %-7s %10s %10s %10s %14s %12s %12s %10s\n", "cores", "shared", "wall s",
-              "CPU s", "cells/min", "cells/CPU-min", "runs comp.", "runs shared", "peak MB");
+  std::printf("%-6s %-7s %10s %10s %10s %14s %12s %12s %10s %16s %7s\n", "cores", "shared",
+              "wall s", "CPU s", "cells/min", "cells/CPU-min", "runs comp.", "runs shared",
+              "peak MB", "file hash", "bvh s");
   const std::string dir =
       (std::filesystem::temp_directory_path() / ("bake_speed_bench_" + std::to_string(::getpid())))
           .string();
@@ -121,6 +129,7 @@ int main(int argc, char** argv) {
       s.region.runs = runs;
       s.share_segments = share >= 1;
       s.long_segments = share == 2 ? long_parts : 1;
+      s.bvh = bvh;
       const std::string path = dir + "/" + k + "_" + std::to_string(share) + ".pvs";
       reset_peak();
       const auto t0 = std::chrono::steady_clock::now();
@@ -132,12 +141,15 @@ int main(int argc, char** argv) {
       const std::string label = share == 2   ? "long" + std::to_string(long_parts)
                                 : share == 1 ? "yes"
                                              : "no";
-      std::printf("%-6s %-7s %10.2f %10.2f %10.1f %14.1f %12llu %12llu %10.1f\n", k, label.c_str(),
-                  sec, cpu, 60.0 * n / sec, 60.0 * n / cpu,
-                  (unsigned long long)r.segment_runs_computed,
-                  (unsigned long long)r.segment_runs_shared, peak_mb());
-      std::fflush(stdout);
       bytes[share] = read_file(path);
+      uint64_t h = 1469598103934665603ull;  // FNV-1a of the file: compare runs with --no-bvh
+      for (unsigned char ch : bytes[share]) h = (h ^ ch) * 1099511628211ull;
+      std::printf("%-6s %-7s %10.2f %10.2f %10.1f %14.1f %12llu %12llu %10.1f %016llx %7.3f\n", k,
+                  label.c_str(), sec, cpu, 60.0 * n / sec, 60.0 * n / cpu,
+                  (unsigned long long)r.segment_runs_computed,
+                  (unsigned long long)r.segment_runs_shared, peak_mb(), (unsigned long long)h,
+                  r.bvh_seconds);
+      std::fflush(stdout);
     }
     if (bytes[0] != bytes[1]) {
       std::printf("bake_speed_bench: MISMATCH: the shared-edge bake differs from the plain one\n");

@@ -20,7 +20,8 @@
 // final piece, peak memory of the run (VmHWM after resetting it through /proc/self/clear_refs),
 // visible count, pair and piece counts.
 //
-//   kernel_speed_bench [--reps R] [--cases a,b,..] [--cores 1|all|both] [--scalar]
+//   kernel_speed_bench [--reps R] [--cases a,b,..] [--cores 1|all|both] [--scalar] [--no-bvh]
+//       (static cases walk a BVH per tile, built once per scene and timed apart, unless --no-bvh)
 //   kernel_speed_bench --digest FILE [--res N] [--cases ...]
 //       writes, per case, the visible sets, counts and a hash of every final piece (want_pieces)
 //       at resolution N (default 256): the before/after exactness check of an optimisation.
@@ -120,6 +121,8 @@ double median(std::vector<double> v) {
 bool g_scalar = false;  // --scalar: SegmentOptions::simd = false
 int g_tile = 0;         // --tile T: SegmentOptions::tile_size (0: the default)
 bool g_first = false;   // --coplanar first: CoplanarRule::First (default: both, as pvs segment)
+bool g_no_bvh = false;  // --no-bvh: SegmentOptions::bvh stays null (every triangle binned per face)
+const TriangleBvh* g_bvh = nullptr;  // the case's tree (static cases, unless --no-bvh)
 
 SegmentOptions options(int n) {
   SegmentOptions o;
@@ -127,6 +130,7 @@ SegmentOptions options(int n) {
   o.simd = !g_scalar;
   if (g_tile > 0) o.tile_size = g_tile;
   if (g_first) o.coplanar = CoplanarRule::First;
+  o.bvh = g_bvh;
   return o;
 }
 
@@ -261,10 +265,13 @@ int main(int argc, char** argv) {
       g_first = next() == "first";
     else if (a == "--scalar")
       g_scalar = true;
+    else if (a == "--no-bvh")
+      g_no_bvh = true;
     else {
       std::fprintf(stderr,
                    "usage: kernel_speed_bench [--reps R] [--cases a,b] [--cores 1|all|both] "
-                   "[--digest FILE --res N] [--scalar] [--tile T] [--coplanar first|both]\n");
+                   "[--digest FILE --res N] [--scalar] [--tile T] [--coplanar first|both] "
+                   "[--no-bvh]\n");
       return 2;
     }
   }
@@ -276,6 +283,18 @@ int main(int argc, char** argv) {
   for (const Case& c : all_cases()) {
     if (!wanted(c.name)) continue;
     Scene scene = c.make();
+    // The static cases' tree, built once per scene like Embree's (its time is printed, not in
+    // the kernel's column).
+    TriangleBvh tree;
+    g_bvh = nullptr;
+    if (!g_no_bvh && !scene.is_dynamic() && scene.sphere_count() == 0) {
+      double cpu = 0;
+      const double wall = seconds_of([&] { tree = build_triangle_bvh(scene); }, &cpu);
+      g_bvh = &tree;
+      if (digest_file.empty())
+        std::printf("# %s: BVH of %zu triangles built in %.3f s (%.3f CPU s), %zu nodes\n",
+                    c.name.c_str(), scene.triangle_count(), wall, cpu, tree.nodes.size());
+    }
     if (!digest_file.empty()) {
       std::string d = digest(scene, c, res);
       std::fputs(d.c_str(), stdout);

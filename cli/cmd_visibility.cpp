@@ -56,6 +56,8 @@ void add_segment(CLI::App& app) {
     vislib::Vec3 v0 = parse_vec3(*from, "--from"), v1 = parse_vec3(*to, "--to");
     double load_s;
     vislib::Scene scene = load(*a, load_s);
+    vislib::TriangleBvh tree;
+    const double bvh_s = maybe_build_bvh(*a, false, scene, tree, so);
     vislib::SegmentResult r = vislib::with_memory_stage(
         "computing from-segment visibility at N = " + std::to_string(so.resolution) + " on " +
             std::to_string(scene.triangle_count()) + " triangles",
@@ -78,7 +80,8 @@ void add_segment(CLI::App& app) {
     json w = json::array();
     for (const auto& x : r.witnesses) w.push_back(witness_json(x));
     j["witnesses"] = w;
-    j["timings"] = {{"load_seconds", load_s}, {"visibility_seconds", r.stats.seconds}};
+    j["timings"] = {
+        {"load_seconds", load_s}, {"bvh_seconds", bvh_s}, {"visibility_seconds", r.stats.seconds}};
     j["counts"] = counts_json(r.stats);
     j["counts"]["scene_triangles"] = scene.triangle_count();
     j["counts"]["peak_rss_bytes"] = peak_rss_bytes();
@@ -126,6 +129,8 @@ void add_region(CLI::App& app) {
     ro.seed = *seed;
     double load_s;
     vislib::Scene scene = load(*a, load_s);
+    vislib::TriangleBvh tree;
+    const double bvh_s = maybe_build_bvh(*a, true, scene, tree, ro.segment);
     bool tty = isatty(fileno(stderr));
     auto r = vislib::region_visibility(scene, region, ro, [&](size_t done, size_t total) {
       if (!show_progress()) return;
@@ -170,7 +175,8 @@ void add_region(CLI::App& app) {
         {"visible", at_granularity(scene, r.visible, r.visible_spheres, a->granularity)},
         {"visible_spheres", r.visible_spheres},
         {"visible_triangles", r.visible.size()},
-        {"timings", {{"load_seconds", load_s}, {"visibility_seconds", r.seconds}}},
+        {"timings",
+         {{"load_seconds", load_s}, {"bvh_seconds", bvh_s}, {"visibility_seconds", r.seconds}}},
         {"counts",
          {{"scene_triangles", scene.triangle_count()}, {"peak_rss_bytes", peak_rss_bytes()}}}};
     if (*witness) {

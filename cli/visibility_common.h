@@ -31,7 +31,14 @@ struct VisibilityArgs {
   std::string coplanar = "both";
   double eps_z = vislib::kDefaultEpsZ;
   std::string json_out;
+  std::string bvh = "auto";  // auto | on | off (--bvh)
 };
+
+// Builds the triangle BVH the runs walk (SegmentOptions::bvh) when --bvh says so: "on", or
+// "auto" with `auto_on` (a command running many segments); static scenes without spheres only.
+// Sets so.bvh to `tree` and returns the build's wall seconds (0 when none was built).
+double maybe_build_bvh(const VisibilityArgs& a, bool auto_on, const vislib::Scene& scene,
+                       vislib::TriangleBvh& tree, vislib::SegmentOptions& so);
 
 void add_common(CLI::App* cmd, VisibilityArgs& a);
 vislib::SegmentOptions segment_options(const VisibilityArgs& a);

@@ -16,6 +16,7 @@
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/kernel/segment_run_cache.h"
+#include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 namespace vislib {
@@ -138,6 +139,16 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
       for (const Box3& rect : cell_rectangles(info.layout, c))
         for (const Segment& s : perimeter_segments(rect)) shared_runs.expect(s.from, s.to);
     }
+  }
+  // One BVH for every static run of this bake (the runs walk it per tile).
+  TriangleBvh tree;
+  if (settings.bvh && !settings.region.segment.bvh && !scene.is_dynamic() &&
+      scene.sphere_count() == 0 && scene.triangle_count() > 0) {
+    const auto t0 = std::chrono::steady_clock::now();
+    tree = build_triangle_bvh(scene, settings.region.segment.state);
+    run_settings.region.segment.bvh = &tree;
+    report.bvh_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   std::atomic<uint64_t> runs_done{0};
 

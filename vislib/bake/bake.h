@@ -34,6 +34,10 @@ struct BakeSettings {
   // scene: 3.5x on the 1M-triangle city's 2 m cells) and cost where the length does (24 m cells
   // over the 20K-triangle default scene: 2x slower); docs/bake.md.
   int long_segments = 1;
+  // Static scenes without spheres: build one BVH of the triangles (triangle_bvh.h) that every run
+  // of the bake walks per tile, instead of each run computing footprint bounds for every
+  // triangle on every face (issue 13, item 4). The file is byte-identical either way.
+  bool bvh = true;
 };
 
 // Whether `settings` run long segments on `scene` (long_segments > 1 applies).
@@ -101,6 +105,7 @@ struct BakeReport {
   // count for the cell that computed it.
   uint64_t segment_runs_computed = 0;
   uint64_t segment_runs_shared = 0;
+  double bvh_seconds = 0;  // building the BVH the runs share (BakeSettings::bvh), wall time
   // Damaged records skipped (and a torn tail) when the checkpoint was reopened, and their bytes.
   size_t checkpoint_dropped_records = 0;
   uint64_t checkpoint_dropped_bytes = 0;

@@ -31,6 +31,7 @@ std::string bake_report_json(const BakeRunInfo& info, const BakeReport& r) {
       {"timings",
        {{"setup_seconds", info.setup_seconds},
         {"bake_seconds", r.seconds},
+        {"bvh_seconds", r.bvh_seconds},
         {"kernel_seconds", kernel_seconds(r)}}},
       {"cell_seconds", r.cell_seconds},
       {"bytes",

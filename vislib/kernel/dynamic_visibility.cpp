@@ -465,6 +465,8 @@ class DynamicKind {
                                opt_.resolution, b[0], b[1], b[2], b[3]);
   }
 
+  static constexpr bool kHasBvh = false;  // moving primitives: no tree
+
   void cover(Scratch& sc, const TileItem& item, const int* b, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {
     const int N = opt_.resolution;

@@ -143,6 +143,77 @@ bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double n
   return bounds_of(pts, k, kFootprintMargin + kFootprintRelativeMargin * m, n, x0, x1, y0, y1);
 }
 
+bool box_footprint_bounds(const float lo[3], const float hi[3], Vec3 v0, Vec3 v1,
+                          const FaceAxes& axes, double near, int n, int& x0, int& x1, int& y0,
+                          int& y1, double& zmin) {
+  Vec3 q[16];
+  double mag = 0;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner{(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]};
+    for (int e = 0; e < 2; ++e) {
+      const Vec3 rel = corner - (e ? v1 : v0);
+      Vec3& p = q[2 * c + e];
+      p = {dot(axes.S, rel), dot(axes.T, rel), dot(axes.F, rel)};
+      mag = std::max({mag, std::fabs(rel.x), std::fabs(rel.y), std::fabs(rel.z)});
+    }
+  }
+  // delta: far more than the rounding of any of these dot products, or of a contained
+  // triangle's (a few units in the last place of mag), so that every test below is decided the
+  // conservative way for every triangle inside the box.
+  const double delta = 1e-9 * mag + 1e-300;
+  const double g = 1.0 + 2 * kFrustumRejectWidening;
+  bool behind = true, right = true, left = true, up = true, down = true, straddles = false;
+  double z_low = INFINITY;
+  for (const Vec3& p : q) {
+    const double z = (std::fabs(p.z) + delta) * g;
+    behind = behind && p.z < near - delta;
+    right = right && p.x - delta > z;
+    left = left && p.x + delta < -z;
+    up = up && p.y - delta > z;
+    down = down && p.y + delta < -z;
+    straddles = straddles || p.z < near + delta;
+    z_low = std::min(z_low, p.z);
+  }
+  zmin = z_low - delta;
+  if (behind || right || left || up || down) return false;
+  // Clip the box's swept hull at z = near_c, a little nearer than near so that every point of a
+  // contained triangle at z >= near (as its own test computes it) is inside; its projection's
+  // extremes are those of the points in front and of the crossings of all pairs of points with
+  // the clipping plane (a superset of the clipped hull's vertices, inside the hull).
+  const double near_c = near - delta;
+  if (!(near_c > 0.5 * near)) {  // the margin swamps near: the whole face (conservative)
+    x0 = y0 = 0;
+    x1 = y1 = n - 1;
+    return true;
+  }
+  Vec2 pts[16 + 64];
+  int k = 0;
+  for (const Vec3& p : q)
+    if (p.z >= near_c) pts[k++] = {p.x / p.z, p.y / p.z};
+  if (straddles)
+    for (int i = 0; i < 16; ++i)
+      for (int j = i + 1; j < 16; ++j) {
+        const double zi = q[i].z - near_c, zj = q[j].z - near_c;
+        if (!((zi < 0 && zj > 0) || (zi > 0 && zj < 0))) continue;
+        const double s = (near_c - q[i].z) / (q[j].z - q[i].z);
+        const double x = q[i].x + s * (q[j].x - q[i].x), y = q[i].y + s * (q[j].y - q[i].y);
+        pts[k++] = {x / near_c, y / near_c};  // at most 8 x 8 pairs cross
+      }
+  if (k == 0) return false;  // nothing at z >= near_c (then nothing at z >= near either)
+  // The projected triangle points lie inside the hull of these up to rounding, which the margin
+  // (amplified by 1/z, z >= near_c) covers.
+  double m = 0;
+  for (int i = 0; i < k; ++i) m = std::max({m, std::fabs(pts[i].u), std::fabs(pts[i].w)});
+  const double margin =
+      2 * (kFootprintMargin + kFootprintRelativeMargin * m) + 1e-9 * (1 + m) * (mag / near_c + 1);
+  if (!bounds_of(pts, k, margin, n, x0, x1, y0, y1)) return false;
+  x0 = std::max(0, x0 - 1);  // one pixel more on each side
+  y0 = std::max(0, y0 - 1);
+  x1 = std::min(n - 1, x1 + 1);
+  y1 = std::min(n - 1, y1 + 1);
+  return true;
+}
+
 unsigned reachable_faces(const Vec3* rel, int count, const Mat3& R, double near) {
   // World axes A_j = R e_j. Every face axis R a (a = +-e_j, face_axes) equals +-A_j component by
   // component (up to the sign of zero components), so dot(R a, p) = +-dot(A_j, p) bit for bit

@@ -45,6 +45,14 @@ bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y
 bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double near, int n, int& x0,
                       int& x1, int& y0, int& y1, double& zmin);
 
+// A rectangle containing footprint_bounds of every triangle inside the box [lo, hi] (world
+// coordinates) seen from the segment v0 -> v1, and `zmin` below each such triangle's zmin: the
+// bounds of a BVH node (triangle_bvh.h). False when no such triangle can reach the face. The
+// whole face when the box reaches the near plane.
+bool box_footprint_bounds(const float lo[3], const float hi[3], Vec3 v0, Vec3 v1,
+                          const FaceAxes& axes, double near, int n, int& x0, int& x1, int& y0,
+                          int& y1, double& zmin);
+
 // Bit k set for every cube face k (orientation R) on which footprint_bounds / compute_footprint
 // of the same points may be non-empty: the faces that their quick frustum reject does not
 // exclude, decided for all six faces from one set of dot products (bit-identical to the per-face

@@ -342,8 +342,21 @@ class StaticKind {
 #else
     coverage4_ = coverage4_scalar;
 #endif
-    // The faces each triangle can reach (issue 13, item 4).
-    faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
+    // The faces each triangle can reach (issue 13, item 4); with a BVH, only the triangles its
+    // walk reaches get bounds, so nothing is classified up front.
+    if (!opt.bvh)
+      faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
+  }
+
+  static constexpr bool kHasBvh = true;
+  const TriangleBvh* bvh() const {
+    return opt_.bvh;
+  }
+  bool node_bounds(uint32_t node, int face, const FaceAxes& axes, int* b, double& zmin) const {
+    const TriangleBvh::Node& n = opt_.bvh->nodes[node];
+    (void)face;
+    return box_footprint_bounds(n.lo, n.hi, v0_, v1_, axes, opt_.near, opt_.resolution, b[0], b[1],
+                                b[2], b[3], zmin);
   }
 
   size_t count() const {
@@ -360,7 +373,7 @@ class StaticKind {
   // The pixel rectangle of the footprint (footprint_bounds: the hull's rectangle without the
   // hull) and the nearest depth, on the faces the triangle can reach.
   bool bounds(size_t t, int face, const FaceAxes& axes, int* b, double& zmin) const {
-    if (!(faces_[t] >> face & 1)) return false;
+    if (!faces_.empty() && !(faces_[t] >> face & 1)) return false;
     Vec3 rel[6];
     relative_corners(t, rel);
     return footprint_bounds(rel, 6, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], zmin);
@@ -498,6 +511,9 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   }
   if (scene.sphere_count() > 0 || scene.is_dynamic())
     return dynamic_segment_visibility(scene, v0, v1, opt);
+  if (opt.bvh && !opt.bvh->matches(scene, opt.state))
+    throw std::invalid_argument(
+        "the BVH given to segment_visibility was built for another scene or key state");
   auto start = std::chrono::steady_clock::now();
   const int N = opt.resolution;
   const int tiles_x = (N + opt.tile_size - 1) / opt.tile_size;

@@ -10,7 +10,9 @@
 // Arithmetic: coordinates are re-centred at v0 and everything is double; coverage uses 3D triple
 // products with canonically oriented edges (bit-identical on shared edges, so closed meshes do not
 // leak) and the symbolic-perturbation tie rule of §2.5. Deterministic: the result (ids, witnesses,
-// pieces) is identical for any thread count and any triangle input order (ids mapped back).
+// pieces) is identical for any thread count, tile order and with or without a BVH. (Renumbering
+// the triangles changes the order of insertion among equal depths, which can change the tiny
+// pieces at triple depth crossings: interval_list.h.)
 #pragma once
 
 #include <cstdint>
@@ -20,6 +22,7 @@
 #include "vislib/base/tolerances.h"
 #include "vislib/kernel/general_depth.h"
 #include "vislib/kernel/interval_list.h"
+#include "vislib/kernel/triangle_bvh.h"
 #include "vislib/kernel/witness.h"
 #include "vislib/scene/scene.h"
 
@@ -63,6 +66,11 @@ struct SegmentOptions {
   // holds visible_parts; witnesses are not kept per part (want_witnesses gives the whole
   // segment's).
   std::vector<double> splits;
+  // Static scenes: a BVH of the scene's triangles in key state `state` (build_triangle_bvh), so
+  // that each tile walks the tree front to back instead of every triangle getting footprint
+  // bounds on every face (issue 13, item 4). Null: no tree. The results are the same either way;
+  // a tree built for another scene or state is refused (std::invalid_argument).
+  const TriangleBvh* bvh = nullptr;
 };
 
 constexpr size_t kMaxSplitParts = 8;

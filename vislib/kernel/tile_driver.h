@@ -12,6 +12,15 @@
 // (marks, witnesses, pieces). Per-tile statistics are kept apart and reduced in tile order by the
 // caller, so nothing depends on scheduling.
 //
+// With a BVH (static triangles with SegmentOptions::bvh, triangle_bvh.h), steps (1) and (2) are
+// skipped: each tile walks the tree nearest node first (a heap ordered by nearest depth, ties by
+// index), keeps the nodes and triangles whose footprint rectangle meets the tile, and stops when
+// the nearest entry lies behind every pixel of the tile, so the nodes behind it are never opened.
+// Node and triangle rectangles are computed once per face, by the first tile that needs them.
+// The nodes' rectangles contain their triangles' and their depths lie below them
+// (box_footprint_bounds), so the tile meets exactly the triangles it meets without the tree,
+// less those the culling skips; the lists, marks and witnesses are the same.
+//
 // What a kind provides (see StaticKind and DynamicKind):
 //   using Scratch = ...;   per-thread tile state with, per pixel of a tile: `lists` (its pieces),
 //                          `ties` (its tie records) and `far` (a depth that its list covers
@@ -26,20 +35,27 @@
 //              SegmentStats&) const;         coverage and compositing of one primitive
 //   void finish_pixel(Scratch&, size_t k, int face, int x, int y, FoundMarks&) const;
 //                          report the non-empty list of pixel k = (y - y0) * stride + (x - x0)
+//   static constexpr bool kHasBvh;          true: also
+//   const TriangleBvh* bvh() const;         the tree (null: bin every primitive), and
+//   bool node_bounds(uint32_t node, int face, const FaceAxes&, int* box, double& zmin) const;
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <vector>
 
 #include "vislib/base/cubemap.h"
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/kernel/triangle_bvh.h"
 
 namespace vislib {
 
@@ -80,6 +96,165 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
   return faces;
 }
 
+// Per-face, compute-once rectangles and depths (of BVH nodes or triangles): the first thread to
+// need entry i computes it and publishes it; a thread that finds it being written computes its
+// own copy (the same values: the computation is deterministic).
+class FaceBoundsCache {
+ public:
+  void reset(size_t n) {
+    if (n > size_) {
+      state_.reset(new std::atomic<uint8_t>[n]);
+      box_.resize(n * 4);
+      zmin_.resize(n);
+      size_ = n;
+    }
+    for (size_t i = 0; i < n; ++i) state_[i].store(0, std::memory_order_relaxed);
+  }
+  // Rectangle (x0, x1, y0, y1) in box and nearest depth (rounded down) in z; false when empty.
+  template <class Compute>
+  bool get(size_t i, int* box, float& z, Compute compute) {
+    if (state_[i].load(std::memory_order_acquire) != 2) {
+      double zd = 0;
+      bool ok = compute(box, zd);
+      if (!ok) {
+        box[0] = 1;
+        box[1] = 0;
+      }
+      z = ok ? round_down_to_float(zd) : 0.0f;
+      uint8_t expected = 0;
+      if (state_[i].compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+        std::copy(box, box + 4, &box_[i * 4]);
+        zmin_[i] = z;
+        state_[i].store(2, std::memory_order_release);
+      }
+      return ok;
+    }
+    std::copy(&box_[i * 4], &box_[i * 4] + 4, box);
+    z = zmin_[i];
+    return box[0] <= box[1];
+  }
+
+ private:
+  std::unique_ptr<std::atomic<uint8_t>[]> state_;
+  std::vector<int> box_;
+  std::vector<float> zmin_;
+  size_t size_ = 0;
+};
+
+// The culling bound of one tile: the farthest `far` over its pixels (inf while some pixel does
+// not cover [0, 1]), recomputed every 16 primitives (far only decreases once finite, so an older
+// value stays a bound).
+template <class Scratch>
+struct TileFar {
+  const Scratch& sc;
+  int tw, th, ts;
+  double value = INFINITY;
+  int since = 16;
+  // True when a primitive whose nearest depth is zmin lies behind every pixel of the tile.
+  bool culls(float zmin) {
+    if (++since >= 16) {
+      since = 0;
+      double f = -INFINITY;
+      for (int k = 0; k < th && f < INFINITY; ++k)
+        for (int i = 0; i < tw; ++i) f = std::max(f, sc.far[size_t(k) * ts + i]);
+      value = f;
+    }
+    return double(zmin) > value;
+  }
+};
+
+// A tile's queue entry with a BVH: a node or a triangle (with its rectangle), under one 64-bit key
+// ordered as the walk needs it: nearest depth first; at equal depths nodes before triangles, then
+// by index or id. Then the triangles leave the queue in exactly the order of the binned path
+// (nearest depth, then id): a node's depth lies below its triangles', so every triangle ordered
+// before one leaving the queue has already left it. The order matters: in floating point, the
+// final lists of insert_piece depend slightly on it (interval_list.h).
+struct QueueItem {
+  uint64_t key;
+  int box[4];
+};
+constexpr uint32_t kTriangleBit = 0x80000000u;
+inline uint64_t queue_key(float zmin, uint32_t low) {
+  uint32_t bits;
+  const float z = zmin + 0.0f;  // -0 -> +0: equal depths, equal keys
+  std::memcpy(&bits, &z, 4);
+  bits = bits & 0x80000000u ? ~bits : bits | 0x80000000u;  // ascending as the floats
+  return uint64_t(bits) << 32 | low;
+}
+inline float queue_zmin(uint64_t key) {
+  uint32_t bits = uint32_t(key >> 32);
+  bits = bits & 0x80000000u ? bits & 0x7fffffffu : ~bits;
+  float z;
+  std::memcpy(&z, &bits, 4);
+  return z;
+}
+struct QueueAfter {  // min-heap order for std::push_heap / pop_heap
+  bool operator()(const QueueItem& a, const QueueItem& b) const { return a.key > b.key; }
+};
+
+// One tile with a BVH: nearest entry first; a node's children (or a leaf's triangles) enter the
+// queue when their rectangle meets the tile; a triangle is covered when it leaves the queue,
+// unless it (and so everything after it) lies behind every pixel of the tile.
+template <class Kind, class Scratch>
+void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axes,
+               const TileRect& rect, bool culling, Scratch& sc, TileFar<Scratch>& tile_far,
+               FaceBoundsCache& node_cache, FaceBoundsCache& tri_cache,
+               std::vector<QueueItem>& queue, SegmentStats& stats) {
+  auto meets = [&rect](const int* b) {
+    return b[0] <= b[1] && b[0] <= rect.x1 && b[1] >= rect.x0 && b[2] <= rect.y1 && b[3] >= rect.y0;
+  };
+  auto push_node = [&](uint32_t node) {
+    QueueItem q;
+    float z;
+    node_cache.get(node, q.box, z,
+                   [&](int* b, double& zd) { return kind.node_bounds(node, face, axes, b, zd); });
+    if (!meets(q.box)) return;
+    q.key = queue_key(z, node);
+    queue.push_back(q);
+    std::push_heap(queue.begin(), queue.end(), QueueAfter{});
+  };
+  queue.clear();
+  if (bvh.nodes.empty()) return;
+  push_node(0);
+  uint64_t queued_triangles = 0;
+  while (!queue.empty()) {
+    std::pop_heap(queue.begin(), queue.end(), QueueAfter{});
+    const QueueItem q = queue.back();
+    queue.pop_back();
+    const float z = queue_zmin(q.key);
+    const uint32_t low = uint32_t(q.key);
+    if (culling && tile_far.culls(z)) {
+      uint64_t left = low & kTriangleBit ? 1 : 0;
+      for (const QueueItem& e : queue) left += uint32_t(e.key) & kTriangleBit ? 1 : 0;
+      stats.culled_triangle_tiles += left;
+      break;
+    }
+    if (low & kTriangleBit) {
+      kind.cover(sc, TileItem{low & ~kTriangleBit, z}, q.box, rect, axes, stats);
+      continue;
+    }
+    const TriangleBvh::Node& n = bvh.nodes[low];
+    if (n.count == 0) {
+      push_node(n.first);
+      push_node(n.first + 1);
+      continue;
+    }
+    for (uint32_t i = n.first; i < n.first + n.count; ++i) {
+      const uint32_t t = bvh.order[i];
+      QueueItem e;
+      float tz;
+      tri_cache.get(t, e.box, tz,
+                    [&](int* b, double& zd) { return kind.bounds(t, face, axes, b, zd); });
+      if (!meets(e.box)) continue;
+      e.key = queue_key(tz, t | kTriangleBit);
+      ++queued_triangles;
+      queue.push_back(e);
+      std::push_heap(queue.begin(), queue.end(), QueueAfter{});
+    }
+  }
+  stats.triangle_tiles += queued_triangles;
+}
+
 // Runs the six faces of one from-segment run of `kind`. tile_stats has 6 * tiles^2 entries
 // (counts are added to them, so several runs can share them); found_by_thread gets the marks.
 template <class Kind>
@@ -91,31 +266,40 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   const size_t count = kind.count();
   tbb::enumerable_thread_specific<typename Kind::Scratch> scratch(
       [&kind, TS] { return kind.make_scratch(TS); });
-  std::vector<int> bbox(count * 4);
-  std::vector<float> zmin(count);
+  const TriangleBvh* bvh = nullptr;
+  if constexpr (Kind::kHasBvh) bvh = kind.bvh();
+  std::vector<int> bbox(bvh ? 0 : count * 4);
+  std::vector<float> zmin(bvh ? 0 : count);
   std::vector<uint32_t> bin_start;
   std::vector<TileItem> bins;
+  FaceBoundsCache node_cache, tri_cache;
+  tbb::enumerable_thread_specific<std::vector<QueueItem>> queues;
 
   for (int face = 0; face < kCubeFaces; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
-    // (1) footprint bounds and nearest depth of every primitive on this face.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 512),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t p = r.begin(); p != r.end(); ++p) {
-                          int* b = &bbox[p * 4];
-                          double z = 0;
-                          if (!kind.bounds(p, face, axes, b, z)) {
-                            b[0] = 1;
-                            b[1] = 0;  // empty
-                            continue;
+    if (bvh) {
+      node_cache.reset(bvh->nodes.size());
+      tri_cache.reset(count);
+    } else {
+      // (1) footprint bounds and nearest depth of every primitive on this face.
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 512),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t p = r.begin(); p != r.end(); ++p) {
+                            int* b = &bbox[p * 4];
+                            double z = 0;
+                            if (!kind.bounds(p, face, axes, b, z)) {
+                              b[0] = 1;
+                              b[1] = 0;  // empty
+                              continue;
+                            }
+                            zmin[p] = round_down_to_float(z);
                           }
-                          zmin[p] = round_down_to_float(z);
-                        }
-                      });
-    // (2) bin by tile (counting sort, in id order).
-    bin_by_tile(bbox, count, TS, tiles_x, bin_start, bins, [&](size_t p) {
-      return TileItem{uint32_t(p), zmin[p]};
-    });
+                        });
+      // (2) bin by tile (counting sort, in id order).
+      bin_by_tile(bbox, count, TS, tiles_x, bin_start, bins, [&](size_t p) {
+        return TileItem{uint32_t(p), zmin[p]};
+      });
+    }
 
     // (3) tiles in parallel.
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1),
@@ -134,33 +318,27 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           for (auto& l : sc.lists) l.clear();
                           for (auto& l : sc.ties) l.clear();
                           std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-                          TileItem* tb = bins.data() + bin_start[tile];
-                          TileItem* te = bins.data() + bin_start[tile + 1];
-                          // Front to back (nearest possible depth), ties by id: the order only
-                          // affects speed.
-                          std::sort(tb, te, [](const TileItem& a, const TileItem& b) {
-                            return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
-                          });
-                          stats.triangle_tiles += uint64_t(te - tb);
-                          double tile_far = INFINITY;
-                          int since_check = 0;
-                          for (TileItem* it = tb; it != te; ++it) {
-                            if (opt.depth_culling) {
-                              // Every 16 primitives: the farthest `far` over the tile's pixels.
-                              if (++since_check >= 16 || it == tb) {
-                                since_check = 0;
-                                double f = -INFINITY;
-                                for (int k = 0; k < th && f < INFINITY; ++k)
-                                  for (int i = 0; i < tw; ++i)
-                                    f = std::max(f, sc.far[size_t(k) * TS + i]);
-                                tile_far = f;
-                              }
-                              if (double(it->zmin) > tile_far) {
+                          TileFar<typename Kind::Scratch> tile_far{sc, tw, th, TS};
+                          if (bvh) {
+                            if constexpr (Kind::kHasBvh)
+                              walk_tile(kind, *bvh, face, axes, rect, opt.depth_culling, sc,
+                                        tile_far, node_cache, tri_cache, queues.local(), stats);
+                          } else {
+                            TileItem* tb = bins.data() + bin_start[tile];
+                            TileItem* te = bins.data() + bin_start[tile + 1];
+                            // Front to back (nearest possible depth), ties by id: the order only
+                            // affects speed.
+                            std::sort(tb, te, [](const TileItem& a, const TileItem& b) {
+                              return a.zmin < b.zmin || (a.zmin == b.zmin && a.id < b.id);
+                            });
+                            stats.triangle_tiles += uint64_t(te - tb);
+                            for (TileItem* it = tb; it != te; ++it) {
+                              if (opt.depth_culling && tile_far.culls(it->zmin)) {
                                 stats.culled_triangle_tiles += uint64_t(te - it);
                                 break;
                               }
+                              kind.cover(sc, *it, &bbox[size_t(it->id) * 4], rect, axes, stats);
                             }
-                            kind.cover(sc, *it, &bbox[size_t(it->id) * 4], rect, axes, stats);
                           }
                           // Tile results: marks, witnesses, pieces, statistics.
                           size_t bytes = 0;
