@@ -122,6 +122,7 @@ json counts_json(const vislib::SegmentStats& s) {
           {"max_pieces_per_pixel", s.max_pieces_per_pixel},
           {"triangle_tiles", s.triangle_tiles},
           {"culled_triangle_tiles", s.culled_triangle_tiles},
+          {"bvh_nodes_opened", s.bvh_nodes_opened},
           {"peak_tile_bytes", s.peak_tile_bytes}};
 }
 

@@ -141,25 +141,56 @@ class FaceBoundsCache {
   size_t size_ = 0;
 };
 
-// The culling bound of one tile: the farthest `far` over its pixels (inf while some pixel does
-// not cover [0, 1]), recomputed every 16 primitives (far only decreases once finite, so an older
-// value stays a bound).
+// The culling bounds of one tile: the farthest `far` over its pixels (inf while some pixel does
+// not cover [0, 1]), and the same over each of its 4 x 4 blocks, recomputed every 16 primitives
+// (far only decreases once finite, so an older value stays a bound). A primitive whose nearest
+// depth lies beyond the blocks its rectangle meets is hidden at every pixel it can reach: the
+// per-pixel culling of the kind would skip each of its pairs, so skipping it whole is exact and
+// changes nothing.
 template <class Scratch>
 struct TileFar {
   const Scratch& sc;
-  int tw, th, ts;
+  const TileRect& rect;
+  int tw, th;
   double value = INFINITY;
+  double block[16];
+  int bs = 1;  // block side in pixels
   int since = 16;
+  TileFar(const Scratch& s, const TileRect& r) : sc(s), rect(r) {
+    tw = r.x1 - r.x0 + 1;
+    th = r.y1 - r.y0 + 1;
+    bs = (r.stride + 3) / 4;
+    std::fill(block, block + 16, INFINITY);
+  }
+  void refresh() {
+    std::fill(block, block + 16, -INFINITY);
+    for (int k = 0; k < th; ++k) {
+      const double* row = &sc.far[size_t(k) * size_t(rect.stride)];
+      double* b = &block[(k / bs) * 4];
+      for (int i = 0; i < tw; ++i) b[i / bs] = std::max(b[i / bs], row[i]);
+    }
+    value = -INFINITY;
+    for (int i = 0; i < 16; ++i) value = std::max(value, block[i]);
+  }
   // True when a primitive whose nearest depth is zmin lies behind every pixel of the tile.
-  bool culls(float zmin) {
-    if (++since >= 16) {
+  // `count` false: a BVH node, which does not advance the 16 (the same bound as before).
+  bool culls(float zmin, bool count = true) {
+    if (count && ++since >= 16) {
       since = 0;
-      double f = -INFINITY;
-      for (int k = 0; k < th && f < INFINITY; ++k)
-        for (int i = 0; i < tw; ++i) f = std::max(f, sc.far[size_t(k) * ts + i]);
-      value = f;
+      refresh();
     }
     return double(zmin) > value;
+  }
+  // True when it lies behind every pixel of the tile inside box (x0, x1, y0, y1).
+  bool culls_box(float zmin, const int* box) const {
+    const int bx0 = (std::max(box[0], rect.x0) - rect.x0) / bs;
+    const int bx1 = (std::min(box[1], rect.x1) - rect.x0) / bs;
+    const int by0 = (std::max(box[2], rect.y0) - rect.y0) / bs;
+    const int by1 = (std::min(box[3], rect.y1) - rect.y0) / bs;
+    double m = -INFINITY;
+    for (int y = by0; y <= by1; ++y)
+      for (int x = bx0; x <= bx1; ++x) m = std::max(m, block[y * 4 + x]);
+    return double(zmin) > m;
   }
 };
 
@@ -208,7 +239,7 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
     float z;
     node_cache.get(node, q.box, z,
                    [&](int* b, double& zd) { return kind.node_bounds(node, face, axes, b, zd); });
-    if (!meets(q.box)) return;
+    if (!meets(q.box) || (culling && tile_far.culls_box(z, q.box))) return;
     q.key = queue_key(z, node);
     queue.push_back(q);
     std::push_heap(queue.begin(), queue.end(), QueueAfter{});
@@ -223,17 +254,22 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
     queue.pop_back();
     const float z = queue_zmin(q.key);
     const uint32_t low = uint32_t(q.key);
-    if (culling && tile_far.culls(z)) {
+    if (culling && tile_far.culls(z, low & kTriangleBit)) {
       uint64_t left = low & kTriangleBit ? 1 : 0;
       for (const QueueItem& e : queue) left += uint32_t(e.key) & kTriangleBit ? 1 : 0;
       stats.culled_triangle_tiles += left;
       break;
+    }
+    if (culling && tile_far.culls_box(z, q.box)) {
+      stats.culled_triangle_tiles += low & kTriangleBit ? 1 : 0;
+      continue;
     }
     if (low & kTriangleBit) {
       kind.cover(sc, TileItem{low & ~kTriangleBit, z}, q.box, rect, axes, stats);
       continue;
     }
     const TriangleBvh::Node& n = bvh.nodes[low];
+    ++stats.bvh_nodes_opened;
     if (n.count == 0) {
       push_node(n.first);
       push_node(n.first + 1);
@@ -246,8 +282,12 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
       tri_cache.get(t, e.box, tz,
                     [&](int* b, double& zd) { return kind.bounds(t, face, axes, b, zd); });
       if (!meets(e.box)) continue;
-      e.key = queue_key(tz, t | kTriangleBit);
       ++queued_triangles;
+      if (culling && tile_far.culls_box(tz, e.box)) {
+        ++stats.culled_triangle_tiles;
+        continue;
+      }
+      e.key = queue_key(tz, t | kTriangleBit);
       queue.push_back(e);
       std::push_heap(queue.begin(), queue.end(), QueueAfter{});
     }
@@ -314,11 +354,10 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           rect.x1 = std::min(N, rect.x0 + TS) - 1;
                           rect.y1 = std::min(N, rect.y0 + TS) - 1;
                           rect.stride = TS;
-                          const int tw = rect.x1 - rect.x0 + 1, th = rect.y1 - rect.y0 + 1;
                           for (auto& l : sc.lists) l.clear();
                           for (auto& l : sc.ties) l.clear();
                           std::fill(sc.far.begin(), sc.far.end(), INFINITY);
-                          TileFar<typename Kind::Scratch> tile_far{sc, tw, th, TS};
+                          TileFar<typename Kind::Scratch> tile_far(sc, rect);
                           if (bvh) {
                             if constexpr (Kind::kHasBvh)
                               walk_tile(kind, *bvh, face, axes, rect, opt.depth_culling, sc,
@@ -333,11 +372,18 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                             });
                             stats.triangle_tiles += uint64_t(te - tb);
                             for (TileItem* it = tb; it != te; ++it) {
-                              if (opt.depth_culling && tile_far.culls(it->zmin)) {
-                                stats.culled_triangle_tiles += uint64_t(te - it);
-                                break;
+                              const int* box = &bbox[size_t(it->id) * 4];
+                              if (opt.depth_culling) {
+                                if (tile_far.culls(it->zmin)) {
+                                  stats.culled_triangle_tiles += uint64_t(te - it);
+                                  break;
+                                }
+                                if (tile_far.culls_box(it->zmin, box)) {
+                                  ++stats.culled_triangle_tiles;
+                                  continue;
+                                }
                               }
-                              kind.cover(sc, *it, &bbox[size_t(it->id) * 4], rect, axes, stats);
+                              kind.cover(sc, *it, box, rect, axes, stats);
                             }
                           }
                           // Tile results: marks, witnesses, pieces, statistics.
