@@ -135,6 +135,7 @@ vislib::BakeSettings settings_of(const BakeArgs& a) {
   s.region.segment.eps_len = a.eps_len;
   s.region.segment.tile_size = a.tile;
   s.long_segments = a.long_segments;
+  s.bvh = a.bvh == "on";
   s.region.runs = a.runs;
   s.region.seed = a.seed;
   s.granularity =
@@ -187,6 +188,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "one long segment, split per edge (1 = off; static scenes; pays for many small "
                   "cells over a large scene, see docs/bake.md)")
       ->check(in_range(1, int(vislib::kMaxSplitParts)))
+      ->capture_default_str();
+  cmd->add_option("--bvh", a.bvh,
+                  "Static scenes: every run walks one BVH of the triangles front to back per "
+                  "tile (built once per bake); 'off' bins every triangle on every face of every "
+                  "run. The file is the same either way")
+      ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")

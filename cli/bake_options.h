@@ -27,6 +27,7 @@ struct BakeArgs {
   double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
   std::string preset = "default";
+  std::string bvh = "on";  // --bvh on|off
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).

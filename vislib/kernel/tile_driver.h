@@ -98,22 +98,30 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
 
 // Per-face, compute-once rectangles and depths (of BVH nodes or triangles): the first thread to
 // need entry i computes it and publishes it; a thread that finds it being written computes its
-// own copy (the same values: the computation is deterministic).
+// own copy (the same values: the computation is deterministic). Entries carry the stamp of the
+// face they were written for, so a new face costs no pass over all entries (the stamps are
+// cleared only when they wrap, every 2^31 faces).
 class FaceBoundsCache {
  public:
-  void reset(size_t n) {
+  void next_face(size_t n) {
     if (n > size_) {
-      state_.reset(new std::atomic<uint8_t>[n]);
-      box_.resize(n * 4);
-      zmin_.resize(n);
+      stamp_.reset(new std::atomic<uint32_t>[n]());
+      box_.reset(new int[n * 4]);  // uninitialised: read only under a current stamp
+      zmin_.reset(new float[n]);
       size_ = n;
+      epoch_ = 0;
     }
-    for (size_t i = 0; i < n; ++i) state_[i].store(0, std::memory_order_relaxed);
+    if (epoch_ >= 0xfffffff0u) {
+      for (size_t i = 0; i < size_; ++i) stamp_[i].store(0, std::memory_order_relaxed);
+      epoch_ = 0;
+    }
+    epoch_ += 2;  // ready: stamp == epoch_; being written: epoch_ - 1; anything less: stale
   }
   // Rectangle (x0, x1, y0, y1) in box and nearest depth (rounded down) in z; false when empty.
   template <class Compute>
   bool get(size_t i, int* box, float& z, Compute compute) {
-    if (state_[i].load(std::memory_order_acquire) != 2) {
+    uint32_t seen = stamp_[i].load(std::memory_order_acquire);
+    if (seen != epoch_) {
       double zd = 0;
       bool ok = compute(box, zd);
       if (!ok) {
@@ -121,11 +129,11 @@ class FaceBoundsCache {
         box[1] = 0;
       }
       z = ok ? round_down_to_float(zd) : 0.0f;
-      uint8_t expected = 0;
-      if (state_[i].compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+      if (seen < epoch_ - 1 &&
+          stamp_[i].compare_exchange_strong(seen, epoch_ - 1, std::memory_order_acq_rel)) {
         std::copy(box, box + 4, &box_[i * 4]);
         zmin_[i] = z;
-        state_[i].store(2, std::memory_order_release);
+        stamp_[i].store(epoch_, std::memory_order_release);
       }
       return ok;
     }
@@ -135,10 +143,11 @@ class FaceBoundsCache {
   }
 
  private:
-  std::unique_ptr<std::atomic<uint8_t>[]> state_;
-  std::vector<int> box_;
-  std::vector<float> zmin_;
+  std::unique_ptr<std::atomic<uint32_t>[]> stamp_;
+  std::unique_ptr<int[]> box_;
+  std::unique_ptr<float[]> zmin_;
   size_t size_ = 0;
+  uint32_t epoch_ = 0;
 };
 
 // The culling bounds of one tile: the farthest `far` over its pixels (inf while some pixel does
@@ -167,7 +176,11 @@ struct TileFar {
     for (int k = 0; k < th; ++k) {
       const double* row = &sc.far[size_t(k) * size_t(rect.stride)];
       double* b = &block[(k / bs) * 4];
-      for (int i = 0; i < tw; ++i) b[i / bs] = std::max(b[i / bs], row[i]);
+      for (int x0 = 0, bx = 0; x0 < tw; x0 += bs, ++bx) {
+        double m = b[bx];
+        for (int i = x0, e = std::min(tw, x0 + bs); i < e; ++i) m = std::max(m, row[i]);
+        b[bx] = m;
+      }
     }
     value = -INFINITY;
     for (int i = 0; i < 16; ++i) value = std::max(value, block[i]);
@@ -318,8 +331,8 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   for (int face = 0; face < kCubeFaces; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
     if (bvh) {
-      node_cache.reset(bvh->nodes.size());
-      tri_cache.reset(count);
+      node_cache.next_face(bvh->nodes.size());
+      tri_cache.next_face(count);
     } else {
       // (1) footprint bounds and nearest depth of every primitive on this face.
       tbb::parallel_for(tbb::blocked_range<size_t>(0, count, 512),
