@@ -389,3 +389,30 @@ TEST(CliBake, LongSegmentsRunFewerSegmentsForTheSameSets) {
   EXPECT_EQ(run_pvs(grid_bake(dir + "/bad.pvs") + " --long-segments 9", &out), 2) << out;
   EXPECT_NE(out.find("--long-segments"), std::string::npos) << out;
 }
+
+// Issue 13 item 4: the BVH every run walks changes nothing in the file; pvs segment and pvs
+// region give the same sets with and without it, and report its build time.
+TEST(CliBake, TheBvhWalkGivesTheSameFileAndTheSameSets) {
+  std::string dir = temp_dir("cli_bake_bvh");
+  std::string out;
+  ASSERT_EQ(run_pvs(grid_bake(dir + "/on.pvs") + " --runs 2", &out), 0) << out;
+  ASSERT_EQ(run_pvs(grid_bake(dir + "/off.pvs") + " --runs 2 --bvh off", &out), 0) << out;
+  EXPECT_EQ(vislib::read_file(dir + "/on.pvs"), vislib::read_file(dir + "/off.pvs"));
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/bad.pvs") + " --bvh maybe", &out), 2) << out;
+  EXPECT_NE(out.find("--bvh"), std::string::npos) << out;
+  std::string sets[2];
+  for (int on = 0; on < 2; ++on) {
+    const std::string path = dir + "/seg" + std::to_string(on) + ".json";
+    ASSERT_EQ(run_pvs("segment " + city() + " --from 0,1.7,-20 --to 0,1.7,20 --res 48 --seed 3 " +
+                          "--witness --bvh " + (on ? "on" : "off") + " --json " + path,
+                      &out),
+              0)
+        << out;
+    const auto j = nlohmann::json::parse(vislib::read_file(path));
+    sets[on] = j["visible"].dump() + j["witnesses"].dump();
+    EXPECT_EQ(j["timings"]["bvh_seconds"].get<double>() > 0, on == 1);
+    EXPECT_EQ(j["counts"]["bvh_nodes_opened"].get<uint64_t>() > 0, on == 1);
+  }
+  EXPECT_EQ(sets[0], sets[1]);
+  EXPECT_GT(sets[0].size(), 100u);
+}
