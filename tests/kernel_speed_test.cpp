@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "tests/kernel_compare.h"
 #include "tests/scene_builders.h"
 #include "vislib/base/random.h"
 #include "vislib/base/tolerances.h"
@@ -14,33 +15,11 @@
 #include "vislib/scene/generate.h"
 
 using namespace vislib;
+using vislib_test::identical_lists;
 using vislib_test::random_soup;
+using vislib_test::same_witnesses;
 
 namespace {
-
-// Every byte of every piece (t0, t1, id, depth) equal: bit-identical, -0.0 != +0.0.
-bool identical_lists(const std::vector<PieceList>& a, const std::vector<PieceList>& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t k = 0; k < a.size(); ++k) {
-    if (a[k].size() != b[k].size()) return false;
-    for (size_t i = 0; i < a[k].size(); ++i) {
-      const Piece &p = a[k][i], &q = b[k][i];
-      if (std::memcmp(&p.t0, &q.t0, 8) || std::memcmp(&p.t1, &q.t1, 8) || p.id != q.id ||
-          std::memcmp(&p.depth, &q.depth, sizeof(LinearDepth)))
-        return false;
-    }
-  }
-  return true;
-}
-
-bool same_witnesses(const std::vector<Witness>& a, const std::vector<Witness>& b) {
-  if (a.size() != b.size()) return false;
-  for (size_t i = 0; i < a.size(); ++i)
-    if (a[i].tri != b[i].tri || a[i].face != b[i].face || a[i].x != b[i].x || a[i].y != b[i].y ||
-        a[i].t != b[i].t)
-      return false;
-  return true;
-}
 
 // A small city street (many layers of facades, axis-aligned edges that pixel centres hit
 // exactly, so the tie rule runs) plus a random soup in front of it.
