@@ -47,8 +47,11 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
+#include <type_traits>
 #include <vector>
 
 #include "vislib/base/cubemap.h"
@@ -96,18 +99,30 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
   return faces;
 }
 
-// Per-face, compute-once rectangles and depths (of BVH nodes or triangles): the first thread to
-// need entry i computes it and publishes it; a thread that finds it being written computes its
-// own copy (the same values: the computation is deterministic). Entries carry the stamp of the
-// face they were written for, so a new face costs no pass over all entries (the stamps are
-// cleared only when they wrap, every 2^31 faces).
+// Per-face, compute-once rectangles and depths (of BVH nodes, or of triangles by their position in
+// the tree's leaf order): the first thread to need entry i computes it and publishes it; a thread
+// that finds it being written computes its own copy (the same values: the computation is
+// deterministic). Entries carry the stamp of the face they were written for, so a new face costs
+// no pass over all entries (the stamps are cleared only when they wrap, every 2^31 faces).
+// Memory: the arrays are allocated untouched (calloc and malloc), so a run's resident memory grows
+// with the entries its walk touches (nodes and leaves lie in tree order, so those are few pages),
+// not with the scene: several runs of a bake hold these at once.
 class FaceBoundsCache {
+  static_assert(std::is_trivially_default_constructible_v<std::atomic<uint32_t>>);
+
  public:
+  FaceBoundsCache() = default;
+  FaceBoundsCache(const FaceBoundsCache&) = delete;
+  FaceBoundsCache& operator=(const FaceBoundsCache&) = delete;
+  ~FaceBoundsCache() { release(); }
   void next_face(size_t n) {
     if (n > size_) {
-      stamp_.reset(new std::atomic<uint32_t>[n]());
-      box_.reset(new int[n * 4]);  // uninitialised: read only under a current stamp
-      zmin_.reset(new float[n]);
+      release();
+      // std::atomic<uint32_t> is trivially constructible: zeroed memory holds zero stamps.
+      stamp_ = static_cast<std::atomic<uint32_t>*>(std::calloc(n, sizeof(std::atomic<uint32_t>)));
+      box_ = static_cast<int*>(std::malloc(n * 4 * sizeof(int)));  // read only under a stamp
+      zmin_ = static_cast<float*>(std::malloc(n * sizeof(float)));
+      if (!stamp_ || !box_ || !zmin_) throw std::bad_alloc();
       size_ = n;
       epoch_ = 0;
     }
@@ -143,9 +158,18 @@ class FaceBoundsCache {
   }
 
  private:
-  std::unique_ptr<std::atomic<uint32_t>[]> stamp_;
-  std::unique_ptr<int[]> box_;
-  std::unique_ptr<float[]> zmin_;
+  void release() {
+    std::free(stamp_);
+    std::free(box_);
+    std::free(zmin_);
+    stamp_ = nullptr;
+    box_ = nullptr;
+    zmin_ = nullptr;
+    size_ = 0;
+  }
+  std::atomic<uint32_t>* stamp_ = nullptr;
+  int* box_ = nullptr;
+  float* zmin_ = nullptr;
   size_t size_ = 0;
   uint32_t epoch_ = 0;
 };
@@ -292,7 +316,7 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
       const uint32_t t = bvh.order[i];
       QueueItem e;
       float tz;
-      tri_cache.get(t, e.box, tz,
+      tri_cache.get(i, e.box, tz,
                     [&](int* b, double& zd) { return kind.bounds(t, face, axes, b, zd); });
       if (!meets(e.box)) continue;
       ++queued_triangles;
