@@ -19,32 +19,41 @@ float up(double x) {
   return f;
 }
 
+// Splits on the triangles' centroids only (12 bytes a triangle while building); a leaf's bounds
+// come from its corners, an inner node's from its children's (the same floats as the union of
+// per-triangle bounds rounded outward: rounding outward is monotone).
 struct Builder {
-  std::vector<float> lo, hi;  // per triangle, 3 each
-  std::vector<float> mid;     // per triangle: centroid of its box, 3 each
+  const Scene& scene;
+  size_t state;
+  std::vector<float> mid;  // per triangle: centre of its box, 3 each
   TriangleBvh& bvh;
 
   void build(uint32_t node, uint32_t begin, uint32_t end) {
     TriangleBvh::Node n;
-    for (int a = 0; a < 3; ++a) {
-      n.lo[a] = INFINITY;
-      n.hi[a] = -INFINITY;
+    if (end - begin <= kBvhLeafSize) {
+      double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+      for (uint32_t i = begin; i < end; ++i)
+        for (const Vec3& c : scene.corners(bvh.order[i], state))
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], c[a]);
+            hi[a] = std::max(hi[a], c[a]);
+          }
+      for (int a = 0; a < 3; ++a) {
+        n.lo[a] = down(lo[a]);
+        n.hi[a] = up(hi[a]);
+      }
+      n.first = begin;
+      n.count = end - begin;
+      bvh.nodes[node] = n;
+      return;
     }
     float cmin[3] = {INFINITY, INFINITY, INFINITY}, cmax[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = begin; i < end; ++i) {
       const uint32_t t = bvh.order[i];
       for (int a = 0; a < 3; ++a) {
-        n.lo[a] = std::min(n.lo[a], lo[t * 3 + a]);
-        n.hi[a] = std::max(n.hi[a], hi[t * 3 + a]);
         cmin[a] = std::min(cmin[a], mid[t * 3 + a]);
         cmax[a] = std::max(cmax[a], mid[t * 3 + a]);
       }
-    }
-    if (end - begin <= kBvhLeafSize) {
-      n.first = begin;
-      n.count = end - begin;
-      bvh.nodes[node] = n;
-      return;
     }
     int axis = 0;
     for (int a = 1; a < 3; ++a)
@@ -55,13 +64,18 @@ struct Builder {
                        const float cx = mid[x * 3 + axis], cy = mid[y * 3 + axis];
                        return cx < cy || (cx == cy && x < y);
                      });
-    n.first = uint32_t(bvh.nodes.size());
-    n.count = 0;
-    bvh.nodes[node] = n;
+    const uint32_t left = uint32_t(bvh.nodes.size());
     bvh.nodes.resize(bvh.nodes.size() + 2);
-    const uint32_t left = n.first;
     build(left, begin, m);
     build(left + 1, m, end);
+    const TriangleBvh::Node &l = bvh.nodes[left], &r = bvh.nodes[left + 1];
+    for (int a = 0; a < 3; ++a) {
+      n.lo[a] = std::min(l.lo[a], r.lo[a]);
+      n.hi[a] = std::max(l.hi[a], r.hi[a]);
+    }
+    n.first = left;
+    n.count = 0;
+    bvh.nodes[node] = n;
   }
 };
 
@@ -77,20 +91,19 @@ TriangleBvh build_triangle_bvh(const Scene& scene, size_t state) {
   if (n >= (size_t(1) << 31)) throw std::invalid_argument("too many triangles for the BVH");
   if (state >= scene.positions.size())
     throw std::invalid_argument("BVH: key state " + std::to_string(state) + " out of range");
-  Builder b{std::vector<float>(n * 3), std::vector<float>(n * 3), std::vector<float>(n * 3), bvh};
+  Builder b{scene, state, std::vector<float>(n * 3), bvh};
   for (size_t t = 0; t < n; ++t) {
     const auto c = scene.corners(uint32_t(t), state);
     for (int a = 0; a < 3; ++a) {
       const double l = std::min({c[0][a], c[1][a], c[2][a]});
       const double h = std::max({c[0][a], c[1][a], c[2][a]});
-      b.lo[t * 3 + a] = down(l);
-      b.hi[t * 3 + a] = up(h);
       b.mid[t * 3 + a] = float(0.5 * (l + h));
     }
   }
   bvh.order.resize(n);
   for (size_t t = 0; t < n; ++t) bvh.order[t] = uint32_t(t);
-  bvh.nodes.reserve(2 * (n / kBvhLeafSize + 1));
+  bvh.nodes.reserve(n +
+                    2);  // leaves hold at least 2 triangles (or the one), so at most n + 2 nodes
   bvh.nodes.resize(1);
   b.build(0, 0, uint32_t(n));
   return bvh;
