@@ -291,7 +291,7 @@ int main(int argc, char** argv) {
     // the kernel's column).
     TriangleBvh tree;
     g_bvh = nullptr;
-    if (!g_no_bvh && !scene.is_dynamic() && scene.sphere_count() == 0) {
+    if (!g_no_bvh && bvh_applies(scene)) {
       double cpu = 0;
       const double wall = seconds_of([&] { tree = build_triangle_bvh(scene); }, &cpu);
       g_bvh = &tree;

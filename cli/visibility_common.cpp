@@ -69,8 +69,7 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
 double maybe_build_bvh(const VisibilityArgs& a, bool auto_on, const vislib::Scene& scene,
                        vislib::TriangleBvh& tree, vislib::SegmentOptions& so) {
   const bool want = a.bvh == "on" || (a.bvh == "auto" && auto_on);
-  if (!want || scene.is_dynamic() || scene.sphere_count() > 0 || scene.triangle_count() == 0)
-    return 0.0;
+  if (!want || !vislib::bvh_applies(scene)) return 0.0;
   const auto t0 = std::chrono::steady_clock::now();
   tree = vislib::build_triangle_bvh(scene, so.state);
   so.bvh = &tree;

@@ -142,8 +142,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   }
   // One BVH for every static run of this bake (the runs walk it per tile).
   TriangleBvh tree;
-  if (settings.bvh && !settings.region.segment.bvh && !scene.is_dynamic() &&
-      scene.sphere_count() == 0 && scene.triangle_count() > 0) {
+  if (settings.bvh && !settings.region.segment.bvh && bvh_applies(scene)) {
     const auto t0 = std::chrono::steady_clock::now();
     tree = build_triangle_bvh(scene, settings.region.segment.state);
     run_settings.region.segment.bvh = &tree;

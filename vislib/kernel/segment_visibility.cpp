@@ -352,9 +352,8 @@ class StaticKind {
   const TriangleBvh* bvh() const {
     return opt_.bvh;
   }
-  bool node_bounds(uint32_t node, int face, const FaceAxes& axes, int* b, double& zmin) const {
+  bool node_bounds(uint32_t node, const FaceAxes& axes, int* b, double& zmin) const {
     const TriangleBvh::Node& n = opt_.bvh->nodes[node];
-    (void)face;
     return box_footprint_bounds(n.lo, n.hi, v0_, v1_, axes, opt_.near, opt_.resolution, b[0], b[1],
                                 b[2], b[3], zmin);
   }

@@ -8,14 +8,17 @@
 // (ties by id), each handed to the kind, which tests coverage at the pixels of its footprint and
 // composites the intervals into the pixel lists; once every pixel of the tile covers [0, 1]
 // nearer than a primitive's nearest depth, that primitive and all later ones are skipped (exact:
-// none of them can be first anywhere in the tile); then the kind reports each pixel's final list
+// none of them can be first anywhere in the tile), and one that lies beyond every block (of 4 x 4)
+// of the tile its rectangle meets is skipped alone (TileFar); then the kind reports each pixel's
+// final list
 // (marks, witnesses, pieces). Per-tile statistics are kept apart and reduced in tile order by the
 // caller, so nothing depends on scheduling.
 //
 // With a BVH (static triangles with SegmentOptions::bvh, triangle_bvh.h), steps (1) and (2) are
 // skipped: each tile walks the tree nearest node first (a heap ordered by nearest depth, ties by
-// index), keeps the nodes and triangles whose footprint rectangle meets the tile, and stops when
-// the nearest entry lies behind every pixel of the tile, so the nodes behind it are never opened.
+// index), keeps the nodes and triangles whose footprint rectangle meets the tile and that do not
+// lie behind the blocks of the tile they meet (TileFar), and stops when the nearest entry lies
+// behind every pixel of the tile, so the nodes behind it are never opened.
 // Node and triangle rectangles are computed once per face, by the first tile that needs them.
 // The nodes' rectangles contain their triangles' and their depths lie below them
 // (box_footprint_bounds), so the tile meets exactly the triangles it meets without the tree,
@@ -37,7 +40,7 @@
 //                          report the non-empty list of pixel k = (y - y0) * stride + (x - x0)
 //   static constexpr bool kHasBvh;          true: also
 //   const TriangleBvh* bvh() const;         the tree (null: bin every primitive), and
-//   bool node_bounds(uint32_t node, int face, const FaceAxes&, int* box, double& zmin) const;
+//   bool node_bounds(uint32_t node, const FaceAxes&, int* box, double& zmin) const;
 #pragma once
 
 #include <tbb/enumerable_thread_specific.h>
@@ -49,7 +52,6 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
-#include <memory>
 #include <new>
 #include <type_traits>
 #include <vector>
@@ -262,7 +264,8 @@ struct QueueAfter {  // min-heap order for std::push_heap / pop_heap
 
 // One tile with a BVH: nearest entry first; a node's children (or a leaf's triangles) enter the
 // queue when their rectangle meets the tile; a triangle is covered when it leaves the queue,
-// unless it (and so everything after it) lies behind every pixel of the tile.
+// unless it lies behind the blocks its rectangle meets (skipped), or behind every pixel of the
+// tile (it and everything after it: the walk ends).
 template <class Kind, class Scratch>
 void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axes,
                const TileRect& rect, bool culling, Scratch& sc, TileFar<Scratch>& tile_far,
@@ -275,7 +278,7 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
     QueueItem q;
     float z;
     node_cache.get(node, q.box, z,
-                   [&](int* b, double& zd) { return kind.node_bounds(node, face, axes, b, zd); });
+                   [&](int* b, double& zd) { return kind.node_bounds(node, axes, b, zd); });
     if (!meets(q.box) || (culling && tile_far.culls_box(z, q.box))) return;
     q.key = queue_key(z, node);
     queue.push_back(q);

@@ -46,4 +46,9 @@ struct TriangleBvh {
 constexpr uint32_t kBvhLeafSize = 4;
 TriangleBvh build_triangle_bvh(const Scene& scene, size_t state = 0);
 
+// Whether a tree serves runs on `scene`: static triangles, no spheres (the dynamic kernel bins).
+inline bool bvh_applies(const Scene& scene) {
+  return !scene.is_dynamic() && scene.sphere_count() == 0 && scene.triangle_count() > 0;
+}
+
 }  // namespace vislib
