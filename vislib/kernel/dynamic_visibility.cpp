@@ -467,6 +467,8 @@ class DynamicKind {
 
   static constexpr bool kHasBvh = false;  // moving primitives: no tree
 
+  void flush(Scratch&, const TileRect&, const FaceAxes&, SegmentStats&) const {}  // nothing held
+
   void cover(Scratch& sc, const TileItem& item, const int* b, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {
     const int N = opt_.resolution;

@@ -310,6 +310,15 @@ bool cpu_has_avx2() {
 // per-pixel depth envelope, lists of linear depths.
 class StaticKind {
  public:
+  // A triangle of the tile set up for compositing (cover, flush).
+  struct Pending {
+    StaticTriangle st;
+    Footprint fp;
+    uint32_t id;
+    float zmin;
+    int y0, y1;  // its rows in the tile
+  };
+  static constexpr size_t kBatch = 16;
   struct Scratch {
     std::vector<PieceList> lists;
     std::vector<double> env;      // kEnvBins per pixel: the depth envelope (not reset per tile: a
@@ -318,6 +327,8 @@ class StaticKind {
     std::vector<double> far;      // per pixel: max of its envelope (inf unless [0,1] is covered)
     std::vector<uint8_t> env_ok;  // per pixel with far < inf: its envelope is built
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
+    std::vector<Pending> batch = std::vector<Pending>(kBatch);  // triangles set up, not composited
+    size_t batch_size = 0;
   };
 
   StaticKind(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt,
@@ -378,20 +389,55 @@ class StaticKind {
     return footprint_bounds(rel, 6, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], zmin);
   }
 
+  // A triangle of the tile, set up and put in the batch; the batch is composited row by row
+  // when full (and at the end of the tile: flush). Row by row, the lists being edited are one
+  // row's (32 pixels, a few KB) instead of the whole tile's (hundreds of KB, beyond L1), and each
+  // pixel still gets its insertions in the tile's order (the batch's order within a row).
+  // Per-pixel culling reads the pixel's state when the pair is composited, so it is as strong as
+  // before; only the tile driver's whole-triangle culling sees the state up to the last batch.
   void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {
-    const int N = opt_.resolution;
-    const double tz = double(item.zmin);
     auto c = scene_.corners(item.id, opt_.state);
     Vec3 corners[3] = {c[0], c[1], c[2]};
-    StaticTriangle st = prepare_static_triangle(corners, v0_, v1_);
-    if (st.n == Vec3{0, 0, 0}) return;  // degenerate: never covers (H5)
+    Pending& b = sc.batch[sc.batch_size];
+    b.st = prepare_static_triangle(corners, v0_, v1_);
+    if (b.st.n == Vec3{0, 0, 0}) return;  // degenerate: never covers (H5)
+    b.y0 = std::max(rect.y0, box[2]);
+    b.y1 = std::min(rect.y1, box[3]);
+    if (b.y0 > b.y1) return;
     Vec3 rel[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
-    Footprint fp = compute_footprint(rel, 6, axes, opt_.near);
-    const int y0 = std::max(rect.y0, box[2]), y1 = std::min(rect.y1, box[3]);
-    for (int y = y0; y <= y1; ++y) {
+    b.fp = compute_footprint(rel, 6, axes, opt_.near);
+    b.id = item.id;
+    b.zmin = item.zmin;
+    if (++sc.batch_size == kBatch) flush(sc, rect, axes, stats);
+  }
+
+  void flush(Scratch& sc, const TileRect& rect, const FaceAxes& axes, SegmentStats& stats) const {
+    if (sc.batch_size == 0) return;
+    int ylo = rect.y1, yhi = rect.y0;
+    for (size_t i = 0; i < sc.batch_size; ++i) {
+      ylo = std::min(ylo, sc.batch[i].y0);
+      yhi = std::max(yhi, sc.batch[i].y1);
+    }
+    for (int y = ylo; y <= yhi; ++y)
+      for (size_t i = 0; i < sc.batch_size; ++i) {
+        const Pending& b = sc.batch[i];
+        if (y >= b.y0 && y <= b.y1) cover_row(sc, b, y, rect, axes, stats);
+      }
+    sc.batch_size = 0;
+  }
+
+ private:
+  // The pairs of one batched triangle on row y of the tile.
+  void cover_row(Scratch& sc, const Pending& b, int y, const TileRect& rect, const FaceAxes& axes,
+                 SegmentStats& stats) const {
+    const int N = opt_.resolution;
+    const double tz = double(b.zmin);
+    const StaticTriangle& st = b.st;
+    const TileItem item{b.id, b.zmin};
+    {
       int x0, x1;
-      if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+      if (!footprint_row_span(b.fp, N, y, x0, x1)) return;
       x0 = std::max(x0, rect.x0);
       x1 = std::min(x1, rect.x1);
       const double tc = pixel_centers_[size_t(y)];
@@ -449,6 +495,8 @@ class StaticKind {
       }
     }
   }
+
+ public:
 
   void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found) const {
     const PieceList& l = sc.lists[k];

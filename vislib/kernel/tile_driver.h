@@ -35,7 +35,10 @@
 //                          pixel rectangle (x0, x1, y0, y1) and nearest depth; false when empty.
 //                          Called in parallel for different p.
 //   void cover(Scratch&, const TileItem&, const int* box, const TileRect&, const FaceAxes&,
-//              SegmentStats&) const;         coverage and compositing of one primitive
+//              SegmentStats&) const;         coverage and compositing of one primitive (the kind
+//                          may hold it back; culling bounds it has not yet lowered stay bounds)
+//   void flush(Scratch&, const TileRect&, const FaceAxes&, SegmentStats&) const;
+//                          composite whatever cover() held back (before the tile's results)
 //   void finish_pixel(Scratch&, size_t k, int face, int x, int y, FoundMarks&) const;
 //                          report the non-empty list of pixel k = (y - y0) * stride + (x - x0)
 //   static constexpr bool kHasBvh;          true: also
@@ -426,6 +429,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                               kind.cover(sc, *it, box, rect, axes, stats);
                             }
                           }
+                          kind.flush(sc, rect, axes, stats);  // what the kind still holds
                           // Tile results: marks, witnesses, pieces, statistics.
                           size_t bytes = 0;
                           for (int y = rect.y0; y <= rect.y1; ++y)
