@@ -38,11 +38,13 @@ int convex_hull(Vec2* pts, int n, Vec2* out) {
 
 // Margin in face coordinates: absolute plus relative to the polygon's magnitude (points near the
 // near plane project far out; their rounding grows with them).
-double margin_of(const Footprint& fp) {
+double margin_of(const Vec2* hull, int size) {
   double m = 0;
-  for (int i = 0; i < fp.size; ++i)
-    m = std::max({m, std::fabs(fp.hull[i].u), std::fabs(fp.hull[i].w)});
+  for (int i = 0; i < size; ++i) m = std::max({m, std::fabs(hull[i].u), std::fabs(hull[i].w)});
   return kFootprintMargin + kFootprintRelativeMargin * m;
+}
+double margin_of(const Footprint& fp) {
+  return margin_of(fp.hull.data(), fp.size);
 }
 
 }  // namespace
@@ -129,6 +131,15 @@ Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, do
   Footprint fp;
   if (n > 0) fp.size = convex_hull(pts, n, fp.hull.data());
   return fp;
+}
+
+int compute_footprint_hull(const Vec3* rel, int count, const FaceAxes& axes, double near,
+                           Vec2* hull, double& margin) {
+  Vec2 pts[kMaxFootprintPoints];
+  int n = projected_points(rel, count, axes, near, pts, nullptr);
+  const int size = n > 0 ? convex_hull(pts, n, hull) : 0;
+  margin = margin_of(hull, size);
+  return size;
 }
 
 bool footprint_bounds(const Vec3* rel, int count, const FaceAxes& axes, double near, int n, int& x0,
@@ -265,18 +276,21 @@ bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y
 
 bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1) {
   if (fp.empty()) return false;
-  double m = margin_of(fp);
+  return footprint_row_span(fp.hull.data(), fp.size, margin_of(fp), n, y, x0, x1);
+}
+
+bool footprint_row_span(const Vec2* hull, int k, double m, int n, int y, int& x0, int& x1) {
+  if (k == 0) return false;
   double wc = pixel_center(y, n), wlo = wc - m, whi = wc + m;
   double umin = INFINITY, umax = -INFINITY;
-  const int k = fp.size;
   for (int i = 0; i < k; ++i) {
-    Vec2 a = fp.hull[i];
+    Vec2 a = hull[i];
     if (a.w >= wlo && a.w <= whi) {
       umin = std::min(umin, a.u);
       umax = std::max(umax, a.u);
     }
     if (k == 1) break;
-    Vec2 b = fp.hull[(i + 1) % k];
+    Vec2 b = hull[(i + 1) % k];
     for (double wl : {wlo, whi}) {
       if ((a.w < wl && b.w > wl) || (a.w > wl && b.w < wl)) {
         double u = a.u + (wl - a.w) / (b.w - a.w) * (b.u - a.u);

@@ -34,6 +34,10 @@ struct Footprint {
 // `rel` holds the eye-relative points (e.g. a-v0, ..., c-v1: any count up to 12); `axes` the
 // world axes of the face. Returns the clipped, projected hull.
 Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near);
+// The same hull written to `hull` (room for kMaxFootprintPoints); returns its size and sets
+// `margin`, the margin footprint_row_span adds (computed once here instead of once per row).
+int compute_footprint_hull(const Vec3* rel, int count, const FaceAxes& axes, double near,
+                           Vec2* hull, double& margin);
 
 // Pixel rectangle [x0,x1] x [y0,y1] (inclusive) of an N x N face containing every pixel centre
 // of the footprint (with kFootprintMargin); false when none.
@@ -61,5 +65,7 @@ unsigned reachable_faces(const Vec3* rel, int count, const Mat3& R, double near)
 
 // Columns [x0, x1] of row `y` whose centres may lie in the footprint; false when none.
 bool footprint_row_span(const Footprint& fp, int n, int y, int& x0, int& x1);
+// The same for a hull of `size` points with its margin (compute_footprint_hull).
+bool footprint_row_span(const Vec2* hull, int size, double margin, int n, int y, int& x0, int& x1);
 
 }  // namespace vislib

@@ -38,7 +38,8 @@
 //              SegmentStats&) const;         coverage and compositing of one primitive (the kind
 //                          may hold it back; culling bounds it has not yet lowered stay bounds)
 //   void flush(Scratch&, const TileRect&, const FaceAxes&, SegmentStats&) const;
-//                          composite whatever cover() held back (before the tile's results)
+//                          composite what cover() held back; called before the driver
+//                          recomputes its culling bounds, and before the tile's results
 //   void finish_pixel(Scratch&, size_t k, int face, int x, int y, FoundMarks&) const;
 //                          report the non-empty list of pixel k = (y - y0) * stride + (x - x0)
 //   static constexpr bool kHasBvh;          true: also
@@ -216,9 +217,13 @@ struct TileFar {
   }
   // True when a primitive whose nearest depth is zmin lies behind every pixel of the tile.
   // `count` false: a BVH node, which does not advance the 16 (the same bound as before).
-  bool culls(float zmin, bool count = true) {
+  // `before_refresh` runs before the bounds are recomputed: the kind composites what it holds
+  // back, so that the bounds are those of every primitive covered so far.
+  template <class F>
+  bool culls(float zmin, bool count, F&& before_refresh) {
     if (count && ++since >= 16) {
       since = 0;
+      before_refresh();
       refresh();
     }
     return double(zmin) > value;
@@ -287,6 +292,7 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
     queue.push_back(q);
     std::push_heap(queue.begin(), queue.end(), QueueAfter{});
   };
+  auto flush = [&] { kind.flush(sc, rect, axes, stats); };
   queue.clear();
   if (bvh.nodes.empty()) return;
   push_node(0);
@@ -297,7 +303,7 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
     queue.pop_back();
     const float z = queue_zmin(q.key);
     const uint32_t low = uint32_t(q.key);
-    if (culling && tile_far.culls(z, low & kTriangleBit)) {
+    if (culling && tile_far.culls(z, low & kTriangleBit, flush)) {
       uint64_t left = low & kTriangleBit ? 1 : 0;
       for (const QueueItem& e : queue) left += uint32_t(e.key) & kTriangleBit ? 1 : 0;
       stats.culled_triangle_tiles += left;
@@ -401,6 +407,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           for (auto& l : sc.ties) l.clear();
                           std::fill(sc.far.begin(), sc.far.end(), INFINITY);
                           TileFar<typename Kind::Scratch> tile_far(sc, rect);
+                          auto flush = [&] { kind.flush(sc, rect, axes, stats); };
                           if (bvh) {
                             if constexpr (Kind::kHasBvh)
                               walk_tile(kind, *bvh, face, axes, rect, opt.depth_culling, sc,
@@ -417,7 +424,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                             for (TileItem* it = tb; it != te; ++it) {
                               const int* box = &bbox[size_t(it->id) * 4];
                               if (opt.depth_culling) {
-                                if (tile_far.culls(it->zmin)) {
+                                if (tile_far.culls(it->zmin, true, flush)) {
                                   stats.culled_triangle_tiles += uint64_t(te - it);
                                   break;
                                 }
@@ -429,7 +436,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                               kind.cover(sc, *it, box, rect, axes, stats);
                             }
                           }
-                          kind.flush(sc, rect, axes, stats);  // what the kind still holds
+                          flush();  // what the kind still holds back
                           // Tile results: marks, witnesses, pieces, statistics.
                           size_t bytes = 0;
                           for (int y = rect.y0; y <= rect.y1; ++y)
