@@ -6,7 +6,8 @@
 // (tile_driver.h, shared with the dynamic kernel). This file is the static kind: the faces each
 // triangle can reach (classified once), its footprint bounds there, coverage 4 pixels at a time
 // (AVX2 when the CPU has it, bit-identical to the scalar path), lower-envelope insertion of linear
-// depths, and exact per-pixel culling (plane depth, and the depth envelope over t-bins).
+// depths (triangles composited in batches of 16, row by row, so that the lists being edited stay
+// in L1), and exact per-pixel culling (plane depth, and the depth envelope over t-bins).
 #include "vislib/kernel/segment_visibility.h"
 
 #include <tbb/enumerable_thread_specific.h>
