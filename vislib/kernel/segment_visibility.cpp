@@ -398,8 +398,8 @@ class StaticKind {
   // pixel still gets its insertions in the tile's order (the batch's order within a row).
   // Per-pixel culling reads the pixel's state when the pair is composited, and the tile driver
   // flushes the batch before it recomputes its bounds, so every culling is as strong as without
-  // batches. Measured (session 7): 1.0-1.02x; the search in insert_piece no longer waits for
-  // memory, but the time moved elsewhere (docs/performance.md).
+  // batches. Measured (session 7): 1.02-1.06x on the kernel suite; the search in insert_piece
+  // no longer waits for memory, but most of that time moved elsewhere (docs/performance.md).
   void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {
     auto c = scene_.corners(item.id, opt_.state);
@@ -442,62 +442,59 @@ class StaticKind {
     const int N = opt_.resolution;
     const double tz = double(b.zmin);
     const StaticTriangle& st = b.st;
-    const TileItem item{b.id, b.zmin};
-    {
-      int x0, x1;
-      if (!footprint_row_span(hull, b.hull_size, b.margin, N, y, x0, x1)) return;
-      x0 = std::max(x0, rect.x0);
-      x1 = std::min(x1, rect.x1);
-      const double tc = pixel_centers_[size_t(y)];
-      for (int xb = x0; xb <= x1; xb += 4) {
-        const int lanes = std::min(4, x1 - xb + 1);
-        const size_t kb = rect.index(xb, y);
-        bool any = false;
-        for (int i = 0; i < lanes; ++i) any |= !(opt_.depth_culling && tz > sc.far[kb + i]);
-        if (!any) {
-          stats.culled_pairs += uint64_t(lanes);
+    int x0, x1;
+    if (!footprint_row_span(hull, b.hull_size, b.margin, N, y, x0, x1)) return;
+    x0 = std::max(x0, rect.x0);
+    x1 = std::min(x1, rect.x1);
+    const double tc = pixel_centers_[size_t(y)];
+    for (int xb = x0; xb <= x1; xb += 4) {
+      const int lanes = std::min(4, x1 - xb + 1);
+      const size_t kb = rect.index(xb, y);
+      bool any = false;
+      for (int i = 0; i < lanes; ++i) any |= !(opt_.depth_culling && tz > sc.far[kb + i]);
+      if (!any) {
+        stats.culled_pairs += uint64_t(lanes);
+        continue;
+      }
+      Coverage4 cov;
+      coverage4_(st, axes, &pixel_centers_[size_t(xb)], tc, lanes, opt_.near, cov);
+      for (int i = 0; i < lanes; ++i) {
+        const size_t k = kb + size_t(i);
+        if (opt_.depth_culling &&
+            (tz > sc.far[k] ||
+             (sc.far[k] < INFINITY && plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
+          ++stats.culled_pairs;
           continue;
         }
-        Coverage4 cov;
-        coverage4_(st, axes, &pixel_centers_[size_t(xb)], tc, lanes, opt_.near, cov);
-        for (int i = 0; i < lanes; ++i) {
-          const size_t k = kb + size_t(i);
-          if (opt_.depth_culling &&
-              (tz > sc.far[k] ||
-               (sc.far[k] < INFINITY && plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
-            ++stats.culled_pairs;
-            continue;
-          }
-          ++stats.pair_tests;
-          if (!cov.ok[i]) continue;
-          ++stats.covered_pairs;
-          const double lo = cov.lo[i], hi = cov.hi[i];
-          const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
-          double* env = &sc.env[k * kEnvBins];
-          if (opt_.depth_culling && sc.far[k] < INFINITY && !sc.env_ok[k]) {
-            // First use of this covered pixel's envelope: built from the list now.
-            sc.far[k] = update_envelope(sc.lists[k], env, 0.0, 1.0) * far_scale_;
-            sc.env_ok[k] = 1;
-          }
-          if (opt_.depth_culling && sc.far[k] < INFINITY &&
-              envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_)) {
-            ++stats.hidden_pairs;
-            continue;
-          }
-          PieceList& l = sc.lists[k];
-          // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
-          // until then every bin stays infinite): recomputed whole when the list first covers,
-          // then over the bins each insertion touches.
-          TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
-          if (insert_piece(l, Piece{lo, hi, item.id, depth}, rule) && opt_.depth_culling) {
-            if (sc.far[k] < INFINITY) {
-              // The list only got nearer: the old far stays a bound; the envelope (if built)
-              // is recomputed over the bins this insertion touched.
-              if (sc.env_ok[k]) sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
-            } else if (covers_segment(l)) {
-              sc.far[k] = upper_depth(l) * far_scale_;  // the envelope waits for its first use
-              sc.env_ok[k] = 0;
-            }
+        ++stats.pair_tests;
+        if (!cov.ok[i]) continue;
+        ++stats.covered_pairs;
+        const double lo = cov.lo[i], hi = cov.hi[i];
+        const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
+        double* env = &sc.env[k * kEnvBins];
+        if (opt_.depth_culling && sc.far[k] < INFINITY && !sc.env_ok[k]) {
+          // First use of this covered pixel's envelope: built from the list now.
+          sc.far[k] = update_envelope(sc.lists[k], env, 0.0, 1.0) * far_scale_;
+          sc.env_ok[k] = 1;
+        }
+        if (opt_.depth_culling && sc.far[k] < INFINITY &&
+            envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_)) {
+          ++stats.hidden_pairs;
+          continue;
+        }
+        PieceList& l = sc.lists[k];
+        // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
+        // until then every bin stays infinite): recomputed whole when the list first covers,
+        // then over the bins each insertion touches.
+        TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
+        if (insert_piece(l, Piece{lo, hi, b.id, depth}, rule) && opt_.depth_culling) {
+          if (sc.far[k] < INFINITY) {
+            // The list only got nearer: the old far stays a bound; the envelope (if built)
+            // is recomputed over the bins this insertion touched.
+            if (sc.env_ok[k]) sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
+          } else if (covers_segment(l)) {
+            sc.far[k] = upper_depth(l) * far_scale_;  // the envelope waits for its first use
+            sc.env_ok[k] = 0;
           }
         }
       }
