@@ -126,10 +126,9 @@ bool bounds_of(const Vec2* pts, int count, double m, int n, int& x0, int& x1, in
 }  // namespace
 
 Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near) {
-  Vec2 pts[kMaxFootprintPoints];
-  int n = projected_points(rel, count, axes, near, pts, nullptr);
   Footprint fp;
-  if (n > 0) fp.size = convex_hull(pts, n, fp.hull.data());
+  double margin;
+  fp.size = compute_footprint_hull(rel, count, axes, near, fp.hull.data(), margin);
   return fp;
 }
 
