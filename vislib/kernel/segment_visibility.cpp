@@ -188,6 +188,24 @@ inline double update_envelope(const PieceList& l, double* env, double lo, double
   return double(far);
 }
 
+// envelope_hides for a list that is the one piece `q` over [0, 1], without building its bins:
+// their largest value over the bins [lo, hi) meets is q's depth_upper at the first bin's start or
+// at the last bin's end (depth_upper is monotone in t: every rounded step is), the values the
+// bins would hold. 1: hidden, 0: not; -1 (let the bins decide) when a product at an end
+// overflows, where depth_upper divides instead and monotony is not shown.
+inline int single_piece_hides(const Piece& q, double lo, double hi, const LinearDepth& depth,
+                              double inv, double scale) {
+  int b0, b1;
+  bins_of(lo, hi, b0, b1);
+  const double qinv = 1.0 / q.depth.dn;
+  const double ta = double(b0) / kEnvBins, tb = std::min(1.0, double(b1 + 1) / kEnvBins);
+  if (!(std::fabs((q.depth.n0 - q.depth.n1 * ta) * qinv) < INFINITY) ||
+      !(std::fabs((q.depth.n0 - q.depth.n1 * tb) * qinv) < INFINITY))
+    return -1;
+  const double m = std::max(depth_upper(q.depth, qinv, ta), depth_upper(q.depth, qinv, tb));
+  return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
+}
+
 // An upper bound of a list's depth over all its pieces (depth_upper at each piece's ends: the
 // depth is monotone on a piece), without the envelope's bins.
 inline double upper_depth(const PieceList& l) {
@@ -472,26 +490,44 @@ class StaticKind {
         const double lo = cov.lo[i], hi = cov.hi[i];
         const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
         double* env = &sc.env[k * kEnvBins];
-        if (opt_.depth_culling && sc.far[k] < INFINITY && !sc.env_ok[k]) {
-          // First use of this covered pixel's envelope: built from the list now.
-          sc.far[k] = update_envelope(sc.lists[k], env, 0.0, 1.0) * far_scale_;
-          sc.env_ok[k] = 1;
-        }
-        if (opt_.depth_culling && sc.far[k] < INFINITY &&
-            envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_)) {
-          ++stats.hidden_pairs;
-          continue;
-        }
         PieceList& l = sc.lists[k];
         // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
-        // until then every bin stays infinite): recomputed whole when the list first covers,
-        // then over the bins each insertion touches.
+        // until then every bin stays infinite). It is built when first needed: at the first
+        // test of the pixel, or while the list is one piece at its first change (one piece
+        // answers the test without bins: single_piece_hides).
+        if (opt_.depth_culling && sc.far[k] < INFINITY) {
+          bool hidden;
+          if (sc.env_ok[k]) {
+            hidden = envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_);
+          } else if (int h = l.size() == 1
+                                 ? single_piece_hides(l[0], lo, hi, depth, cov.inv[i], far_scale_)
+                                 : -1;
+                     h >= 0) {
+            hidden = h > 0;
+          } else {
+            sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
+            sc.env_ok[k] = 1;
+            hidden = envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_);
+          }
+          if (hidden) {
+            ++stats.hidden_pairs;
+            continue;
+          }
+        }
         TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
         if (insert_piece(l, Piece{lo, hi, b.id, depth}, rule) && opt_.depth_culling) {
           if (sc.far[k] < INFINITY) {
-            // The list only got nearer: the old far stays a bound; the envelope (if built)
-            // is recomputed over the bins this insertion touched.
-            if (sc.env_ok[k]) sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
+            // The list only got nearer: the old far stays a bound; the envelope is recomputed
+            // over the bins this insertion touched (built whole if it was not yet; one piece
+            // needs no bins, its far is its depth at its ends).
+            if (sc.env_ok[k])
+              sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
+            else if (l.size() == 1)
+              sc.far[k] = upper_depth(l) * far_scale_;
+            else {
+              sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
+              sc.env_ok[k] = 1;
+            }
           } else if (covers_segment(l)) {
             sc.far[k] = upper_depth(l) * far_scale_;  // the envelope waits for its first use
             sc.env_ok[k] = 0;
