@@ -520,11 +520,12 @@ class StaticKind {
             // The list only got nearer: the old far stays a bound; the envelope is recomputed
             // over the bins this insertion touched (built whole if it was not yet; one piece
             // needs no bins, its far is its depth at its ends).
-            if (sc.env_ok[k])
-              sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
-            else if (l.size() == 1)
+            if (l.size() == 1) {
               sc.far[k] = upper_depth(l) * far_scale_;
-            else {
+              sc.env_ok[k] = 0;
+            } else if (sc.env_ok[k]) {
+              sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
+            } else {
               sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
               sc.env_ok[k] = 1;
             }
