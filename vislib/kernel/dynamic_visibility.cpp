@@ -498,13 +498,15 @@ class DynamicKind {
       if (!mt.moving && mt.lin.n == Vec3{0, 0, 0}) return;  // degenerate (H5)
       Vec3 rel[6];
       relative_corners(p, rel);
-      Footprint fp = compute_footprint(rel, 6, axes, opt_.near);
+      Vec2 hull[kMaxFootprintPoints];
+      double margin;
+      const int hull_size = compute_footprint_hull(rel, 6, axes, opt_.near, hull, margin);
       auto coverage = [&](Vec3 d, Interval* out) {
         return moving_coverage(mt, d, axes.S, axes.T, opt_.near, out);
       };
       for (int y = y0; y <= y1; ++y) {
         int x0, x1;
-        if (!footprint_row_span(fp, N, y, x0, x1)) continue;
+        if (!footprint_row_span(hull, hull_size, margin, N, y, x0, x1)) continue;
         for (int x = std::max(x0, rect.x0); x <= std::min(x1, rect.x1); ++x) pixel(x, y, coverage);
       }
     } else {
