@@ -156,6 +156,20 @@ inline bool linear_not_tied(double x, double y, double eps) {
   return std::fabs(x - y) > eps * std::fabs(x) * (1 + 0x1p-30) + 0x1p-48 * mag;
 }
 
+// record_tie, with its first test decided by products where they decide it (linear depths):
+// most stretches are no tie, and then the three divisions of record_tie are skipped.
+template <class D>
+void record_tie_checked(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& loser,
+                        double t0, double t1) {
+  if constexpr (std::is_same_v<D, LinearDepth>) {
+    double x, y;
+    if (linear_nearer(winner.depth, loser.depth, 0.5 * (t0 + t1), x, y) < 0 &&
+        linear_not_tied(x, y, rule.eps_z))
+      return;
+  }
+  record_tie(rule, winner, loser, t0, t1);
+}
+
 template <class D>
 int crossings(const PieceT<D>& a, const PieceT<D>& b, double lo, double hi, double* out) {
   return a.id < b.id ? depth_crossings(a.depth, b.depth, lo, hi, out)
@@ -269,7 +283,7 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
         const PieceT<D>& w = detail::front(I, p, 0.5 * (cuts[k] + cuts[k + 1]));
         detail::push(out, w, cuts[k], cuts[k + 1]);
         if (ties.sink && cuts[k] < cuts[k + 1])
-          detail::record_tie(ties, w, &w == &p ? I : p, cuts[k], cuts[k + 1]);
+          detail::record_tie_checked(ties, w, &w == &p ? I : p, cuts[k], cuts[k + 1]);
       }
       if (I.t1 > f) detail::push(out, I, f, I.t1);
       cur = hi;
