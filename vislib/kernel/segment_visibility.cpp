@@ -492,9 +492,9 @@ class StaticKind {
         double* env = &sc.env[k * kEnvBins];
         PieceList& l = sc.lists[k];
         // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
-        // until then every bin stays infinite). It is built when first needed: at the first
-        // test of the pixel, or while the list is one piece at its first change (one piece
-        // answers the test without bins: single_piece_hides).
+        // until then every bin stays infinite), and only while the list has two or more
+        // pieces: it is built at the first test or change that finds two, and dropped when a
+        // change leaves one. One piece answers the test itself (single_piece_hides).
         if (opt_.depth_culling && sc.far[k] < INFINITY) {
           bool hidden;
           if (sc.env_ok[k]) {
