@@ -342,8 +342,8 @@ class StaticKind {
   struct Scratch {
     std::vector<PieceList> lists;
     std::vector<double> env;      // kEnvBins per pixel: the depth envelope (not reset per tile: a
-                                  // pixel's bins are read only while far < inf, and are all written
-                                  // when its list first covers [0, 1])
+                                  // pixel's bins are read only while env_ok, and are all written
+                                  // when env_ok is set)
     std::vector<double> far;      // per pixel: max of its envelope (inf unless [0,1] is covered)
     std::vector<uint8_t> env_ok;  // per pixel with far < inf: its envelope is built
     std::vector<std::vector<TieRecord>> ties;                   // per pixel (CoplanarRule::Both)
@@ -517,9 +517,9 @@ class StaticKind {
         TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
         if (insert_piece(l, Piece{lo, hi, b.id, depth}, rule) && opt_.depth_culling) {
           if (sc.far[k] < INFINITY) {
-            // The list only got nearer: the old far stays a bound; the envelope is recomputed
-            // over the bins this insertion touched (built whole if it was not yet; one piece
-            // needs no bins, its far is its depth at its ends).
+            // The list only got nearer, so far can be lowered: one piece needs no bins (its far
+            // is its depth at its ends); built bins are recomputed over the ones this insertion
+            // touched; otherwise they are built whole.
             if (l.size() == 1) {
               sc.far[k] = upper_depth(l) * far_scale_;
               sc.env_ok[k] = 0;
