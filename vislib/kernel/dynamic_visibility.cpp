@@ -376,18 +376,7 @@ bool sphere_pixel_bounds(Vec3 c0w, Vec3 c1w, double r, const FaceAxes& ax, doubl
   double m = kFootprintMargin +
              kFootprintRelativeMargin *
                  std::max({std::fabs(umin), std::fabs(umax), std::fabs(wmin), std::fabs(wmax)});
-  if (umax < -1 - m || umin > 1 + m || wmax < -1 - m || wmin > 1 + m) return false;
-  auto lo = [n](double c) {
-    return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n)))));
-  };
-  auto hi = [n](double c) {
-    return std::min(n - 1, int(std::floor(std::min(double(n) + 1, pixel_coord(c, n)))));
-  };
-  x0 = lo(umin - m);
-  x1 = hi(umax + m);
-  y0 = lo(wmin - m);
-  y1 = hi(wmax + m);
-  return x0 <= x1 && y0 <= y1;
+  return face_box_pixels(umin, umax, wmin, wmax, m, n, x0, x1, y0, y1);
 }
 
 // ---- One run ------------------------------------------------------------------------------

@@ -109,6 +109,13 @@ bool bounds_of(const Vec2* pts, int count, double m, int n, int& x0, int& x1, in
     wmin = std::min(wmin, p.w);
     wmax = std::max(wmax, p.w);
   }
+  return face_box_pixels(umin, umax, wmin, wmax, m, n, x0, x1, y0, y1);
+}
+
+}  // namespace
+
+bool face_box_pixels(double umin, double umax, double wmin, double wmax, double m, int n, int& x0,
+                     int& x1, int& y0, int& y1) {
   if (umax < -1 - m || umin > 1 + m || wmax < -1 - m || wmin > 1 + m) return false;
   auto lo = [n](double c) {
     return std::max(0, int(std::ceil(std::max(-2.0, pixel_coord(c, n)))));
@@ -122,8 +129,6 @@ bool bounds_of(const Vec2* pts, int count, double m, int n, int& x0, int& x1, in
   y1 = hi(wmax + m);
   return x0 <= x1 && y0 <= y1;
 }
-
-}  // namespace
 
 Footprint compute_footprint(const Vec3* rel, int count, const FaceAxes& axes, double near) {
   Footprint fp;

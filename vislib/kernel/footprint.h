@@ -40,6 +40,12 @@ int compute_footprint_hull(const Vec3* rel, int count, const FaceAxes& axes, dou
                            Vec2* hull, double& margin);
 
 // Pixel rectangle [x0,x1] x [y0,y1] (inclusive) of an N x N face containing every pixel centre
+// in the box [umin, umax] x [wmin, wmax] of face coordinates widened by m on every side; false
+// when none. The rectangles below (and the dynamic kernel's sphere bounds) all end here.
+bool face_box_pixels(double umin, double umax, double wmin, double wmax, double m, int n, int& x0,
+                     int& x1, int& y0, int& y1);
+
+// Pixel rectangle [x0,x1] x [y0,y1] (inclusive) of an N x N face containing every pixel centre
 // of the footprint (with kFootprintMargin); false when none.
 bool footprint_pixel_bounds(const Footprint& fp, int n, int& x0, int& x1, int& y0, int& y1);
 
