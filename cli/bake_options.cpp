@@ -180,8 +180,10 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--eps-len", a.eps_len, "Final pieces must be longer than this (in t) to count")
       ->check(in_range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--tile", a.tile, "Kernel tile side in pixels")
-      ->check(in_range(1, 4096))
+  cmd->add_option("--tile", a.tile,
+                  "Kernel tile side in pixels; 0: 32 for static scenes, 16 with moving triangles "
+                  "or spheres")
+      ->check(in_range(0, 4096))
       ->capture_default_str();
   cmd->add_option("--long-segments", a.long_segments,
                   "Run the world-aligned pass of up to this many cell edges lying end to end as "

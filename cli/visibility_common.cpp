@@ -30,8 +30,10 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
       ->capture_default_str();
   cmd->add_option("-j,--threads", a.threads, "Worker threads (0 = all cores)")
       ->check(non_negative());
-  cmd->add_option("--tile", a.tile, "Tile side in pixels (memory/parallelism grain)")
-      ->check(in_range(1, 4096))
+  cmd->add_option("--tile", a.tile,
+                  "Tile side in pixels (memory/parallelism grain); 0: 32 for static scenes, 16 "
+                  "with moving triangles or spheres")
+      ->check(in_range(0, 4096))
       ->capture_default_str();
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")

@@ -24,7 +24,7 @@ struct VisibilityArgs {
   double near = vislib::kDefaultNear;
   double eps_len = vislib::kDefaultEpsLen;
   int threads = 0;
-  int tile = 32;
+  int tile = 0;
   int states = 1;
   std::string granularity = "triangle";
   std::string mode = "diagonal";

@@ -86,7 +86,7 @@ vislib::SegmentOptions segment_options(int resolution, double near, double eps_l
   if (!(near > 0) || !std::isfinite(near)) throw py::value_error("near must be > 0 and finite");
   if (!(eps_len >= 0)) throw py::value_error("eps_len must be >= 0");
   if (!(eps_z >= 0)) throw py::value_error("eps_z must be >= 0");
-  if (tile_size < 1) throw py::value_error("tile_size must be >= 1");
+  if (tile_size < 0) throw py::value_error("tile_size must be >= 0 (0: the kernel's choice)");
   if (coplanar != "both" && coplanar != "first")
     throw py::value_error("coplanar must be 'both' or 'first'");
   if (mode != "diagonal" && mode != "decoupled")
@@ -307,7 +307,7 @@ PYBIND11_MODULE(pyvislib, m) {
       },
       py::arg("scene"), py::arg("from_"), py::arg("to"), py::kw_only(), py::arg("resolution") = 512,
       py::arg("near") = vislib::kDefaultNear, py::arg("eps_len") = vislib::kDefaultEpsLen,
-      py::arg("eps_z") = vislib::kDefaultEpsZ, py::arg("tile_size") = 32,
+      py::arg("eps_z") = vislib::kDefaultEpsZ, py::arg("tile_size") = 0,
       py::arg("coplanar") = "both", py::arg("mode") = "diagonal", py::arg("depth_culling") = true,
       py::arg("simd") = true, py::arg("state") = 0, py::arg("orientation") = py::none(),
       py::arg("threads") = 0,
@@ -355,7 +355,7 @@ PYBIND11_MODULE(pyvislib, m) {
       py::arg("scene"), py::arg("box_min"), py::arg("box_max"), py::kw_only(), py::arg("runs") = 1,
       py::arg("seed") = 1, py::arg("resolution") = 512, py::arg("near") = vislib::kDefaultNear,
       py::arg("eps_len") = vislib::kDefaultEpsLen, py::arg("eps_z") = vislib::kDefaultEpsZ,
-      py::arg("tile_size") = 32, py::arg("coplanar") = "both", py::arg("mode") = "diagonal",
+      py::arg("tile_size") = 0, py::arg("coplanar") = "both", py::arg("mode") = "diagonal",
       py::arg("threads") = 0,
       "Triangles visible from the box box_min..box_max (vislib::region_visibility): runs cube "
       "orientations on each perimeter segment, united. Same as `pvs region --box ... --runs K`.");

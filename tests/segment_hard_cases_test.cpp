@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
 
 #include "tests/scene_builders.h"
 #include "tests/support/ray_oracle.h"
@@ -366,6 +369,38 @@ TEST(SegmentHardCases, H11_QuadraticRootsStayAccurateForTinyLeadingCoefficients)
   ASSERT_EQ(solve_quadratic(0, 2, -1, r), 1);
   EXPECT_EQ(r[0], 0.5);
   EXPECT_EQ(solve_quadratic(0, 0, 1, r), 0);
+}
+
+// The inline min_num/max_num that replaced std::fmin/std::fmax in the root finder must give the
+// same bits as libm for every input the kernel can meet (and NaN), or results change.
+TEST(SegmentHardCases, InlineMinAndMaxGiveTheSameBitsAsLibm) {
+  auto bits = [](double v) {
+    uint64_t b;
+    std::memcpy(&b, &v, 8);
+    return b;
+  };
+  const double nan = std::nan("");
+  std::vector<double> values = {0.0,     -0.0,     1.0,   -1.0,     0.5,       1e-300,
+                                -1e-300, 4.9e-324, 1e300, INFINITY, -INFINITY, nan};
+  Rng rng(31);
+  for (int k = 0; k < 200; ++k) values.push_back(rng.uniform(-2, 2));
+  volatile double sink = 0;  // keeps std::fmin from being folded at compile time
+  for (double x : values)
+    for (double y : values) {
+      volatile double vx = x, vy = y;
+      const double lib_min = std::fmin(vx, vy), lib_max = std::fmax(vx, vy);
+      sink = lib_min + lib_max;
+      const double mn = min_num(x, y), mx = max_num(x, y);
+      if (std::isnan(lib_min))
+        EXPECT_TRUE(std::isnan(mn)) << x << " " << y;
+      else
+        EXPECT_EQ(bits(mn), bits(lib_min)) << x << " " << y;
+      if (std::isnan(lib_max))
+        EXPECT_TRUE(std::isnan(mx)) << x << " " << y;
+      else
+        EXPECT_EQ(bits(mx), bits(lib_max)) << x << " " << y;
+    }
+  (void)sink;
 }
 
 TEST(SegmentHardCases, H12_FootprintContainsEveryCoveredPixelWhenVerticesAreBehindTheEye) {

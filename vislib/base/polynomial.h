@@ -6,6 +6,17 @@
 
 namespace vislib {
 
+// std::fmin and std::fmax without the call into libm (GCC inlines those only with
+// -ffinite-math-only; the calls were 6% of the grass field's kernel): the same value for every
+// input. A NaN operand is ignored (IEEE minNum/maxNum); of two equal values (+0 and -0) the first
+// is returned, as x86-64 glibc does (tested against it).
+inline double min_num(double x, double y) {
+  return y < x ? y : (x == x ? x : y);
+}
+inline double max_num(double x, double y) {
+  return y > x ? y : (x == x ? x : y);
+}
+
 // Real roots of a t^2 + b t + c, ascending, written to r[0..count). Discriminant with Kahan's FMA
 // trick (exact products), roots by q = -(b + sign(b) sqrt(disc))/2, t = q/a and c/q (no
 // cancellation). a == 0: the linear root; a == b == 0: none. A double root is reported twice
@@ -27,8 +38,8 @@ inline int solve_quadratic(double a, double b, double c, double r[2]) {
     return 2;
   }
   double x0 = q / a, x1 = c / q;
-  r[0] = std::fmin(x0, x1);
-  r[1] = std::fmax(x0, x1);
+  r[0] = min_num(x0, x1);
+  r[1] = max_num(x0, x1);
   return 2;
 }
 
@@ -53,8 +64,8 @@ inline bool poly_may_vanish(const double* c, int deg, double lo, double hi) {
   double a = c[deg], b = c[deg];
   for (int k = deg - 1; k >= 0; --k) {
     double p0 = a * lo, p1 = a * hi, p2 = b * lo, p3 = b * hi;
-    a = std::fmin(std::fmin(p0, p1), std::fmin(p2, p3)) + c[k];
-    b = std::fmax(std::fmax(p0, p1), std::fmax(p2, p3)) + c[k];
+    a = min_num(min_num(p0, p1), min_num(p2, p3)) + c[k];
+    b = max_num(max_num(p0, p1), max_num(p2, p3)) + c[k];
     // Widen by the rounding of this step (relative 4 ulp of the magnitudes involved).
     double e = 4 * 2.2e-16 * (std::fabs(a) + std::fabs(b) + std::fabs(c[k]));
     a -= e;

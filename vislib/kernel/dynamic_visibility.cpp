@@ -22,6 +22,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 #include "vislib/base/polynomial.h"
@@ -389,15 +390,58 @@ struct Run {
   bool diagonal;      // part of the Diagonal mode (its pieces map onto t)
 };
 
+// ---- Compact pixel lists (issue 13, item 2) ----------------------------------------------
+// A GeneralDepth is 136 bytes, so a GeneralPiece is 160; the dense lists of vegetation (a grass
+// field ends with 150 pieces a pixel on average, up to 965) spent most of their time moving them
+// (vector growth, memmove on insertion, page faults). Inside a tile the lists hold a 32-byte
+// piece whose depth is a pointer into a per-tile pool, one entry per inserted interval that
+// changed its list. The handle forwards every question to the pointed-to depth (same_depth
+// compares the coefficients unless the pointers are equal), so the lists are those of
+// GeneralPiece bit for bit; finish_pixel copies the depths out for SegmentResult::general_pieces.
+struct DepthRef {
+  const GeneralDepth* d = nullptr;
+  double at(double t) const { return d->at(t); }
+};
+int depth_crossings(const DepthRef& i, const DepthRef& j, double lo, double hi, double* out) {
+  return depth_crossings(*i.d, *j.d, lo, hi, out);
+}
+bool same_depth(const DepthRef& a, const DepthRef& b) {
+  return a.d == b.d || same_depth(*a.d, *b.d);
+}
+using CompactPiece = PieceT<DepthRef>;
+
+// The depths a tile's lists point at, in the order they were inserted: chunks that never move
+// (pointers stay valid while the pool grows), kept from tile to tile and reused. (Chunks of their
+// own per pixel were measured slower on the grass field.)
+class DepthPool {
+ public:
+  GeneralDepth* push(const GeneralDepth& d) {
+    if (used_ == chunks_.size() * kChunk) chunks_.emplace_back(new GeneralDepth[kChunk]);
+    GeneralDepth* slot = &chunks_[used_ / kChunk][used_ % kChunk];
+    *slot = d;
+    ++used_;
+    return slot;
+  }
+  void pop() { --used_; }  // the last push, which no list points at
+  void clear() { used_ = 0; }
+  size_t bytes() const { return chunks_.size() * kChunk * sizeof(GeneralDepth); }
+
+ private:
+  static constexpr size_t kChunk = 1024;
+  std::vector<std::unique_ptr<GeneralDepth[]>> chunks_;
+  size_t used_ = 0;
+};
+
 // One run of moving triangles and spheres for the tile driver (tile_driver.h): footprints of the
 // six eye-relative corners (triangles) or of the swept sphere, coverage as intervals with general
 // depths, exact depth culling with each piece's primitive's farthest depth over the run.
 class DynamicKind {
  public:
   struct Scratch {
-    std::vector<std::vector<GeneralPiece>> lists;
+    std::vector<std::vector<CompactPiece>> lists;
     std::vector<double> far;  // per pixel: farthest zmax over its pieces once they cover [0,1]
     std::vector<std::vector<TieRecord>> ties;  // per pixel (CoplanarRule::Both)
+    DepthPool depths;                          // what the pieces of `lists` point at
   };
 
   DynamicKind(const Scene& scene, const Run& run, const SegmentOptions& opt,
@@ -423,9 +467,12 @@ class DynamicKind {
 
   Scratch make_scratch(int ts) const {
     const size_t n = size_t(ts) * size_t(ts);
-    return Scratch{std::vector<std::vector<GeneralPiece>>(n), std::vector<double>(n),
-                   std::vector<std::vector<TieRecord>>(n)};
+    return Scratch{std::vector<std::vector<CompactPiece>>(n), std::vector<double>(n),
+                   std::vector<std::vector<TieRecord>>(n), DepthPool()};
   }
+
+  void begin_tile(Scratch& sc) const { sc.depths.clear(); }
+  size_t held_bytes(const Scratch& sc) const { return sc.depths.bytes(); }
 
   // Bounds of the view depth of every primitive over the run on this face: any hit of it at any s
   // has zmin <= lambda <= zmax (the eye-relative triangle lies in the hull of its six eye-relative
@@ -477,8 +524,13 @@ class DynamicKind {
       if (n) ++stats.covered_pairs;
       bool changed = false;
       const TieRule tie{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
-      for (int i = 0; i < n; ++i)
-        changed |= insert_piece(sc.lists[k], GeneralPiece{iv[i].lo, iv[i].hi, p, iv[i].depth}, tie);
+      for (int i = 0; i < n; ++i) {
+        const GeneralDepth* d = sc.depths.push(iv[i].depth);
+        if (insert_piece(sc.lists[k], CompactPiece{iv[i].lo, iv[i].hi, p, DepthRef{d}}, tie))
+          changed = true;
+        else
+          sc.depths.pop();  // the list is unchanged: nothing points at it
+      }
       if (changed && opt_.depth_culling) update_far(sc, k);
     };
     if (p < ntri_) {
@@ -531,7 +583,8 @@ class DynamicKind {
     if (!pieces_ || !run_.diagonal) return;
     const int N = opt_.resolution;
     auto& dst = (*pieces_)[(size_t(face) * N + y) * N + x];
-    for (GeneralPiece pc : l) {
+    for (const CompactPiece& c : l) {
+      GeneralPiece pc{c.t0, c.t1, c.id, *c.depth.d};
       pc.t0 = run_.t0 + pc.t0 * (run_.t1 - run_.t0);
       pc.t1 = pc.t1 == 1.0 ? run_.t1 : run_.t0 + pc.t1 * (run_.t1 - run_.t0);
       if (!(pc.t0 < pc.t1)) continue;
@@ -564,7 +617,7 @@ class DynamicKind {
     const auto& l = sc.lists[k];
     if (!covers_segment(l)) return;
     double f = -INFINITY;
-    for (const GeneralPiece& pc : l) f = std::max(f, zmax_[pc.id]);
+    for (const CompactPiece& pc : l) f = std::max(f, zmax_[pc.id]);
     sc.far[k] = f * far_scale_;
   }
 
@@ -584,7 +637,12 @@ class DynamicKind {
 
 SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
                                          const SegmentOptions& opt) {
-  assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
+  assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 0);
+  if (opt.tile_size == 0) {  // the kernel's choice
+    SegmentOptions o = opt;
+    o.tile_size = kDynamicTileSize;
+    return dynamic_segment_visibility(scene, v0, v1, o);
+  }
   auto start = std::chrono::steady_clock::now();
   const size_t K = std::max<size_t>(1, scene.state_count());
   const size_t ntri = scene.triangle_count(), nprim = ntri + scene.sphere_count();

@@ -253,8 +253,10 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
               !changes && near < 0 && ties.sink && detail::linear_not_tied(x, y, ties.eps_z);
         }
       } else {
-        changes = detail::crossings(I, p, lo, hi, cuts) > 0 ||
-                  &detail::front(I, p, 0.5 * (lo + hi)) == &p;
+        // The cheap question first (two depth evaluations against a polynomial's roots); the
+        // answer is the same either way.
+        changes = &detail::front(I, p, 0.5 * (lo + hi)) == &p ||
+                  detail::crossings(I, p, lo, hi, cuts) > 0;
       }
       if (!changes && ties.sink && !tie_checked) detail::record_tie(ties, I, p, lo, hi);
       cur = hi;

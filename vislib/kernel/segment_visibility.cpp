@@ -437,6 +437,11 @@ class StaticKind {
     if (++sc.batch_size == kBatch) flush(sc, rect, axes, stats);
   }
 
+  void begin_tile(Scratch&) const {}  // nothing kept beyond the driver's per-pixel state
+  size_t held_bytes(const Scratch&) const {
+    return 0;
+  }
+
   void flush(Scratch& sc, const TileRect& rect, const FaceAxes& axes, SegmentStats& stats) const {
     if (sc.batch_size == 0) return;
     int ylo = rect.y1, yhi = rect.y0;
@@ -586,7 +591,13 @@ class StaticKind {
 }  // namespace
 
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
-  assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 1);
+  assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 0);
+  if (opt.tile_size == 0) {  // the kernel's choice
+    SegmentOptions o = opt;
+    o.tile_size =
+        scene.sphere_count() > 0 || scene.is_dynamic() ? kDynamicTileSize : kStaticTileSize;
+    return segment_visibility(scene, v0, v1, o);
+  }
   if (!opt.splits.empty()) {
     bool ok = opt.splits.size() < kMaxSplitParts && opt.splits.front() > 0 && opt.splits.back() < 1;
     for (size_t i = 1; i < opt.splits.size(); ++i) ok = ok && opt.splits[i - 1] < opt.splits[i];

@@ -29,6 +29,8 @@
 //                          `ties` (its tie records) and `far` (a depth that its list covers
 //                          [0, 1] nearer than; inf until it does); the driver resets all three
 //                          for every tile
+//   void begin_tile(Scratch&) const;  reset what else the kind keeps per tile (called after them)
+//   size_t held_bytes(const Scratch&) const;  bytes of that, for SegmentStats::peak_tile_bytes
 //   Scratch make_scratch(int tile_size) const;
 //   size_t count() const;  primitives
 //   bool bounds(size_t p, int face, const FaceAxes&, int* box, double& zmin);
@@ -406,6 +408,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           for (auto& l : sc.lists) l.clear();
                           for (auto& l : sc.ties) l.clear();
                           std::fill(sc.far.begin(), sc.far.end(), INFINITY);
+                          kind.begin_tile(sc);
                           TileFar<typename Kind::Scratch> tile_far(sc, rect);
                           auto flush = [&] { kind.flush(sc, rect, axes, stats); };
                           if (bvh) {
@@ -438,7 +441,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           }
                           flush();  // what the kind still holds back
                           // Tile results: marks, witnesses, pieces, statistics.
-                          size_t bytes = 0;
+                          size_t bytes = kind.held_bytes(sc);
                           for (int y = rect.y0; y <= rect.y1; ++y)
                             for (int x = rect.x0; x <= rect.x1; ++x) {
                               const size_t k = rect.index(x, y);
