@@ -615,7 +615,9 @@ class DynamicKind {
   // A covered pixel's far: the largest zmax over the primitives of its pieces.
   void update_far(Scratch& sc, size_t k) const {
     const auto& l = sc.lists[k];
-    if (!covers_segment(l)) return;
+    // A list that covers [0, 1] keeps covering it (insertions only add coverage), and its far is
+    // finite from then on: walk the list for gaps only until it first covers.
+    if (sc.far[k] == INFINITY && !covers_segment(l)) return;
     double f = -INFINITY;
     for (const CompactPiece& pc : l) f = std::max(f, zmax_[pc.id]);
     sc.far[k] = f * far_scale_;
