@@ -253,8 +253,8 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
               !changes && near < 0 && ties.sink && detail::linear_not_tied(x, y, ties.eps_z);
         }
       } else {
-        // The cheap question first (two depth evaluations against a polynomial's roots); the
-        // answer is the same either way.
+        // The cheap question first (two depth evaluations, where the crossings need a
+        // polynomial's roots); `||` gives the same answer in either order.
         changes = &detail::front(I, p, 0.5 * (lo + hi)) == &p ||
                   detail::crossings(I, p, lo, hi, cuts) > 0;
       }
