@@ -592,12 +592,6 @@ class StaticKind {
 
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
   assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 0);
-  if (opt.tile_size == 0) {  // the kernel's choice
-    SegmentOptions o = opt;
-    o.tile_size =
-        scene.sphere_count() > 0 || scene.is_dynamic() ? kDynamicTileSize : kStaticTileSize;
-    return segment_visibility(scene, v0, v1, o);
-  }
   if (!opt.splits.empty()) {
     bool ok = opt.splits.size() < kMaxSplitParts && opt.splits.front() > 0 && opt.splits.back() < 1;
     for (size_t i = 1; i < opt.splits.size(); ++i) ok = ok && opt.splits[i - 1] < opt.splits[i];
@@ -609,7 +603,12 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
       throw std::invalid_argument("a segment can be split only in a static scene without spheres");
   }
   if (scene.sphere_count() > 0 || scene.is_dynamic())
-    return dynamic_segment_visibility(scene, v0, v1, opt);
+    return dynamic_segment_visibility(scene, v0, v1, opt);  // resolves tile_size 0 itself
+  if (opt.tile_size == 0) {                                 // the kernel's choice
+    SegmentOptions o = opt;
+    o.tile_size = kStaticTileSize;
+    return segment_visibility(scene, v0, v1, o);
+  }
   if (opt.bvh && !opt.bvh->matches(scene, opt.state))
     throw std::invalid_argument(
         "the BVH given to segment_visibility was built for another scene or key state");
