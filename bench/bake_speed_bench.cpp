@@ -13,7 +13,7 @@
 // same cells to a file in a temporary folder; the files with and without sharing must be
 // byte-identical (checked; exit 1 otherwise).
 //
-//   bake_speed_bench [--triangles T] [--sample S] [--res N] [--runs K] [--long L]
+//   bake_speed_bench [--triangles T] [--sample S] [--res N] [--runs K] [--long L|auto]
 //                    [--cores 1|all|both] [--no-bvh]
 // --no-bvh: the runs bin every triangle on every face instead of walking the BVH (BakeSettings::
 // bvh); the file hashes printed must equal those of a run without it.
@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
     if (i + 1 >= argc) {
       std::fprintf(stderr,
                    "usage: bake_speed_bench [--triangles T] [--sample S] [--res N] [--runs K] "
-                   "[--long L] [--cores 1|all|both] [--no-bvh]\n");
+                   "[--long L|auto] [--cores 1|all|both] [--no-bvh]\n");
       return 2;
     }
     const std::string v = argv[++i];
@@ -81,7 +81,7 @@ int main(int argc, char** argv) {
     else if (a == "--runs")
       runs = std::stoi(v);
     else if (a == "--long")
-      long_parts = std::stoi(v);
+      long_parts = v == "auto" ? 0 : std::stoi(v);
     else if (a == "--cores")
       cores = v;
     else {
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
       limit =
           std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, 1);
     std::string bytes[3];
-    for (int share = 0; share < (long_parts > 1 ? 3 : 2); ++share) {
+    for (int share = 0; share < (long_parts != 1 ? 3 : 2); ++share) {
       BakeSettings s;
       s.region.segment.resolution = res;
       s.region.runs = runs;
@@ -138,9 +138,10 @@ int main(int argc, char** argv) {
       const double sec =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       const double cpu = process_cpu() - c0;
-      const std::string label = share == 2   ? "long" + std::to_string(long_parts)
-                                : share == 1 ? "yes"
-                                             : "no";
+      const std::string label =
+          share == 2   ? (long_parts == 0 ? "auto" : "long") + std::to_string(r.long_segments)
+          : share == 1 ? "yes"
+                       : "no";
       bytes[share] = read_file(path);
       uint64_t h = 1469598103934665603ull;  // FNV-1a of the file: compare runs with --no-bvh
       for (unsigned char ch : bytes[share]) h = (h ^ ch) * 1099511628211ull;
@@ -149,6 +150,14 @@ int main(int argc, char** argv) {
                   (unsigned long long)r.segment_runs_computed,
                   (unsigned long long)r.segment_runs_shared, peak_mb(), (unsigned long long)h,
                   r.bvh_seconds);
+      if (!r.long_segment_choice.candidates.empty()) {
+        std::printf("       auto: pilot of %d stretches at N = %d, %.2f s wall:",
+                    r.long_segment_choice.stretches_sampled, r.long_segment_choice.resolution,
+                    r.long_segment_choice.seconds);
+        for (const LongSegmentCandidate& lc : r.long_segment_choice.candidates)
+          std::printf(" L=%d %.3g s (work %.3g)", lc.parts, lc.seconds, lc.cost);
+        std::printf("\n");
+      }
       std::fflush(stdout);
     }
     if (bytes[0] != bytes[1]) {

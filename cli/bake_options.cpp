@@ -134,7 +134,7 @@ vislib::BakeSettings settings_of(const BakeArgs& a) {
   s.region.segment.near = a.near;
   s.region.segment.eps_len = a.eps_len;
   s.region.segment.tile_size = a.tile;
-  s.long_segments = a.long_segments;
+  s.long_segments = a.long_segments == "auto" ? 0 : std::stoi(a.long_segments);
   s.bvh = a.bvh == "on";
   s.region.runs = a.runs;
   s.region.seed = a.seed;
@@ -188,8 +188,9 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--long-segments", a.long_segments,
                   "Run the world-aligned pass of up to this many cell edges lying end to end as "
                   "one long segment, split per edge (1 = off; static scenes; pays for many small "
-                  "cells over a large scene, see docs/bake.md)")
-      ->check(in_range(1, int(vislib::kMaxSplitParts)))
+                  "cells over a large scene, see docs/bake.md); 'auto': a pilot over a few rows "
+                  "of edges picks 1, 2, 4 or 8 from the kernel's counted work")
+      ->check(CLI::IsMember({"1", "2", "3", "4", "5", "6", "7", "8", "auto"}))
       ->capture_default_str();
   cmd->add_option("--bvh", a.bvh,
                   "Static scenes: every run walks one BVH of the triangles front to back per "

@@ -18,7 +18,7 @@ struct BakeArgs {
   std::string box, grid, eye, shard = "0/1";
   bool walkable = false, resume = false, no_headroom = false, dry_run = false;
   double cell_size = 0, max_slope = 45;
-  int resolution = 512, runs = 1, threads = 0, tile = 0, long_segments = 1;
+  int resolution = 512, runs = 1, threads = 0, tile = 0;
   uint64_t seed = 1;
   double near = vislib::kDefaultNear, eps_len = vislib::kDefaultEpsLen;
   std::string granularity = "triangle";
@@ -27,7 +27,8 @@ struct BakeArgs {
   double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
   std::string preset = "default";
-  std::string bvh = "on";  // --bvh on|off
+  std::string bvh = "on";           // --bvh on|off
+  std::string long_segments = "1";  // --long-segments: 1..8 or auto
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).

@@ -1,5 +1,6 @@
 // pvs bake: bake a scene's view cells into a PVS file (docs/bake.md); cmd_merge.cpp joins the
 // shard files of a sharded bake.
+#include <fmt/format.h>
 #include <sys/stat.h>
 #include <tbb/global_control.h>
 #include <unistd.h>
@@ -7,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <string>
 
 #include "cli/bake_options.h"
 #include "cli/bake_progress.h"
@@ -37,6 +39,17 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
                  "were baked again, %u valid records kept\n",
                  checkpoint.c_str(), r.checkpoint_dropped_records,
                  static_cast<unsigned long long>(r.checkpoint_dropped_bytes), r.resumed);
+  const vislib::LongSegmentChoice& pilot = r.long_segment_choice;
+  if (!pilot.candidates.empty() && show_progress()) {
+    std::string est;
+    for (const vislib::LongSegmentCandidate& c : pilot.candidates)
+      est += fmt::format("{}L = {}: {:.3g}", est.empty() ? "" : ", ", c.parts, c.cost);
+    std::fprintf(stderr,
+                 "pvs bake: long segments: L = %d chosen by the pilot (%d rows of edges at N = %d, "
+                 "%.2f s; estimated work in covered-pair equivalents %s)\n",
+                 r.long_segments, pilot.stretches_sampled, pilot.resolution, pilot.seconds,
+                 est.c_str());
+  }
   const double kernel = vislib::kernel_seconds(r);
   if (show_progress())
     std::fprintf(
@@ -117,9 +130,18 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     std::fprintf(stderr, "pvs bake: %u cells (%s), %zu triangles, shard %u/%u\n", n,
                  cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
                  scene.triangle_count(), shard.index, shard.count);
+  const vislib::BakeSettings settings = settings_of(a);
+  if (settings.long_segments == 0 && show_progress()) {
+    vislib::BakeSettings probe = settings;
+    probe.long_segments = 2;
+    if (vislib::uses_long_segments(scene, probe))
+      std::fprintf(stderr,
+                   "pvs bake: --long-segments auto: a pilot runs a few rows of cell edges with "
+                   "L = 1, 2, 4 and 8 and counts the kernel's work\n");
+  }
   vislib::BakeFiles files{a.output, checkpoint, a.resume, /*lock=*/false};
   const vislib::BakeReport r =
-      vislib::bake(scene, cells, settings_of(a), shard, files, progress_printer());
+      vislib::bake(scene, cells, settings, shard, files, progress_printer());
   report_bake(a, info, r, checkpoint);
 }
 

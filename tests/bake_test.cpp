@@ -17,11 +17,14 @@
 #include "vislib/bake/bake_report.h"
 #include "vislib/bake/cell_set.h"
 #include "vislib/bake/checkpoint.h"
+#include "vislib/bake/long_segments.h"
 #include "vislib/bake/scene_subset.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/kernel/segment_run_cache.h"
+#include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/generate.h"
+#include "vislib/scene/import.h"
 #include "vislib/scene/scene_fingerprint.h"
 
 using namespace vislib;
@@ -603,6 +606,164 @@ TEST(BakeLongSegments, SetsEqualBakingEachCellAloneWithFarFewerRuns) {
     shards.push_back(pvs::Reader::from_file(path));
   }
   EXPECT_EQ(pvs::merge_pvs(shards), read_file(dir + "/long.pvs"));
+}
+
+TEST(LongSegmentChoice, PicksTheLongestLengthFivePercentCheaperThanEveryShorterOne) {
+  auto pick = [](std::vector<double> costs) {
+    std::vector<LongSegmentCandidate> c;
+    for (size_t i = 0; i < costs.size(); ++i) {
+      c.emplace_back();
+      c.back().parts = 1 << i;
+      c.back().cost = costs[i];
+    }
+    return pick_long_segments(c);
+  };
+  EXPECT_EQ(pick({100, 95, 80, 79}), 4);  // 95 is not 5% below 100; 79 not 5% below 80
+  EXPECT_EQ(pick({100, 120, 85, 70}), 8);
+  EXPECT_EQ(pick({100, 96, 120, 95}), 1);  // 95 is not 5% below 96
+  EXPECT_EQ(pick({100, 94}), 2);
+  EXPECT_EQ(pick({100}), 1);
+}
+
+TEST(SegmentRunCache, StretchesEndToEndAreMaximalAndIndependentOfTheSegmentsOrder) {
+  std::vector<SegmentEnds> segs;
+  for (int i = 0; i < 5; ++i) segs.push_back({{double(i), 1.5, 0}, {double(i + 1), 1.5, 0}});
+  segs.push_back({{7, 1.5, 0}, {8, 1.5, 0}});  // alone on its line: no stretch
+  segs.push_back({{0, 1.5, 2}, {0, 1.5, 3}});  // along z
+  segs.push_back({{0, 1.5, 3}, {0, 1.5, 4}});
+  segs.push_back({{2, 1.5, 0}, {3, 1.5, 0}});  // a duplicate counts once
+  segs.push_back({{0, 1.5, 0}, {1, 1.5, 1}});  // not axis-parallel
+  const std::vector<std::vector<SegmentEnds>> got = segments_end_to_end(segs);
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0].size(), 5u);
+  EXPECT_EQ(got[0].front().first.x, 0.0);
+  EXPECT_EQ(got[0].back().second.x, 5.0);
+  EXPECT_EQ(got[1].size(), 2u);
+  EXPECT_EQ(got[1].front().first.z, 2.0);
+  std::vector<SegmentEnds> reversed(segs.rbegin(), segs.rend());
+  EXPECT_EQ(segments_end_to_end(reversed), got);
+}
+
+// The pilot's choice follows the kernel's counts: many small cells over a large scene chain (a
+// run costs far less than its length times an edge's), a few large cells over a small scene do
+// not (a longer run holds more pieces per pixel and culls less). Bakes of such scenes measure
+// the same way (docs/performance.md, "Choosing L").
+TEST(LongSegmentChoice, ChainsSmallCellsOfALargeCityAndNotLargeCellsOfASmallOne) {
+  CityOptions big;
+  big.seed = 1;
+  big.target_triangles = 100000;
+  big.auto_blocks = true;
+  const Scene large = generate_city(big);
+  const TriangleBvh tree = build_triangle_bvh(large, 0);
+  SegmentOptions o;
+  o.resolution = 64;
+  o.bvh = &tree;
+  std::vector<SegmentEnds> row;  // 2 m cells along a street at eye height
+  for (int i = 0; i < 8; ++i) row.push_back({{-8.0 + 2 * i, 1.5, 0}, {-6.0 + 2 * i, 1.5, 0}});
+  const LongSegmentChoice chained = choose_long_segments(large, row, o);
+  ASSERT_GE(chained.candidates.size(), 3u);
+  EXPECT_EQ(chained.stretches_sampled, 1);
+  EXPECT_EQ(chained.resolution, 64);  // the bake's own
+  EXPECT_GT(chained.parts, 1);
+  EXPECT_LT(chained.candidates[2].cost, chained.candidates[0].cost);
+
+  // The quick start's case: 24 m cells over the 20K-triangle default city.
+  const Scene small = load_scene(std::string(VISLIB_SOURCE_DIR) + "/data/city.glb");
+  SegmentOptions so;
+  so.resolution = 128;  // the quick start's
+  std::vector<SegmentEnds> wide;
+  for (int i = 0; i < 4; ++i)
+    wide.push_back({{-96.0 + 24 * i, 1.6, 0.5}, {-72.0 + 24 * i, 1.6, 0.5}});
+  const LongSegmentChoice alone = choose_long_segments(small, wide, so);
+  // L = 2 costs more than L = 1, so the pilot stops there.
+  ASSERT_EQ(alone.candidates.size(), 2u);
+  EXPECT_EQ(alone.parts, 1);
+  EXPECT_GE(alone.candidates[1].cost, alone.candidates[0].cost);
+}
+
+TEST(BakeLongSegmentsAuto, GivesTheBytesOfTheChosenLengthOnEveryShardAndThreadCount) {
+  const Scene scene = small_city();
+  const ViewCells cells = city_grid(32, 8, 8, EyeBand{1.5, 1.75});
+  BakeSettings s;
+  s.region.segment.resolution = 16;
+  s.long_segments = 0;
+  const std::string dir = temp_dir("bake_long_auto");
+  const BakeReport r = bake(scene, cells, s, {}, {dir + "/auto.pvs", "", false});
+  ASSERT_GE(r.long_segment_choice.candidates.size(), 2u);
+  EXPECT_EQ(r.long_segments, r.long_segment_choice.parts);
+  BakeSettings fixed = s;
+  fixed.long_segments = r.long_segments;
+  const std::string autob = read_file(dir + "/auto.pvs");
+  // The pilot's runs of the chosen L are handed to the bake (SegmentRunCache::provide) and count
+  // as its own: the same runs, the same bytes.
+  const BakeReport rf = bake(scene, cells, fixed, {}, {dir + "/fixed.pvs", "", false});
+  EXPECT_EQ(read_file(dir + "/fixed.pvs"), autob);
+  EXPECT_EQ(r.segment_runs_computed, rf.segment_runs_computed);
+  EXPECT_EQ(r.segment_runs_shared, rf.segment_runs_shared);
+  EXPECT_EQ(bake_bytes(scene, cells, s, dir + "/one.pvs", {}, 1), autob);
+  std::vector<pvs::Reader> shards;
+  for (uint32_t i = 0; i < 2; ++i) {
+    const std::string path = dir + "/s" + std::to_string(i) + ".pvs";
+    bake_bytes(scene, cells, s, path, {i, 2}, 2);
+    shards.push_back(pvs::Reader::from_file(path));
+  }
+  EXPECT_EQ(pvs::merge_pvs(shards), autob);
+  const std::string meta = pvs::Reader::from_memory(autob).info().metadata;
+  EXPECT_EQ(meta.find("\"long_segments\":") != std::string::npos, r.long_segments > 1);
+  const nlohmann::json j = nlohmann::json::parse(bake_report_json({}, r));
+  EXPECT_EQ(j["long_segments"]["parts"], r.long_segments);
+  EXPECT_EQ(j["long_segments"]["pilot"]["candidates"].size(),
+            r.long_segment_choice.candidates.size());
+  // Nothing to choose in a dynamic scene: no pilot, no long segments.
+  GrassOptions go;
+  go.size = 8;
+  go.density = 2;
+  go.states = 2;
+  const Scene grass = generate_grass(go);
+  const BakeReport g = bake(grass, city_grid(4, 2, 2), s, {}, {dir + "/grass.pvs", "", false});
+  EXPECT_EQ(g.long_segments, 1);
+  EXPECT_TRUE(g.long_segment_choice.candidates.empty());
+}
+
+TEST(SegmentRunCache, AProvidedRunIsHandedOutWithoutComputingItAgain) {
+  SegmentRunCache cache;
+  std::vector<SegmentEnds> segs;
+  for (int i = 0; i < 4; ++i) segs.push_back({{double(i), 1.5, 0}, {double(i + 1), 1.5, 0}});
+  cache.plan_chains(segs, 2);  // chains [0, 2] and [2, 4], each split at 0.5
+  for (const auto& [a, b] : segs) cache.expect(a, b);
+  cache.expect({9, 1.5, 0}, {9, 1.5, 1});  // a single segment
+  SegmentResult chain;
+  chain.visible = {7, 8};
+  chain.visible_parts = {{7}, {8}};
+  SegmentResult single;
+  single.visible = {5};
+  cache.provide({0, 1.5, 0}, {2, 1.5, 0}, {0.5}, chain);
+  cache.provide({2, 1.5, 0}, {4, 1.5, 0}, {0.25}, chain);  // other splits: not that chain
+  cache.provide({9, 1.5, 0}, {9, 1.5, 1}, {}, single);
+  cache.provide({5, 1.5, 0}, {6, 1.5, 0}, {}, single);  // nobody expects it
+  EXPECT_EQ(cache.runs_computed(), 2u);
+  int computations = 0;
+  auto compute = [&](Vec3, Vec3, const std::vector<double>& s) {
+    ++computations;
+    SegmentResult r;
+    for (size_t i = 0; i <= s.size(); ++i) r.visible_parts.push_back({uint32_t(100 + i)});
+    return r;
+  };
+  bool computed = false;
+  EXPECT_EQ(cache.get(segs[1].first, segs[1].second, compute, &computed)->visible,
+            std::vector<uint32_t>{8});
+  EXPECT_TRUE(computed);  // the first use takes the provided run as its own
+  EXPECT_EQ(cache.get(segs[0].first, segs[0].second, compute, &computed)->visible,
+            std::vector<uint32_t>{7});
+  EXPECT_FALSE(computed);
+  EXPECT_EQ(cache.get({9, 1.5, 0}, {9, 1.5, 1}, compute, &computed)->visible,
+            std::vector<uint32_t>{5});
+  EXPECT_TRUE(computed);
+  EXPECT_EQ(computations, 0);
+  EXPECT_EQ(cache.get(segs[2].first, segs[2].second, compute)->visible, std::vector<uint32_t>{100});
+  EXPECT_EQ(computations, 1);
+  EXPECT_EQ(cache.runs_computed(), 3u);
+  EXPECT_EQ(cache.runs_shared(), 1u);  // the chain's second use
 }
 
 TEST(SegmentRunCache, ConcurrentUsesOfAChainComputeItOnceAndReleaseEveryPart) {

@@ -388,6 +388,42 @@ TEST(CliBake, LongSegmentsRunFewerSegmentsForTheSameSets) {
   for (uint32_t c = 0; c < 16; ++c) EXPECT_EQ(a.read_cell(c), b.read_cell(c)) << "cell " << c;
   EXPECT_EQ(run_pvs(grid_bake(dir + "/bad.pvs") + " --long-segments 9", &out), 2) << out;
   EXPECT_NE(out.find("--long-segments"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs(grid_bake(dir + "/bad.pvs") + " --long-segments 2.5", &out), 2) << out;
+  EXPECT_NE(out.find("--long-segments"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad.pvs"));
+}
+
+// --long-segments auto: the pilot says what it does and what it chose, the report holds its
+// counts, and the file is the one the chosen L gives.
+TEST(CliBake, LongSegmentsAutoReportsItsPilotAndBakesTheChosenLength) {
+  std::string dir = temp_dir("cli_bake_long_auto");
+  std::string out;
+  ASSERT_EQ(
+      run_pvs(grid_bake(dir + "/auto.pvs") + " --long-segments auto --json " + dir + "/auto.json",
+              &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("a pilot runs a few rows of cell edges"), std::string::npos) << out;
+  const size_t at = out.find("long segments: L = ");
+  ASSERT_NE(at, std::string::npos) << out;
+  const int parts = std::stoi(out.substr(at + 19));
+  const json report = json::parse(vislib::read_file(dir + "/auto.json"));
+  EXPECT_EQ(report["long_segments"]["parts"], parts);
+  const json& pilot = report["long_segments"]["pilot"];
+  // Rows of 4 edges: L = 8 would repeat L = 4; the pilot may stop earlier (long_segments.h).
+  ASSERT_GE(pilot["candidates"].size(), 2u);
+  ASSERT_LE(pilot["candidates"].size(), 3u);
+  for (const json& c : pilot["candidates"]) {
+    EXPECT_GT(c["covered_pairs"].get<double>(), 0) << c;
+    EXPECT_EQ(c["estimated_work"].get<double>(), c["covered_pairs"].get<double>() +
+                                                     4 * c["triangle_tiles"].get<double>() +
+                                                     6 * c["bvh_nodes_opened"].get<double>())
+        << c;
+  }
+  ASSERT_EQ(
+      run_pvs(grid_bake(dir + "/fixed.pvs") + " --long-segments " + std::to_string(parts), &out), 0)
+      << out;
+  EXPECT_EQ(vislib::read_file(dir + "/auto.pvs"), vislib::read_file(dir + "/fixed.pvs"));
 }
 
 // Issue 13 item 4: the BVH every run walks changes nothing in the file; pvs segment and pvs

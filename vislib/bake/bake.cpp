@@ -13,6 +13,7 @@
 
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/id_universe.h"
+#include "vislib/bake/long_segments.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/kernel/segment_run_cache.h"
@@ -84,18 +85,52 @@ uint64_t cell_runs(const pvs::CellLayout& layout, uint32_t cell, int runs) {
   return segments * uint64_t(runs);
 }
 
+// Run 0's segment of every perimeter edge of every cell of the layout, in cell order.
+std::vector<SegmentEnds> all_edges(const pvs::CellLayout& layout) {
+  std::vector<SegmentEnds> all;
+  for (uint32_t c = 0; c < layout.cell_count(); ++c)
+    for (const Box3& rect : cell_rectangles(layout, c))
+      for (const Segment& s : perimeter_segments(rect)) all.emplace_back(s.from, s.to);
+  return all;
+}
+
 }  // namespace
 
-BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& settings,
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& requested,
                 Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
   assert(shard.count >= 1 && shard.index < shard.count);
   std::unique_ptr<FileLock> lock;
   if (files.lock)
     lock = std::make_unique<FileLock>(files.output + ".lock", "the output " + files.output);
+  BakeReport report;
+  // One BVH for every static run of this bake (the runs walk it per tile).
+  TriangleBvh tree;
+  const TriangleBvh* bvh = requested.region.segment.bvh;
+  if (requested.bvh && !bvh && bvh_applies(scene)) {
+    const auto t0 = std::chrono::steady_clock::now();
+    tree = build_triangle_bvh(scene, requested.region.segment.state);
+    bvh = &tree;
+    report.bvh_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  // --long-segments auto: L from a pilot over every cell of the layout (not only this shard's),
+  // so that every shard and every resumed run chooses the same L (long_segments.h).
+  BakeSettings settings = requested;
+  if (settings.long_segments == 0) {
+    settings.long_segments = 2;
+    const bool applies = uses_long_segments(scene, settings);
+    settings.long_segments = 1;
+    if (applies) {
+      SegmentOptions run0 = settings.region.segment;
+      run0.bvh = bvh;
+      report.long_segment_choice = choose_long_segments(scene, all_edges(cells.layout), run0);
+      settings.long_segments = report.long_segment_choice.parts;
+    }
+  }
+  report.long_segments = uses_long_segments(scene, settings) ? settings.long_segments : 1;
   pvs::FileInfo info = bake_file_info(scene, cells, settings);
   info.partial = shard.count > 1;
   const uint32_t n = info.layout.cell_count();
-  BakeReport report;
   report.cells = n;
   report.cell_seconds.assign(n, 0.0);
 
@@ -128,27 +163,19 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     if (uses_long_segments(scene, settings)) {
       // The plan covers every cell of the layout, so that it does not depend on the shard or on
       // the cells recovered from a checkpoint.
-      std::vector<std::pair<Vec3, Vec3>> all;
-      for (uint32_t c = 0; c < n; ++c)
-        for (const Box3& rect : cell_rectangles(info.layout, c))
-          for (const Segment& s : perimeter_segments(rect)) all.emplace_back(s.from, s.to);
-      shared_runs.plan_chains(all, settings.long_segments);
+      shared_runs.plan_chains(all_edges(info.layout), settings.long_segments);
     }
     for (uint32_t c = 0; c < n; ++c) {
       if (!in_shard(c, shard) || recovered[c]) continue;
       for (const Box3& rect : cell_rectangles(info.layout, c))
         for (const Segment& s : perimeter_segments(rect)) shared_runs.expect(s.from, s.to);
     }
+    // The pilot's runs of the chosen L are runs of this bake: not computed again.
+    for (LongSegmentChoice::Run& run : report.long_segment_choice.runs)
+      shared_runs.provide(run.from, run.to, run.splits, std::move(run.result));
+    report.long_segment_choice.runs.clear();
   }
-  // One BVH for every static run of this bake (the runs walk it per tile).
-  TriangleBvh tree;
-  if (settings.bvh && !settings.region.segment.bvh && bvh_applies(scene)) {
-    const auto t0 = std::chrono::steady_clock::now();
-    tree = build_triangle_bvh(scene, settings.region.segment.state);
-    run_settings.region.segment.bvh = &tree;
-    report.bvh_seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
+  run_settings.region.segment.bvh = bvh;
   std::atomic<uint64_t> runs_done{0};
 
   // Streaming: cells are baked in parallel and written in cell order as soon as every earlier

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/long_segments.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/scene.h"
@@ -32,7 +33,8 @@ struct BakeSettings {
   // within rounding of a junction (none seen in the tests and benchmarks, docs/performance.md).
   // Off by default: they pay where a run's fixed cost dominates (many small cells over a large
   // scene: 3.5x on the 1M-triangle city's 2 m cells) and cost where the length does (24 m cells
-  // over the 20K-triangle default scene: 2x slower); docs/bake.md.
+  // over the 20K-triangle default scene: 2x slower); docs/bake.md. 0 = auto: a pilot of a few
+  // chains measures which L (1, 2, 4 or 8) costs least (long_segments.h) and the bake runs it.
   int long_segments = 1;
   // Static scenes without spheres: build one BVH of the triangles (triangle_bvh.h) that every run
   // of the bake walks per tile, instead of each run computing footprint bounds for every
@@ -106,6 +108,8 @@ struct BakeReport {
   uint64_t segment_runs_computed = 0;
   uint64_t segment_runs_shared = 0;
   double bvh_seconds = 0;  // building the BVH the runs share (BakeSettings::bvh), wall time
+  int long_segments = 1;   // the L the bake ran (1: none), chosen by the pilot for "auto"
+  LongSegmentChoice long_segment_choice;  // the pilot of "auto" (no candidates: no pilot ran)
   // Damaged records skipped (and a torn tail) when the checkpoint was reopened, and their bytes.
   size_t checkpoint_dropped_records = 0;
   uint64_t checkpoint_dropped_bytes = 0;

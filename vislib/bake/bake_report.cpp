@@ -13,6 +13,32 @@ double kernel_seconds(const BakeReport& r) {
   return kernel;
 }
 
+namespace {
+
+// The L the bake ran and, with --long-segments auto, its pilot (long_segments.h).
+json long_segments_json(const BakeReport& r) {
+  json j = {{"parts", r.long_segments}};
+  const LongSegmentChoice& c = r.long_segment_choice;
+  if (c.candidates.empty()) return j;
+  json candidates = json::array();
+  for (const LongSegmentCandidate& k : c.candidates)
+    candidates.push_back({{"parts", k.parts},
+                          {"runs", k.runs},
+                          {"estimated_work", k.cost},
+                          {"measured_seconds", k.seconds},
+                          {"covered_pairs", k.stats.covered_pairs},
+                          {"triangle_tiles", k.stats.triangle_tiles},
+                          {"bvh_nodes_opened", k.stats.bvh_nodes_opened},
+                          {"final_pieces", k.stats.final_pieces}});
+  j["pilot"] = {{"resolution", c.resolution},
+                {"stretches", c.stretches_sampled},
+                {"seconds", c.seconds},
+                {"candidates", candidates}};
+  return j;
+}
+
+}  // namespace
+
 std::string bake_report_json(const BakeRunInfo& info, const BakeReport& r) {
   const json preset = {{"name", info.preset},
                        {"res", info.resolution},
@@ -28,6 +54,7 @@ std::string bake_report_json(const BakeRunInfo& info, const BakeReport& r) {
       {"baked", r.baked},
       {"resumed", r.resumed},
       {"segment_runs", {{"computed", r.segment_runs_computed}, {"shared", r.segment_runs_shared}}},
+      {"long_segments", long_segments_json(r)},
       {"timings",
        {{"setup_seconds", info.setup_seconds},
         {"bake_seconds", r.seconds},

@@ -15,20 +15,16 @@ SegmentRunCache::Key SegmentRunCache::key_of(Vec3 from, Vec3 to) {
   return k;
 }
 
-void SegmentRunCache::plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segments,
-                                  int max_parts) {
-  chains_.clear();
-  chain_of_.clear();
-  planned_ = 0;
-  if (max_parts < 2) return;
-  max_parts = std::min<int>(max_parts, int(kMaxSplitParts));
+std::vector<std::vector<SegmentEnds>> segments_end_to_end(
+    const std::vector<SegmentEnds>& segments) {
   // Group the axis-parallel segments by line: (axis, the bits of the two other coordinates).
   struct Item {
     double a, b;  // along the axis
-    Vec3 from, to;
+    SegmentEnds s;
   };
   std::map<std::array<uint64_t, 3>, std::vector<Item>> lines;
-  for (const auto& [from, to] : segments) {
+  for (const SegmentEnds& s : segments) {
+    const auto& [from, to] = s;
     int axis = -1, differing = 0;
     for (int i = 0; i < 3; ++i)
       if (from[i] != to[i]) {
@@ -43,40 +39,57 @@ void SegmentRunCache::plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segm
         const double v = from[i];
         std::memcpy(&line[size_t(k++)], &v, sizeof v);
       }
-    lines[line].push_back({from[axis], to[axis], from, to});
+    lines[line].push_back({from[axis], to[axis], s});
   }
+  std::vector<std::vector<SegmentEnds>> out;
   for (auto& [line, items] : lines) {
     std::sort(items.begin(), items.end(),
               [](const Item& p, const Item& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); });
     items.erase(std::unique(items.begin(), items.end(),
                             [](const Item& p, const Item& q) { return p.a == q.a && p.b == q.b; }),
                 items.end());
-    // Maximal runs meeting end to end, cut into chains of at most max_parts from the low end.
-    size_t i = 0;
-    while (i < items.size()) {
-      size_t j = i + 1;
-      while (j < items.size() && j - i < size_t(max_parts) && items[j].a == items[j - 1].b) ++j;
-      if (j - i >= 2) {
-        Chain c;
-        c.from = items[i].from;
-        c.to = items[j - 1].to;
-        const double a = items[i].a, len = items[j - 1].b - a;
-        bool ok = true;
-        for (size_t m = i + 1; m < j; ++m) {
-          double s = (items[m].a - a) / len;
-          ok = ok && s > 0 && s < 1 && (c.splits.empty() || c.splits.back() < s);
-          c.splits.push_back(s);
-        }
-        if (ok) {
-          c.remaining.assign(j - i, 0);
-          for (size_t m = i; m < j; ++m)
-            chain_of_[key_of(items[m].from, items[m].to)] = {uint32_t(chains_.size()),
-                                                             uint32_t(m - i)};
-          chains_.push_back(std::move(c));
-          ++planned_;
-        }
+    for (size_t i = 0, j; i < items.size(); i = j) {  // maximal stretches meeting end to end
+      j = i + 1;
+      while (j < items.size() && items[j].a == items[j - 1].b) ++j;
+      if (j - i < 2) continue;
+      out.emplace_back();
+      for (size_t m = i; m < j; ++m) out.back().push_back(items[m].s);
+    }
+  }
+  return out;
+}
+
+void SegmentRunCache::plan_chains(const std::vector<SegmentEnds>& segments, int max_parts) {
+  chains_.clear();
+  chain_of_.clear();
+  planned_ = 0;
+  if (max_parts < 2) return;
+  max_parts = std::min<int>(max_parts, int(kMaxSplitParts));
+  for (const std::vector<SegmentEnds>& stretch : segments_end_to_end(segments)) {
+    // Cut into chains of at most max_parts from the low end.
+    for (size_t i = 0, j; i < stretch.size(); i = j) {
+      j = std::min(stretch.size(), i + size_t(max_parts));
+      if (j - i < 2) continue;
+      const int axis = stretch[i].first.x != stretch[i].second.x   ? 0
+                       : stretch[i].first.y != stretch[i].second.y ? 1
+                                                                   : 2;
+      Chain c;
+      c.from = stretch[i].first;
+      c.to = stretch[j - 1].second;
+      const double a = c.from[axis], len = c.to[axis] - a;
+      bool ok = true;
+      for (size_t m = i + 1; m < j; ++m) {
+        double s = (stretch[m].first[axis] - a) / len;
+        ok = ok && s > 0 && s < 1 && (c.splits.empty() || c.splits.back() < s);
+        c.splits.push_back(s);
       }
-      i = j;
+      if (!ok) continue;
+      c.remaining.assign(j - i, 0);
+      for (size_t m = i; m < j; ++m)
+        chain_of_[key_of(stretch[m].first, stretch[m].second)] = {uint32_t(chains_.size()),
+                                                                  uint32_t(m - i)};
+      chains_.push_back(std::move(c));
+      ++planned_;
     }
   }
 }
@@ -105,24 +118,49 @@ size_t SegmentRunCache::entries_held() const {
   return held;
 }
 
+std::shared_ptr<SegmentRunCache::Parts> SegmentRunCache::split_parts(SegmentResult whole,
+                                                                     bool split) {
+  auto parts = std::make_shared<Parts>();
+  if (!split) {
+    parts->push_back(std::make_shared<const SegmentResult>(std::move(whole)));
+    return parts;
+  }
+  for (size_t i = 0; i < whole.visible_parts.size(); ++i) {
+    auto part = std::make_shared<SegmentResult>();
+    part->visible = std::move(whole.visible_parts[i]);
+    part->stats = whole.stats;  // the chain's run, shown on every part
+    parts->push_back(std::move(part));
+  }
+  return parts;
+}
+
 std::shared_ptr<SegmentRunCache::Parts> SegmentRunCache::run_chain(const Chain& c,
                                                                    const RunFn& compute) {
-  auto parts = std::make_shared<Parts>();
-  tbb::this_task_arena::isolate([&] {
-    SegmentResult whole = compute(c.from, c.to, c.splits);
-    if (c.splits.empty()) {
-      parts->push_back(std::make_shared<const SegmentResult>(std::move(whole)));
-      return;
-    }
-    for (size_t i = 0; i < whole.visible_parts.size(); ++i) {
-      auto part = std::make_shared<SegmentResult>();
-      part->visible = std::move(whole.visible_parts[i]);
-      part->stats = whole.stats;  // the chain's run, shown on every part
-      parts->push_back(std::move(part));
-    }
-  });
+  std::shared_ptr<Parts> parts;
+  tbb::this_task_arena::isolate(
+      [&] { parts = split_parts(compute(c.from, c.to, c.splits), !c.splits.empty()); });
   computed_.fetch_add(1);
   return parts;
+}
+
+void SegmentRunCache::provide(Vec3 from, Vec3 to, const std::vector<double>& splits,
+                              SegmentResult whole) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const Key key = key_of(from, to);
+  for (Chain& c : chains_) {
+    if (key_of(c.from, c.to) != key || c.splits != splits) continue;
+    bool expected = false;
+    for (uint32_t r : c.remaining) expected = expected || r > 0;
+    const size_t parts = c.splits.empty() ? 0 : c.splits.size() + 1;  // visible_parts of its run
+    if (c.started || !expected || whole.visible_parts.size() != parts) return;
+    std::promise<std::shared_ptr<Parts>> ready;
+    ready.set_value(split_parts(std::move(whole), !c.splits.empty()));
+    c.result = ready.get_future().share();
+    c.started = true;
+    c.provided = true;
+    computed_.fetch_add(1);
+    return;
+  }
 }
 
 std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, const RunFn& compute,
@@ -146,6 +184,8 @@ std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, co
     return (*run_chain(c, compute))[part];
   }
   const bool first = !c.started;
+  const bool claims = c.provided;  // the first use of a provided run counts as computing it
+  c.provided = false;
   std::promise<std::shared_ptr<Parts>> promise;
   if (first) {
     c.started = true;
@@ -153,14 +193,14 @@ std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, co
   }
   auto future = c.result;
   lock.unlock();
-  if (computed) *computed = first;
+  if (computed) *computed = first || claims;
   if (first) {
     try {
       promise.set_value(run_chain(c, compute));
     } catch (...) {
       promise.set_exception(std::current_exception());
     }
-  } else {
+  } else if (!claims) {
     shared_.fetch_add(1);
   }
   std::shared_ptr<Parts> parts;

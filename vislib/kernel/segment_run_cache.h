@@ -33,6 +33,14 @@
 
 namespace vislib {
 
+// A segment as (from, to).
+using SegmentEnds = std::pair<Vec3, Vec3>;
+
+// The maximal stretches of two or more of `segments` that meet end to end bit for bit along one
+// axis (from and to differ in that coordinate only, from < to), each from its low end; duplicates
+// count once. In a fixed order (by line, then along it), whatever the order of `segments`.
+std::vector<std::vector<SegmentEnds>> segments_end_to_end(const std::vector<SegmentEnds>& segments);
+
 class SegmentRunCache {
  public:
   // Computes the world-aligned run on (from, to), split at `splits` when not empty.
@@ -43,7 +51,7 @@ class SegmentRunCache {
   // at most `max_parts` (<= kMaxSplitParts) segments from the chain's low end. Pass every segment
   // the bake could ask for, not only those it will compute, so that the plan (hence the sets)
   // does not depend on the shard or on a resumed checkpoint. Call before expect().
-  void plan_chains(const std::vector<std::pair<Vec3, Vec3>>& segments, int max_parts);
+  void plan_chains(const std::vector<SegmentEnds>& segments, int max_parts);
 
   // Registers one future get() of the world-aligned run on (from, to). Not thread-safe with get().
   void expect(Vec3 from, Vec3 to);
@@ -56,6 +64,13 @@ class SegmentRunCache {
   // exception from compute() reaches every caller.
   std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to, const RunFn& compute,
                                            bool* computed = nullptr);
+
+  // Hands the cache a run computed elsewhere (the pilot of --long-segments auto): `whole`, the
+  // result of compute(from, to, splits), for the planned chain from `from` to `to` with these
+  // splits, or for one announced segment (splits empty). Its first get() takes it as its own
+  // computation (`*computed` true). Nothing is kept when no chain matches bit for bit, when it
+  // has started, or when no use of it is expected. Call after expect(), before any get().
+  void provide(Vec3 from, Vec3 to, const std::vector<double>& splits, SegmentResult whole);
 
   uint64_t runs_computed() const { return computed_.load(); }
   uint64_t runs_shared() const { return shared_.load(); }  // get() calls served from the cache
@@ -73,6 +88,7 @@ class SegmentRunCache {
     std::vector<double> splits;       // the junctions' parameters on from -> to
     std::vector<uint32_t> remaining;  // per part: expected get() calls still to come
     bool started = false;
+    bool provided = false;  // result given by provide(), not yet claimed by a get()
     // The parts; a part is released after its last expected use (the mutex guards the vector).
     std::shared_future<std::shared_ptr<Parts>> result;
   };
@@ -80,6 +96,7 @@ class SegmentRunCache {
     uint32_t chain, part;
   };
   std::shared_ptr<Parts> run_chain(const Chain& c, const RunFn& compute);
+  static std::shared_ptr<Parts> split_parts(SegmentResult whole, bool split);
 
   mutable std::mutex mutex_;
   std::vector<Chain> chains_;
