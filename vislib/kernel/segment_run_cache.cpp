@@ -135,10 +135,17 @@ std::shared_ptr<SegmentRunCache::Parts> SegmentRunCache::split_parts(SegmentResu
 }
 
 std::shared_ptr<SegmentRunCache::Parts> SegmentRunCache::run_chain(const Chain& c,
-                                                                   const RunFn& compute) {
+                                                                   const RunFn& compute,
+                                                                   bool isolated) {
   std::shared_ptr<Parts> parts;
-  tbb::this_task_arena::isolate(
-      [&] { parts = split_parts(compute(c.from, c.to, c.splits), !c.splits.empty()); });
+  auto run = [&] { parts = split_parts(compute(c.from, c.to, c.splits), !c.splits.empty()); };
+  // Isolated, the computing thread never picks up a task that would wait for an entry it holds.
+  // Inside collaborative_call_once the call is isolated already, with a tag its waiting callers
+  // share: a nested isolate would keep them from the run's tiles.
+  if (isolated)
+    tbb::this_task_arena::isolate(run);
+  else
+    run();
   computed_.fetch_add(1);
   return parts;
 }
@@ -153,9 +160,8 @@ void SegmentRunCache::provide(Vec3 from, Vec3 to, const std::vector<double>& spl
     for (uint32_t r : c.remaining) expected = expected || r > 0;
     const size_t parts = c.splits.empty() ? 0 : c.splits.size() + 1;  // visible_parts of its run
     if (c.started || !expected || whole.visible_parts.size() != parts) return;
-    std::promise<std::shared_ptr<Parts>> ready;
-    ready.set_value(split_parts(std::move(whole), !c.splits.empty()));
-    c.result = ready.get_future().share();
+    tbb::collaborative_call_once(
+        *c.once, [&] { c.parts = split_parts(std::move(whole), !c.splits.empty()); });
     c.started = true;
     c.provided = true;
     computed_.fetch_add(1);
@@ -183,41 +189,31 @@ std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, co
     lock.unlock();
     return (*run_chain(c, compute))[part];
   }
-  const bool first = !c.started;
   const bool claims = c.provided;  // the first use of a provided run counts as computing it
   c.provided = false;
-  std::promise<std::shared_ptr<Parts>> promise;
-  if (first) {
-    c.started = true;
-    c.result = promise.get_future().share();
-  }
-  auto future = c.result;
+  c.started = true;
   lock.unlock();
-  if (computed) *computed = first || claims;
-  if (first) {
+  // The first caller computes; callers that arrive meanwhile work on the same run's tiles (the
+  // kernel is TBB-parallel inside) and see its parts, or its error, once it is done.
+  bool ran = false;
+  tbb::collaborative_call_once(*c.once, [&] {
+    ran = true;
     try {
-      promise.set_value(run_chain(c, compute));
+      c.parts = run_chain(c, compute, /*isolated=*/false);
     } catch (...) {
-      promise.set_exception(std::current_exception());
+      c.error = std::current_exception();
     }
-  } else if (!claims) {
-    shared_.fetch_add(1);
-  }
-  std::shared_ptr<Parts> parts;
-  try {
-    parts = future.get();
-  } catch (...) {
-    lock.lock();
-    if (c.remaining[part] > 0) --c.remaining[part];
-    throw;
-  }
+  });
+  if (computed) *computed = ran || claims;
+  if (!ran && !claims) shared_.fetch_add(1);
   lock.lock();
-  std::shared_ptr<const SegmentResult> mine = (*parts)[part];
-  if (c.remaining[part] > 0 && --c.remaining[part] == 0)
-    (*parts)[part].reset();  // its last use: release it
+  const bool last = c.remaining[part] > 0 && --c.remaining[part] == 0;
+  if (c.error) std::rethrow_exception(c.error);
+  std::shared_ptr<const SegmentResult> mine = (*c.parts)[part];
+  if (last) (*c.parts)[part].reset();  // its last use: release it
   bool done = true;
   for (uint32_t r : c.remaining) done = done && r == 0;
-  if (done) c.result = {};
+  if (done) c.parts.reset();
   if (!mine) {
     // Released by a concurrent use beyond those announced: run it again for this one.
     lock.unlock();

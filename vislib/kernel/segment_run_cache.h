@@ -18,11 +18,13 @@
 // cell order, about one row of cells; with chains, up to max_parts rows of the edges across rows).
 #pragma once
 
+#include <tbb/collaborative_call_once.h>
+
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <exception>
 #include <functional>
-#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -56,12 +58,12 @@ class SegmentRunCache {
   // Registers one future get() of the world-aligned run on (from, to). Not thread-safe with get().
   void expect(Vec3 from, Vec3 to);
 
-  // The result of the world-aligned run on (from, to): `compute` runs on the first call (inside
-  // a TBB isolated region, so that the computing thread never picks up a task that waits for this
-  // very entry), concurrent callers for the same segment wait for it, later callers get the stored
-  // result. A segment of a planned chain gets its part of the chain's run. `*computed` says
-  // whether this call ran compute(). A use that was not announced is computed and not stored. An
-  // exception from compute() reaches every caller.
+  // The result of the world-aligned run on (from, to): `compute` runs on the first call
+  // (tbb::collaborative_call_once: isolated, so that the computing thread never picks up a task
+  // that waits for this very entry; concurrent callers for the same run join its parallel work
+  // instead of waiting idle), later callers get the stored result. A segment of a planned chain
+  // gets its part of the chain's run. `*computed` says whether this call ran compute(). A use that
+  // was not announced is computed and not stored. An exception from compute() reaches every caller.
   std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to, const RunFn& compute,
                                            bool* computed = nullptr);
 
@@ -87,15 +89,20 @@ class SegmentRunCache {
     Vec3 from, to;
     std::vector<double> splits;       // the junctions' parameters on from -> to
     std::vector<uint32_t> remaining;  // per part: expected get() calls still to come
-    bool started = false;
-    bool provided = false;  // result given by provide(), not yet claimed by a get()
-    // The parts; a part is released after its last expected use (the mutex guards the vector).
-    std::shared_future<std::shared_ptr<Parts>> result;
+    bool started = false;             // a get() or provide() has begun computing or setting it
+    bool provided = false;            // result given by provide(), not yet claimed by a get()
+    // Set once (tbb::collaborative_call_once: callers that arrive while the first computes join
+    // its tiles instead of waiting idle), with the parts or the error of compute(). A part is
+    // released after its last expected use (the mutex guards the vector).
+    std::unique_ptr<tbb::collaborative_once_flag> once =
+        std::make_unique<tbb::collaborative_once_flag>();
+    std::shared_ptr<Parts> parts;
+    std::exception_ptr error;
   };
   struct ChainRef {
     uint32_t chain, part;
   };
-  std::shared_ptr<Parts> run_chain(const Chain& c, const RunFn& compute);
+  std::shared_ptr<Parts> run_chain(const Chain& c, const RunFn& compute, bool isolated = true);
   static std::shared_ptr<Parts> split_parts(SegmentResult whole, bool split);
 
   mutable std::mutex mutex_;
