@@ -131,14 +131,11 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
                  cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
                  scene.triangle_count(), shard.index, shard.count);
   const vislib::BakeSettings settings = settings_of(a);
-  if (settings.long_segments == 0 && show_progress()) {
-    vislib::BakeSettings probe = settings;
-    probe.long_segments = 2;
-    if (vislib::uses_long_segments(scene, probe))
-      std::fprintf(stderr,
-                   "pvs bake: --long-segments auto: a pilot runs a few rows of cell edges with "
-                   "L = 1, 2, 4 and 8 and counts the kernel's work\n");
-  }
+  if (settings.long_segments == 0 && show_progress() &&
+      vislib::long_segments_apply(scene, settings))
+    std::fprintf(stderr,
+                 "pvs bake: --long-segments auto: a pilot runs a few rows of cell edges with "
+                 "L = 1, 2, 4 and 8 and counts the kernel's work\n");
   vislib::BakeFiles files{a.output, checkpoint, a.resume, /*lock=*/false};
   const vislib::BakeReport r =
       vislib::bake(scene, cells, settings, shard, files, progress_printer());

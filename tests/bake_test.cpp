@@ -579,12 +579,21 @@ TEST(SegmentRunCache, ChainsOfEdgesEndToEndRunOnceAndHandEachEdgeItsPart) {
   EXPECT_EQ(cache.entries_held(), 0u);
 }
 
-TEST(BakeLongSegments, SetsEqualBakingEachCellAloneWithFarFewerRuns) {
-  const Scene scene = small_city();
-  const ViewCells cells = city_grid(32, 8, 8, EyeBand{1.5, 1.75});
+// An 8 x 8 grid of 8 m cells over the small city, N = 16, for the long-segment bakes.
+ViewCells long_grid() {
+  return city_grid(32, 8, 8, EyeBand{1.5, 1.75});
+}
+BakeSettings long_settings(int long_segments) {
   BakeSettings s;
   s.region.segment.resolution = 16;
-  s.long_segments = 4;
+  s.long_segments = long_segments;
+  return s;
+}
+
+TEST(BakeLongSegments, SetsEqualBakingEachCellAloneWithFarFewerRuns) {
+  const Scene scene = small_city();
+  const ViewCells cells = long_grid();
+  const BakeSettings s = long_settings(4);
   const std::string dir = temp_dir("bake_long_segments");
   tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
   const BakeReport r = bake(scene, cells, s, {}, {dir + "/long.pvs", "", false});
@@ -683,10 +692,8 @@ TEST(LongSegmentChoice, ChainsSmallCellsOfALargeCityAndNotLargeCellsOfASmallOne)
 
 TEST(BakeLongSegmentsAuto, GivesTheBytesOfTheChosenLengthOnEveryShardAndThreadCount) {
   const Scene scene = small_city();
-  const ViewCells cells = city_grid(32, 8, 8, EyeBand{1.5, 1.75});
-  BakeSettings s;
-  s.region.segment.resolution = 16;
-  s.long_segments = 0;
+  const ViewCells cells = long_grid();
+  const BakeSettings s = long_settings(0);  // auto
   const std::string dir = temp_dir("bake_long_auto");
   const BakeReport r = bake(scene, cells, s, {}, {dir + "/auto.pvs", "", false});
   ASSERT_GE(r.long_segment_choice.candidates.size(), 2u);

@@ -52,9 +52,13 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
   return info;
 }
 
+bool long_segments_apply(const Scene& scene, const BakeSettings& settings) {
+  return settings.share_segments && !scene.is_dynamic() && scene.sphere_count() == 0 &&
+         !settings.region.segment.want_witnesses;
+}
+
 bool uses_long_segments(const Scene& scene, const BakeSettings& settings) {
-  return settings.share_segments && settings.long_segments > 1 && !scene.is_dynamic() &&
-         scene.sphere_count() == 0 && !settings.region.segment.want_witnesses;
+  return settings.long_segments > 1 && long_segments_apply(scene, settings);
 }
 
 uint64_t bake_key(const pvs::FileInfo& info, Shard shard) {
@@ -117,10 +121,8 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   // so that every shard and every resumed run chooses the same L (long_segments.h).
   BakeSettings settings = requested;
   if (settings.long_segments == 0) {
-    settings.long_segments = 2;
-    const bool applies = uses_long_segments(scene, settings);
     settings.long_segments = 1;
-    if (applies) {
+    if (long_segments_apply(scene, settings)) {
       SegmentOptions run0 = settings.region.segment;
       run0.bvh = bvh;
       report.long_segment_choice = choose_long_segments(scene, all_edges(cells.layout), run0);

@@ -42,7 +42,10 @@ struct BakeSettings {
   bool bvh = true;
 };
 
-// Whether `settings` run long segments on `scene` (long_segments > 1 applies).
+// Whether long segments can run on `scene` with `settings`, whatever long_segments says (shared
+// edges, a static scene without spheres, no witnesses).
+bool long_segments_apply(const Scene& scene, const BakeSettings& settings);
+// Whether `settings` run long segments on `scene`: long_segments > 1 and they apply.
 bool uses_long_segments(const Scene& scene, const BakeSettings& settings);
 
 // Shard `index` of `count` bakes the cells c with c % count == index (round robin, so each shard

@@ -79,10 +79,7 @@ LongSegmentChoice choose_long_segments(const Scene& scene, const std::vector<Seg
       for (size_t i = 0, j; i < stretch.size(); i = j) {
         j = std::min(stretch.size(), i + size_t(parts));
         const Vec3 from = stretch[i].first, to = stretch[j - 1].second;
-        o.splits.clear();
-        const int axis = from.x != to.x ? 0 : from.y != to.y ? 1 : 2;
-        for (size_t m = i + 1; m < j; ++m)
-          o.splits.push_back((stretch[m].first[axis] - from[axis]) / (to[axis] - from[axis]));
+        o.splits = chain_splits(stretch, i, j);
         SegmentResult r = segment_visibility(scene, from, to, o);
         c.stats.add(r.stats);
         ++c.runs;

@@ -59,6 +59,15 @@ std::vector<std::vector<SegmentEnds>> segments_end_to_end(
   return out;
 }
 
+std::vector<double> chain_splits(const std::vector<SegmentEnds>& stretch, size_t i, size_t j) {
+  const Vec3 from = stretch[i].first, to = stretch[j - 1].second;
+  const int axis = from.x != to.x ? 0 : from.y != to.y ? 1 : 2;
+  const double a = from[axis], len = to[axis] - a;
+  std::vector<double> splits;
+  for (size_t m = i + 1; m < j; ++m) splits.push_back((stretch[m].first[axis] - a) / len);
+  return splits;
+}
+
 void SegmentRunCache::plan_chains(const std::vector<SegmentEnds>& segments, int max_parts) {
   chains_.clear();
   chain_of_.clear();
@@ -70,19 +79,13 @@ void SegmentRunCache::plan_chains(const std::vector<SegmentEnds>& segments, int 
     for (size_t i = 0, j; i < stretch.size(); i = j) {
       j = std::min(stretch.size(), i + size_t(max_parts));
       if (j - i < 2) continue;
-      const int axis = stretch[i].first.x != stretch[i].second.x   ? 0
-                       : stretch[i].first.y != stretch[i].second.y ? 1
-                                                                   : 2;
       Chain c;
       c.from = stretch[i].first;
       c.to = stretch[j - 1].second;
-      const double a = c.from[axis], len = c.to[axis] - a;
+      c.splits = chain_splits(stretch, i, j);
       bool ok = true;
-      for (size_t m = i + 1; m < j; ++m) {
-        double s = (stretch[m].first[axis] - a) / len;
-        ok = ok && s > 0 && s < 1 && (c.splits.empty() || c.splits.back() < s);
-        c.splits.push_back(s);
-      }
+      for (size_t m = 0; m < c.splits.size(); ++m)
+        ok = ok && c.splits[m] > 0 && c.splits[m] < 1 && (m == 0 || c.splits[m - 1] < c.splits[m]);
       if (!ok) continue;
       c.remaining.assign(j - i, 0);
       for (size_t m = i; m < j; ++m)

@@ -43,6 +43,11 @@ using SegmentEnds = std::pair<Vec3, Vec3>;
 // count once. In a fixed order (by line, then along it), whatever the order of `segments`.
 std::vector<std::vector<SegmentEnds>> segments_end_to_end(const std::vector<SegmentEnds>& segments);
 
+// The split points of the chain stretch[i, j) (j - i >= 1): the parameters of its inner
+// junctions on stretch[i].first -> stretch[j - 1].second, ascending, as plan_chains gives them
+// (a run handed to provide() must carry these very bits).
+std::vector<double> chain_splits(const std::vector<SegmentEnds>& stretch, size_t i, size_t j);
+
 class SegmentRunCache {
  public:
   // Computes the world-aligned run on (from, to), split at `splits` when not empty.
