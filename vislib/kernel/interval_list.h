@@ -352,7 +352,12 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
     if (id != tr.front) return;
     const double a = std::max(tr.t0, t0), b = std::min(tr.t1, t1);
     if (!(a < b) || known(tr.hidden, a, b)) return;
-    added.push_back({tr.hidden, a, b});
+    // Field by field: a braced temporary is built on the stack in two stores and copied with
+    // one wider load, which stalls (store forwarding; 3% of the 2 m street's run).
+    Stretch& s = added.emplace_back();
+    s.id = tr.hidden;
+    s.t0 = a;
+    s.t1 = b;
     f(tr.hidden, a, b);
   };
   for (const TieRecord& tr : ties) {
@@ -360,14 +365,11 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
     while (e < list.size() && !(tr.t0 < list[e].t1)) ++e;
     for (; e < list.size() && list[e].t0 < tr.t1; ++e) meet(tr, list[e].id, list[e].t0, list[e].t1);
   }
-  for (size_t done = 0; done < added.size();) {  // then the stretches each round added
-    const size_t n = added.size();
-    for (const TieRecord& tr : ties)
-      for (size_t e = done; e < n; ++e) {
-        const Stretch v = added[e];  // a copy: meet() may grow `added`
-        meet(tr, v.id, v.t0, v.t1);
-      }
-    done = n;
+  // Then each added stretch meets every record (the closure is the same in any order, and so
+  // are the marks its callers make: their reductions are order-free).
+  for (size_t e = 0; e < added.size(); ++e) {
+    const Stretch v = added[e];  // a copy: meet() may grow `added`
+    for (const TieRecord& tr : ties) meet(tr, v.id, v.t0, v.t1);
   }
 }
 
