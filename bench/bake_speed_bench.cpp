@@ -155,7 +155,10 @@ int main(int argc, char** argv) {
                     r.long_segment_choice.stretches_sampled, r.long_segment_choice.resolution,
                     r.long_segment_choice.seconds);
         for (const LongSegmentCandidate& lc : r.long_segment_choice.candidates)
-          std::printf(" L=%d %.3g s (work %.3g)", lc.parts, lc.seconds, lc.cost);
+          std::printf(" L=%d %.3g s (work %.3g: pairs %.3g, tiles %.3g, nodes %.3g, bounded %.3g)",
+                      lc.parts, lc.seconds, lc.cost, double(lc.stats.covered_pairs),
+                      double(lc.stats.triangle_tiles), double(lc.stats.bvh_nodes_opened),
+                      double(lc.stats.primitives_bounded));
         std::printf("\n");
       }
       std::fflush(stdout);

@@ -124,6 +124,7 @@ json counts_json(const vislib::SegmentStats& s) {
           {"triangle_tiles", s.triangle_tiles},
           {"culled_triangle_tiles", s.culled_triangle_tiles},
           {"bvh_nodes_opened", s.bvh_nodes_opened},
+          {"primitives_bounded", s.primitives_bounded},
           {"peak_tile_bytes", s.peak_tile_bytes}};
 }
 

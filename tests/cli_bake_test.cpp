@@ -417,7 +417,8 @@ TEST(CliBake, LongSegmentsAutoReportsItsPilotAndBakesTheChosenLength) {
     EXPECT_GT(c["covered_pairs"].get<double>(), 0) << c;
     EXPECT_EQ(c["estimated_work"].get<double>(), c["covered_pairs"].get<double>() +
                                                      4 * c["triangle_tiles"].get<double>() +
-                                                     6 * c["bvh_nodes_opened"].get<double>())
+                                                     6 * c["bvh_nodes_opened"].get<double>() +
+                                                     0.4 * c["primitives_bounded"].get<double>())
         << c;
   }
   ASSERT_EQ(
@@ -448,6 +449,10 @@ TEST(CliBake, TheBvhWalkGivesTheSameFileAndTheSameSets) {
     sets[on] = j["visible"].dump() + j["witnesses"].dump();
     EXPECT_EQ(j["timings"]["bvh_seconds"].get<double>() > 0, on == 1);
     EXPECT_EQ(j["counts"]["bvh_nodes_opened"].get<uint64_t>() > 0, on == 1);
+    // Without the tree every triangle is bounded on each of the six faces (the count the
+    // long-segment pilot weighs, long_segments.cpp).
+    EXPECT_EQ(j["counts"]["primitives_bounded"].get<uint64_t>(),
+              on ? 0u : 6 * j["counts"]["scene_triangles"].get<uint64_t>());
   }
   EXPECT_EQ(sets[0], sets[1]);
   EXPECT_GT(sets[0].size(), 100u);

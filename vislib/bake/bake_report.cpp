@@ -29,6 +29,7 @@ json long_segments_json(const BakeReport& r) {
                           {"covered_pairs", k.stats.covered_pairs},
                           {"triangle_tiles", k.stats.triangle_tiles},
                           {"bvh_nodes_opened", k.stats.bvh_nodes_opened},
+                          {"primitives_bounded", k.stats.primitives_bounded},
                           {"final_pieces", k.stats.final_pieces}});
   j["pilot"] = {{"resolution", c.resolution},
                 {"stretches", c.stretches_sampled},

@@ -52,7 +52,8 @@ struct LongSegmentChoice {
 };
 
 // The estimated work of kernel runs with these counts, in covered-pair equivalents: covered
-// pairs + 4 (triangle, tile) pairs + 6 BVH nodes opened (long_segments.cpp).
+// pairs + 4 (triangle, tile) pairs + 6 BVH nodes opened + 0.4 (triangle, face) pairs of the
+// per-face pass that runs without a BVH (long_segments.cpp).
 double estimated_work(const SegmentStats& stats);
 
 // The longest candidate L whose cost is below 0.95 times that of every shorter candidate

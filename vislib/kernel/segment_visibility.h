@@ -94,8 +94,9 @@ struct SegmentStats {
   uint64_t triangle_tiles = 0;         // (triangle, tile) pairs binned
   uint64_t culled_triangle_tiles = 0;  // of which skipped by depth culling
   uint64_t bvh_nodes_opened = 0;       // with a BVH: (node, tile) pairs whose children were read
-  double peak_tile_bytes = 0;          // largest memory held by one tile's pixel lists
-  double seconds = 0;                  // wall time of the call
+  uint64_t primitives_bounded = 0;  // without a BVH: (primitive, face) pairs of the per-face pass
+  double peak_tile_bytes = 0;       // largest memory held by one tile's pixel lists
+  double seconds = 0;               // wall time of the call
   // Adds another part's counts (maxima for the max fields).
   void add(const SegmentStats& o) {
     pair_tests += o.pair_tests;
@@ -109,6 +110,7 @@ struct SegmentStats {
     triangle_tiles += o.triangle_tiles;
     culled_triangle_tiles += o.culled_triangle_tiles;
     bvh_nodes_opened += o.bvh_nodes_opened;
+    primitives_bounded += o.primitives_bounded;
     peak_tile_bytes = peak_tile_bytes > o.peak_tile_bytes ? peak_tile_bytes : o.peak_tile_bytes;
   }
   double pieces_per_pixel() const {
