@@ -292,12 +292,16 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
       ++i;
     }
     if (cur < f) detail::push(out, p, cur, f);
-    size_t removed = i - first;
-    if (out.size() > removed)
-      list.insert(list.begin() + i, out.size() - removed, PieceT<D>{});
-    else
-      list.erase(list.begin() + first + out.size(), list.begin() + i);
-    std::copy(out.begin(), out.end(), list.begin() + first);
+    // list[first, i) becomes `out`: overwrite what fits, then insert the rest (each piece written
+    // once) or erase what is left over.
+    const size_t removed = i - first;
+    if (out.size() > removed) {
+      std::copy(out.begin(), out.begin() + long(removed), list.begin() + long(first));
+      list.insert(list.begin() + long(i), out.begin() + long(removed), out.end());
+    } else {
+      std::copy(out.begin(), out.end(), list.begin() + long(first));
+      list.erase(list.begin() + long(first + out.size()), list.begin() + long(i));
+    }
     count = out.size();
   }
   // `push` merged inside the new range; merge across its two ends (higher index first).
