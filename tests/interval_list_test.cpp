@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <tuple>
 #include <vector>
 
 #include "vislib/base/random.h"
@@ -194,4 +195,23 @@ TEST(IntervalList, DivisionFreeDecisionsAgreeWithTheQuotients) {
   EXPECT_GT(decided_cross, 100000);
   EXPECT_GT(decided_tie, 50000);
   EXPECT_GT(undecided, 100);  // the constructed near-ties do reach the fallback
+}
+
+// The tie closure reports each stretch once, also when one is reached twice and begins where a
+// different piece of the list begins: 3 is tied behind 1 directly, and behind 4 (itself tied
+// behind 1) over the same stretch [0, 0.5) that piece 1 starts at.
+TEST(IntervalList, TieClosureReportsAStretchReachedTwiceOnce) {
+  PieceList list{Piece{0.0, 0.5, 1, line(1, 0)}, Piece{0.5, 1.0, 2, line(1, 0)}};
+  std::vector<TieRecord> ties{{0.0, 0.5, 4, 1}, {0.0, 0.5, 3, 4}, {0.0, 0.5, 3, 1}};
+  for (int order = 0; order < 2; ++order) {
+    std::vector<std::tuple<uint32_t, double, double>> seen;
+    for_each_visible(list, ties,
+                     [&](uint32_t id, double t0, double t1) { seen.emplace_back(id, t0, t1); });
+    std::sort(seen.begin(), seen.end());
+    using S = std::tuple<uint32_t, double, double>;
+    EXPECT_EQ(seen,
+              (std::vector<S>{S{1, 0.0, 0.5}, S{2, 0.5, 1.0}, S{3, 0.0, 0.5}, S{4, 0.0, 0.5}}))
+        << "order " << order;
+    std::reverse(ties.begin(), ties.end());
+  }
 }

@@ -344,9 +344,12 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
   thread_local std::vector<Stretch> added;
   added.clear();
   auto known = [&](uint32_t id, double a, double b) {
-    for (const PieceT<D>& p : list) {
+    for (const PieceT<D>& p : list) {  // only one piece can start at a (they are disjoint)
       if (p.t0 > a) break;
-      if (p.t0 == a) return p.id == id && p.t1 == b;
+      if (p.t0 == a) {
+        if (p.id == id && p.t1 == b) return true;
+        break;  // (and the same stretch may have been added: not reported twice)
+      }
     }
     for (const Stretch& v : added)
       if (v.id == id && v.t0 == a && v.t1 == b) return true;
@@ -370,8 +373,13 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
     for (; e < list.size() && list[e].t0 < tr.t1; ++e) meet(tr, list[e].id, list[e].t0, list[e].t1);
   }
   // Then each added stretch meets every record (the closure is the same in any order, and so
-  // are the marks its callers make: their reductions are order-free).
+  // are the marks its callers make: their reductions are order-free). Most added stretches are
+  // in front of no record (measured on the 20 m street: 11.7 added stretches and 12 records per
+  // pixel with ties, 750K such pixels); a bit per id modulo 64 finds those without the records.
+  uint64_t fronts = 0;
+  for (const TieRecord& tr : ties) fronts |= uint64_t(1) << (tr.front & 63u);
   for (size_t e = 0; e < added.size(); ++e) {
+    if (!(fronts >> (added[e].id & 63u) & 1u)) continue;
     const Stretch v = added[e];  // a copy: meet() may grow `added`
     for (const TieRecord& tr : ties) meet(tr, v.id, v.t0, v.t1);
   }
