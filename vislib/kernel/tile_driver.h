@@ -386,7 +386,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                             zmin[p] = round_down_to_float(z);
                           }
                         });
-      // Counted on the face's first tile (a count per run, as the pass is per run).
+      // The pass above bounded every primitive: counted once per face, in its first tile's stats.
       tile_stats[size_t(face) * size_t(tile_count)].primitives_bounded += count;
       // (2) bin by tile (counting sort, in id order).
       bin_by_tile(bbox, count, TS, tiles_x, bin_start, bins, [&](size_t p) {
