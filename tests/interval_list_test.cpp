@@ -215,3 +215,23 @@ TEST(IntervalList, TieClosureReportsAStretchReachedTwiceOnce) {
     std::reverse(ties.begin(), ties.end());
   }
 }
+
+// A caller that keeps only marks can say which ids are settled (already marked): records that hide
+// a settled id are skipped, unless that id is in front in another record (the closure still needs
+// its stretches to reach the ids tied behind it).
+TEST(IntervalList, TieClosureSkipsSettledIdsButStillFollowsThemToOthers) {
+  PieceList list{Piece{0.0, 0.5, 1, line(1, 0)}, Piece{0.5, 1.0, 2, line(1, 0)}};
+  const std::vector<TieRecord> ties{{0.0, 0.5, 4, 1}, {0.0, 0.5, 3, 4}, {0.5, 1.0, 5, 2}};
+  auto ids = [&](auto settled) {
+    std::vector<uint32_t> seen;
+    for_each_visible(
+        list, ties, [&](uint32_t id, double, double) { seen.push_back(id); }, settled);
+    std::sort(seen.begin(), seen.end());
+    return seen;
+  };
+  EXPECT_EQ(ids([](uint32_t) { return false; }), (std::vector<uint32_t>{1, 2, 3, 4, 5}));
+  // 4 is settled but in front of 3: followed, so 3 is still reported.
+  EXPECT_EQ(ids([](uint32_t id) { return id == 4; }), (std::vector<uint32_t>{1, 2, 3, 4, 5}));
+  // 3 and 5 are settled and in front of nothing: their records are skipped.
+  EXPECT_EQ(ids([](uint32_t id) { return id == 3 || id == 5; }), (std::vector<uint32_t>{1, 2, 4}));
+}

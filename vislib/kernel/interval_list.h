@@ -329,8 +329,12 @@ std::optional<PieceT<D>> lookup(const std::vector<PieceT<D>>& list, double t) {
 // the tie records `ties` of that list: a record (hidden, front, [a, b)) makes `hidden` visible
 // over [a, b) intersected with each stretch where `front` is visible, transitively (three coplanar
 // copies: each is visible). Stretches are reported once each (exact duplicates skipped).
-template <class D, class F>
-void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieRecord>& ties, F f) {
+// `settled(id)` (optional) tells that reporting any stretch of `id` would change nothing for the
+// caller (its mark is set and it keeps no witness): a record that hides such an id behind another,
+// and whose hidden id is in front in no record, is then skipped whole, as it can add nothing.
+template <class D, class F, class Settled>
+void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieRecord>& ties, F f,
+                      Settled settled) {
   for (const PieceT<D>& p : list) f(p.id, p.t0, p.t1);
   if (ties.empty()) return;
   struct Stretch {
@@ -367,7 +371,14 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
     s.t1 = b;
     f(tr.hidden, a, b);
   };
+  // The records' front ids, a bit per id modulo 64 (a set bit may be another id's).
+  uint64_t fronts = 0;
+  for (const TieRecord& tr : ties) fronts |= uint64_t(1) << (tr.front & 63u);
+  auto skipped = [&](const TieRecord& tr) {
+    return !(fronts >> (tr.hidden & 63u) & 1u) && settled(tr.hidden);
+  };
   for (const TieRecord& tr : ties) {
+    if (skipped(tr)) continue;
     size_t e = 0;
     while (e < list.size() && !(tr.t0 < list[e].t1)) ++e;
     for (; e < list.size() && list[e].t0 < tr.t1; ++e) meet(tr, list[e].id, list[e].t0, list[e].t1);
@@ -375,14 +386,19 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
   // Then each added stretch meets every record (the closure is the same in any order, and so
   // are the marks its callers make: their reductions are order-free). Most added stretches are
   // in front of no record (measured on the 20 m street: 11.7 added stretches and 12 records per
-  // pixel with ties, 750K such pixels); a bit per id modulo 64 finds those without the records.
-  uint64_t fronts = 0;
-  for (const TieRecord& tr : ties) fronts |= uint64_t(1) << (tr.front & 63u);
+  // pixel with ties, 750K such pixels); the bits of the front ids find those without the records.
   for (size_t e = 0; e < added.size(); ++e) {
     if (!(fronts >> (added[e].id & 63u) & 1u)) continue;
     const Stretch v = added[e];  // a copy: meet() may grow `added`
-    for (const TieRecord& tr : ties) meet(tr, v.id, v.t0, v.t1);
+    for (const TieRecord& tr : ties)
+      if (tr.front == v.id && !skipped(tr)) meet(tr, v.id, v.t0, v.t1);
   }
+}
+
+// for_each_visible reporting every stretch (nothing settled).
+template <class D, class F>
+void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieRecord>& ties, F f) {
+  for_each_visible(list, ties, f, [](uint32_t) { return false; });
 }
 
 // True when the pieces cover [0, 1] without gap.

@@ -555,21 +555,25 @@ class StaticKind {
       return;
     }
     const bool witnesses = !found.witness_len.empty();
-    for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
-      double len = t1 - t0;
-      if (!(len > opt_.eps_len)) return;
-      if (!witnesses) {  // the mark alone (no witness to build and compare)
-        found.seen[id] = 1;
-        return;
-      }
-      Witness w;
-      w.tri = id;
-      w.face = face;
-      w.x = x;
-      w.y = y;
-      w.t = 0.5 * (t0 + t1);
-      found.mark(id, len, w);
-    });
+    auto settled = [&](uint32_t id) { return !witnesses && found.seen[id] != 0; };
+    for_each_visible(
+        l, sc.ties[k],
+        [&](uint32_t id, double t0, double t1) {
+          double len = t1 - t0;
+          if (!(len > opt_.eps_len)) return;
+          if (!witnesses) {  // the mark alone (no witness to build and compare)
+            found.seen[id] = 1;
+            return;
+          }
+          Witness w;
+          w.tri = id;
+          w.face = face;
+          w.x = x;
+          w.y = y;
+          w.t = 0.5 * (t0 + t1);
+          found.mark(id, len, w);
+        },
+        settled);
     const int N = opt_.resolution;
     if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
   }
