@@ -1,6 +1,7 @@
 // The speed work of issue 13 must not change any result: footprint bounds without the hull, the
 // per-pixel depth envelope, and the vectorised coverage are checked against the plain paths.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstring>
@@ -143,6 +144,35 @@ TEST(KernelSpeed, DepthEnvelopeSkipsHiddenIntervalsAndChangesNoPiece) {
   EXPECT_GT(with.stats.hidden_pairs, 0u);
   EXPECT_EQ(without.stats.hidden_pairs, 0u);
   EXPECT_LT(with.stats.pair_tests, without.stats.pair_tests);
+}
+
+// Without witnesses the tie closure skips the records that can only mark an id already marked
+// (for_each_visible's `settled`): the visible set is still the witness run's, on a soup where every
+// triangle has a coplanar copy (every covered pixel has ties) and some copies are chained three
+// deep, on one thread and on all.
+TEST(KernelSpeed, MarksWithoutWitnessesGiveTheVisibleSetOfTheWitnessRun) {
+  Rng rng(21);
+  std::vector<std::array<Vec3, 3>> tris;
+  for (int i = 0; i < 300; ++i) {
+    const Vec3 c{rng.uniform(-10, 10), rng.uniform(-10, 10), rng.uniform(-10, 10)};
+    std::array<Vec3, 3> t;
+    for (auto& p : t) p = c + Vec3{rng.uniform(-2, 2), rng.uniform(-2, 2), rng.uniform(-2, 2)};
+    for (int copies = i % 3 == 0 ? 3 : 2; copies > 0; --copies) tris.push_back(t);
+  }
+  const Scene s = vislib_test::soup(tris);
+  for (int threads : {1, tbb::task_arena::automatic}) {
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+      SegmentOptions o;
+      o.resolution = 40;
+      o.want_witnesses = true;
+      const auto with = segment_visibility(s, {-2, 0, 0}, {2, 0.5, 0}, o);
+      o.want_witnesses = false;
+      const auto without = segment_visibility(s, {-2, 0, 0}, {2, 0.5, 0}, o);
+      EXPECT_EQ(with.visible, without.visible) << threads;
+      EXPECT_GT(with.visible.size(), 200u);
+    });
+  }
 }
 
 // Issue 13 item 5, long segments: one run along a segment split at s_1 < s_2 < ... gives, for
