@@ -152,9 +152,9 @@ inline bool envelope_hides(const double* env, double lo, double hi, const Linear
   return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
 }
 
-// Recomputes the bins of `env` that [lo, hi) overlaps after an insertion there (the rest of the
-// list is unchanged, merged pieces keep their depth functions); returns the largest bin (inf when
-// some bin is not covered), the pixel's bound for culling whole triangles.
+// Recomputes the bins of `env` that [lo, hi) overlaps from the list (the kernel rebuilds them all,
+// lo = 0 and hi = 1, at the first test after a change); returns the largest bin (inf when some
+// bin is not covered), the pixel's bound for culling whole triangles.
 inline double update_envelope(const PieceList& l, double* env, double lo, double hi) {
   int b0, b1;
   bins_of(lo, hi, b0, b1);
@@ -503,8 +503,8 @@ class StaticKind {
         PieceList& l = sc.lists[k];
         // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
         // until then every bin stays infinite), and only while the list has two or more
-        // pieces: it is built at the first test or change that finds two, and dropped when a
-        // change leaves one. One piece answers the test itself (single_piece_hides).
+        // pieces: it is built at the first test that finds two, and dropped by every change
+        // (rebuilt at the next test). One piece answers the test itself (single_piece_hides).
         if (opt_.depth_culling && sc.far[k] < INFINITY) {
           bool hidden;
           if (sc.env_ok[k]) {
@@ -527,18 +527,13 @@ class StaticKind {
         TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
         if (insert_piece(l, Piece{lo, hi, b.id, depth}, rule) && opt_.depth_culling) {
           if (sc.far[k] < INFINITY) {
-            // The list only got nearer, so far can be lowered: one piece needs no bins (its far
-            // is its depth at its ends); built bins are recomputed over the ones this insertion
-            // touched; otherwise they are built whole.
-            if (l.size() == 1) {
-              sc.far[k] = upper_depth(l) * far_scale_;
-              sc.env_ok[k] = 0;
-            } else if (sc.env_ok[k]) {
-              sc.far[k] = update_envelope(l, env, lo, hi) * far_scale_;
-            } else {
-              sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
-              sc.env_ok[k] = 1;
-            }
+            // The list only got nearer: its bins are dropped and rebuilt whole at the next test
+            // that needs them (a stale far is still a bound, only a looser one). One piece
+            // needs no bins, and its far is its depth at its ends. (Session 13: rebuilding on
+            // demand instead of updating the touched bins after every change is 1.05x on the
+            // 2 m street and even on the long segments; docs/performance.md.)
+            if (l.size() == 1) sc.far[k] = upper_depth(l) * far_scale_;
+            sc.env_ok[k] = 0;
           } else if (covers_segment(l)) {
             sc.far[k] = upper_depth(l) * far_scale_;  // the envelope waits for its first use
             sc.env_ok[k] = 0;
