@@ -107,11 +107,10 @@ namespace {
 // smallest depth exceeds the envelope over every bin it overlaps loses every comparison that
 // insert_piece makes (front() at any midpoint inside it), so inserting it would leave the list as
 // it is: skipping it is exact.
-// Four bins, not sixteen (session 13): the bins are recomputed after every change of a covered
-// list of two or more pieces, and sixteen hid more pairs than they cost only on paper. Measured
-// (one core, N = 512, same results): 16 -> 4 bins hides 1.23M instead of 1.97M pairs on the 20 m
-// street and runs 1.02x faster there, 1.09x on the 2 m street, 1.025x on pandora; 2 and 8 bins
-// were no better than 4.
+// Four bins, not sixteen (session 13): every bin is paid for at each rebuild and test, and the
+// extra pairs that sixteen hide do not repay that. Measured (one core, N = 512, same results):
+// 4 bins hide 1.23M pairs instead of 1.97M on the 20 m street and run 1.02x faster there, 1.09x
+// on the 2 m street, 1.025x on pandora; 2 and 8 bins were no better than 4.
 constexpr int kEnvBins = 4;
 
 // Bins overlapped by [lo, hi), 0 <= lo < hi <= 1 (scaling by a power of two is exact).
