@@ -151,34 +151,27 @@ inline bool envelope_hides(const double* env, double lo, double hi, const Linear
   return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
 }
 
-// Recomputes the bins of `env` that [lo, hi) overlaps from the list (the kernel rebuilds them all,
-// lo = 0 and hi = 1, at the first test after a change); returns the largest bin (inf when some
-// bin is not covered), the pixel's bound for culling whole triangles.
-inline double update_envelope(const PieceList& l, double* env, double lo, double hi) {
-  int b0, b1;
-  bins_of(lo, hi, b0, b1);
-  for (int b = b0; b <= b1; ++b) env[b] = -INFINITY;
-  const double blo0 = double(b0) / kEnvBins, bhi1 = double(b1 + 1) / kEnvBins;
-  size_t i = 0;
-  while (i < l.size() && l[i].t1 <= blo0) ++i;
-  // Walk the pieces over [blo0, bhi1]: each adds its depth at its ends clipped to every bin it
-  // overlaps; a gap (or an uncovered end) makes the bins it touches infinite.
-  double cur = blo0;
+// Builds the bins of `env` from a list that covers [0, 1]; returns the largest bin, the pixel's
+// bound for culling whole triangles. The kernel builds them at the first test after a change
+// (they are not kept up to date through changes). A gap, which a covered list never has, would
+// make the bins it touches infinite.
+inline double build_envelope(const PieceList& l, double* env) {
+  for (int b = 0; b < kEnvBins; ++b) env[b] = -INFINITY;
   auto gap = [&](double a, double b) {  // [a, b) uncovered
     int g0, g1;
-    bins_of(std::max(a, blo0), std::min(b, bhi1), g0, g1);
-    for (int g = std::max(g0, b0); g <= std::min(g1, b1); ++g) env[g] = INFINITY;
+    bins_of(a, b, g0, g1);
+    for (int g = g0; g <= g1; ++g) env[g] = INFINITY;
   };
-  for (; i < l.size() && l[i].t0 < bhi1; ++i) {
-    const Piece& p = l[i];
+  // Each piece adds its depth at its ends clipped to every bin it overlaps.
+  double cur = 0;
+  for (const Piece& p : l) {
     if (p.t0 > cur) gap(cur, p.t0);
     const double inv = 1.0 / p.depth.dn;
-    const double a = std::max(p.t0, blo0), e = std::min(p.t1, bhi1);
     int q0, q1;
-    bins_of(a, e, q0, q1);
-    double left = depth_upper(p.depth, inv, a);
+    bins_of(p.t0, p.t1, q0, q1);
+    double left = depth_upper(p.depth, inv, p.t0);
     for (int b = q0; b <= q1; ++b) {
-      const double be = std::min(e, double(b + 1) / kEnvBins);
+      const double be = std::min(p.t1, double(b + 1) / kEnvBins);
       const double right = depth_upper(p.depth, inv, be);
       const double m = std::max(left, right);
       if (env[b] < m) env[b] = m;
@@ -186,10 +179,10 @@ inline double update_envelope(const PieceList& l, double* env, double lo, double
     }
     cur = p.t1;
   }
-  if (cur < bhi1) gap(cur, bhi1);
+  if (cur < 1) gap(cur, 1);
   double far = env[0];
   for (int b = 1; b < kEnvBins; ++b) far = std::max(far, env[b]);
-  return double(far);
+  return far;
 }
 
 // envelope_hides for a list that is the one piece `q` over [0, 1], without building its bins:
@@ -514,7 +507,7 @@ class StaticKind {
                      h >= 0) {
             hidden = h > 0;
           } else {
-            sc.far[k] = update_envelope(l, env, 0.0, 1.0) * far_scale_;
+            sc.far[k] = build_envelope(l, env) * far_scale_;
             sc.env_ok[k] = 1;
             hidden = envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_);
           }
