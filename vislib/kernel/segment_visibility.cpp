@@ -7,7 +7,7 @@
 // triangle can reach (classified once), its footprint bounds there, coverage 4 pixels at a time
 // (AVX2 when the CPU has it, bit-identical to the scalar path), lower-envelope insertion of linear
 // depths (triangles composited in batches of 16, row by row, so that the lists being edited stay
-// in L1), and exact per-pixel culling (plane depth, and the depth envelope over t-bins).
+// in L1), and exact per-pixel culling (plane depth, and the one piece of a covered list).
 #include "vislib/kernel/segment_visibility.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -99,30 +99,6 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
 
 namespace {
 
-// Per-pixel depth envelope over kEnvBins equal t-bins (issue 13, item 4): env[b] is an upper
-// bound (double) of the list's depth over bin b = [b/kEnvBins, (b+1)/kEnvBins] when the
-// list covers the bin without gap, else +inf. LinearDepth::at is monotone in t in floating point
-// (each rounded operation is monotone), so the list's largest evaluated depth on a piece clipped to
-// a bin is at a clipped end, and a new piece's smallest is at one of its ends. An interval whose
-// smallest depth exceeds the envelope over every bin it overlaps loses every comparison that
-// insert_piece makes (front() at any midpoint inside it), so inserting it would leave the list as
-// it is: skipping it is exact.
-// Four bins, not sixteen (session 13): every bin is paid for at each rebuild and test, and the
-// extra pairs that sixteen hide do not repay that. Measured (one core, N = 512, same results):
-// 4 bins hide 1.23M pairs instead of 1.97M on the 20 m street and run 1.02x faster there, 1.09x
-// on the 2 m street, 1.025x on pandora; 2 and 8 bins were no better than 4.
-constexpr int kEnvBins = 4;
-
-// Bins overlapped by [lo, hi), 0 <= lo < hi <= 1 (scaling by a power of two is exact).
-// (ceil by hand: without SSE4.1 std::ceil is a library call, and this runs for every insertion.)
-inline void bins_of(double lo, double hi, int& b0, int& b1) {
-  b0 = std::min(kEnvBins - 1, int(lo * kEnvBins));
-  const double x = hi * kEnvBins;
-  int c = int(x);  // x >= 0: truncation is floor
-  c += double(c) < x;
-  b1 = std::max(b0, std::min(kEnvBins - 1, c - 1));
-}
-
 // Bounds of LinearDepth::at(t) = (n0 - n1 t) / dn without its division: the same numerator times
 // inv = 1/dn is within 3 units in the last place of the quotient (one rounding for inv, one for the
 // product, one of the quotient), so widening it by 2^-50 relative (8 units) bounds at(t) from
@@ -139,72 +115,27 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
   return v * (1 - std::copysign(0x1p-50, v));
 }
 
-// `scale` (>= 1) widens the envelope so that an interval within the tie tolerance of the list
-// (CoplanarRule::Both records such ties) is never skipped.
-inline bool envelope_hides(const double* env, double lo, double hi, const LinearDepth& depth,
-                           double inv, double scale) {
-  int b0, b1;
-  bins_of(lo, hi, b0, b1);
-  double m = env[b0];
-  for (int b = b0 + 1; b <= b1; ++b) m = std::max(m, env[b]);
-  if (!(m < INFINITY)) return false;
-  return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
-}
-
-// Builds the bins of `env` from a list that covers [0, 1]; returns the largest bin, the pixel's
-// bound for culling whole triangles. The kernel builds them at the first test after a change
-// (they are not kept up to date through changes). A gap, which a covered list never has, would
-// make the bins it touches infinite.
-inline double build_envelope(const PieceList& l, double* env) {
-  for (int b = 0; b < kEnvBins; ++b) env[b] = -INFINITY;
-  auto gap = [&](double a, double b) {  // [a, b) uncovered
-    int g0, g1;
-    bins_of(a, b, g0, g1);
-    for (int g = g0; g <= g1; ++g) env[g] = INFINITY;
-  };
-  // Each piece adds its depth at its ends clipped to every bin it overlaps.
-  double cur = 0;
-  for (const Piece& p : l) {
-    if (p.t0 > cur) gap(cur, p.t0);
-    const double inv = 1.0 / p.depth.dn;
-    int q0, q1;
-    bins_of(p.t0, p.t1, q0, q1);
-    double left = depth_upper(p.depth, inv, p.t0);
-    for (int b = q0; b <= q1; ++b) {
-      const double be = std::min(p.t1, double(b + 1) / kEnvBins);
-      const double right = depth_upper(p.depth, inv, be);
-      const double m = std::max(left, right);
-      if (env[b] < m) env[b] = m;
-      left = right;
-    }
-    cur = p.t1;
-  }
-  if (cur < 1) gap(cur, 1);
-  double far = env[0];
-  for (int b = 1; b < kEnvBins; ++b) far = std::max(far, env[b]);
-  return far;
-}
-
-// envelope_hides for a list that is the one piece `q` over [0, 1], without building its bins:
-// their largest value over the bins [lo, hi) meets is q's depth_upper at the first bin's start or
-// at the last bin's end (depth_upper is monotone in t: every rounded step is), the values the
-// bins would hold. 1: hidden, 0: not; -1 (let the bins decide) when a product at an end
-// overflows, where depth_upper divides instead and monotony is not shown.
-inline int single_piece_hides(const Piece& q, double lo, double hi, const LinearDepth& depth,
-                              double inv, double scale) {
-  int b0, b1;
-  bins_of(lo, hi, b0, b1);
+// True when the interval [lo, hi) with depth `depth` (inv = 1 / its dn) lies behind `q`, the one
+// piece of a list that covers [0, 1], over all of [lo, hi): then it loses every comparison that
+// insert_piece makes (front() at any midpoint inside it) and inserting it would leave the list as
+// it is, so skipping it is exact. LinearDepth::at is monotone in t in floating point (each rounded
+// operation is), so q's largest depth over [lo, hi) is at an end, as is the interval's smallest;
+// depth_upper and depth_lower bound them (dividing where a product overflows). `scale` (>= 1)
+// widens q's depth so that an interval within the tie tolerance of it (CoplanarRule::Both records
+// such ties) is never skipped.
+// (Sessions 3-13 kept a depth envelope over t-bins for covered lists of two or more pieces, built
+// again at the first test after every change. Session 14 measured the kernel without it: 1.07x
+// on the 2 m street, 1.11-1.15x on the 20 m one, even on pandora, with 0.5-1.4% more pairs
+// tested; its builds cost more than the insertions it skipped. docs/performance.md.)
+inline bool single_piece_hides(const Piece& q, double lo, double hi, const LinearDepth& depth,
+                               double inv, double scale) {
   const double qinv = 1.0 / q.depth.dn;
-  const double ta = double(b0) / kEnvBins, tb = std::min(1.0, double(b1 + 1) / kEnvBins);
-  if (!(std::fabs((q.depth.n0 - q.depth.n1 * ta) * qinv) < INFINITY) ||
-      !(std::fabs((q.depth.n0 - q.depth.n1 * tb) * qinv) < INFINITY))
-    return -1;
-  const double m = std::max(depth_upper(q.depth, qinv, ta), depth_upper(q.depth, qinv, tb));
+  const double m = std::max(depth_upper(q.depth, qinv, lo), depth_upper(q.depth, qinv, hi));
   return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
 }
 
 // An upper bound of a list's depth over all its pieces (depth_upper at each piece's ends: the
-// depth is monotone on a piece), without the envelope's bins.
+// depth is monotone on a piece).
 inline double upper_depth(const PieceList& l) {
   double far = -INFINITY;
   for (const Piece& p : l) {
@@ -322,8 +253,8 @@ bool cpu_has_avx2() {
 }
 
 // The static triangles of one segment for the tile driver (tile_driver.h): footprint bounds on
-// the faces each triangle can reach, coverage 4 pixels at a time, exact depth culling with the
-// per-pixel depth envelope, lists of linear depths.
+// the faces each triangle can reach, coverage 4 pixels at a time, exact per-pixel depth culling,
+// lists of linear depths.
 class StaticKind {
  public:
   // A triangle of the tile set up for compositing (cover, flush).
@@ -338,11 +269,8 @@ class StaticKind {
   static constexpr size_t kBatch = 16;
   struct Scratch {
     std::vector<PieceList> lists;
-    std::vector<double> env;      // kEnvBins per pixel: the depth envelope (not reset per tile: a
-                                  // pixel's bins are read only while env_ok, and are all written
-                                  // when env_ok is set)
-    std::vector<double> far;      // per pixel: max of its envelope (inf unless [0,1] is covered)
-    std::vector<uint8_t> env_ok;  // per pixel with far < inf: its envelope is built
+    std::vector<double> far;  // per pixel: an upper bound of its list's depth (inf unless the list
+                              // covers [0, 1])
     std::vector<std::vector<TieRecord>> ties;                   // per pixel (CoplanarRule::Both)
     std::vector<Pending> batch = std::vector<Pending>(kBatch);  // triangles set up, not composited
     std::vector<Vec2> hulls = std::vector<Vec2>(kBatch * kMaxFootprintPoints);  // a slot each
@@ -393,8 +321,7 @@ class StaticKind {
 
   Scratch make_scratch(int ts) const {
     const size_t n = size_t(ts) * size_t(ts);
-    return Scratch{std::vector<PieceList>(n), std::vector<double>(n * kEnvBins),
-                   std::vector<double>(n), std::vector<uint8_t>(n),
+    return Scratch{std::vector<PieceList>(n), std::vector<double>(n),
                    std::vector<std::vector<TieRecord>>(n)};
   }
 
@@ -491,45 +418,20 @@ class StaticKind {
         ++stats.covered_pairs;
         const double lo = cov.lo[i], hi = cov.hi[i];
         const LinearDepth depth{st.N0, st.N1, cov.dn[i]};
-        double* env = &sc.env[k * kEnvBins];
         PieceList& l = sc.lists[k];
-        // The envelope is kept only once the list covers [0, 1] (a covered list stays covered;
-        // until then every bin stays infinite), and only while the list has two or more
-        // pieces: it is built at the first test that finds two, and dropped by every change
-        // (rebuilt at the next test). One piece answers the test itself (single_piece_hides).
-        if (opt_.depth_culling && sc.far[k] < INFINITY) {
-          bool hidden;
-          if (sc.env_ok[k]) {
-            hidden = envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_);
-          } else if (int h = l.size() == 1
-                                 ? single_piece_hides(l[0], lo, hi, depth, cov.inv[i], far_scale_)
-                                 : -1;
-                     h >= 0) {
-            hidden = h > 0;
-          } else {
-            sc.far[k] = build_envelope(l, env) * far_scale_;
-            sc.env_ok[k] = 1;
-            hidden = envelope_hides(env, lo, hi, depth, cov.inv[i], far_scale_);
-          }
-          if (hidden) {
-            ++stats.hidden_pairs;
-            continue;
-          }
+        // A covered pixel whose list is one piece tests the interval against it (exact; a
+        // list of more pieces leaves the test to insert_piece's read-only pass).
+        if (opt_.depth_culling && sc.far[k] < INFINITY && l.size() == 1 &&
+            single_piece_hides(l[0], lo, hi, depth, cov.inv[i], far_scale_)) {
+          ++stats.hidden_pairs;
+          continue;
         }
         TieRule rule{opt_.eps_z, keep_ties_ ? &sc.ties[k] : nullptr};
         if (insert_piece(l, Piece{lo, hi, b.id, depth}, rule) && opt_.depth_culling) {
-          if (sc.far[k] < INFINITY) {
-            // The list only got nearer: its bins are dropped and rebuilt whole at the next test
-            // that needs them (a stale far is still a bound, only a looser one). One piece
-            // needs no bins, and its far is its depth at its ends. (Session 13: rebuilding on
-            // demand instead of updating the touched bins after every change is 1.05x on the
-            // 2 m street and even on the long segments; docs/performance.md.)
-            if (l.size() == 1) sc.far[k] = upper_depth(l) * far_scale_;
-            sc.env_ok[k] = 0;
-          } else if (covers_segment(l)) {
-            sc.far[k] = upper_depth(l) * far_scale_;  // the envelope waits for its first use
-            sc.env_ok[k] = 0;
-          }
+          // The list only got nearer, so a stale far is still a bound, only a looser one; a
+          // list that becomes one piece gets its depth at its ends.
+          if (sc.far[k] < INFINITY ? l.size() == 1 : covers_segment(l))
+            sc.far[k] = upper_depth(l) * far_scale_;
         }
       }
     }

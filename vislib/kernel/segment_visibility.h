@@ -61,7 +61,7 @@ struct SegmentOptions {
   int tile_size = 0;  // pixels per tile side (memory/parallelism grain); 0: the kernel's choice,
                       // kStaticTileSize, or kDynamicTileSize with moving triangles or spheres
   bool depth_culling = true;  // skip hidden work (exact): triangles behind a tile's or a pixel's
-                              // covered depth, intervals behind the pixel's depth envelope over t
+                              // covered depth, intervals behind a covered pixel's one piece
   bool simd = true;           // vectorised coverage where the CPU has AVX2 (bit-identical results)
   size_t state = 0;           // static scenes: which key state to use
   DynamicMode mode = DynamicMode::Diagonal;    // dynamic scenes (moving vertices or spheres)
@@ -87,7 +87,7 @@ struct SegmentStats {
   uint64_t pair_tests = 0;     // (triangle, pixel) coverage evaluations
   uint64_t culled_pairs = 0;   // (triangle, pixel) pairs skipped by per-pixel depth culling
   uint64_t covered_pairs = 0;  // of which gave a non-empty interval
-  uint64_t hidden_pairs = 0;   // of which lay behind the pixel's depth envelope (not inserted)
+  uint64_t hidden_pairs = 0;   // of which lay behind a covered pixel's one piece (not inserted)
   uint64_t final_pieces = 0;   // pieces in all final lists
   uint64_t pixels_with_pieces = 0;
   uint64_t max_pieces_per_pixel = 0;
