@@ -39,8 +39,8 @@ Scene street_scene() {
 // neither the pixel's depth bound nor the plane test culls it) but behind the wall over the
 // whole stretch. The wall, inserted first (its nearest depth is the smallest), is the one piece
 // of every pixel that sees it, so the tiles' intervals take the one-piece test, and so do the
-// decals', which must not be skipped (a test that skipped intervals less than 1% behind the
-// wall would skip them).
+// decals', which must not be skipped (a test that also skipped intervals up to 1% nearer than
+// the wall would skip some of them).
 Scene wall_tiles_and_decals_scene() {
   auto on = [](double x, double y, double off) { return Vec3{x, y, 2 + x / 4 + off}; };
   std::vector<std::array<Vec3, 3>> tris;

@@ -124,8 +124,8 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
 // widens q's depth so that an interval within the tie tolerance of it (CoplanarRule::Both records
 // such ties) is never skipped.
 // (Sessions 3-13 kept a depth envelope over t-bins for covered lists of two or more pieces, built
-// again at the first test after every change. Session 14 measured the kernel without it: 1.07x
-// on the 2 m street, 1.11-1.15x on the 20 m one, even on pandora, with 0.5-1.4% more pairs
+// again at the first test after every change. Session 14 measured the kernel without it: 1.09x
+// faster on the 2 m street, 1.13x on the 20 m one, even on pandora, with 0.5-1.4% more pairs
 // tested; its builds cost more than the insertions it skipped. docs/performance.md.)
 inline bool single_piece_hides(const Piece& q, double lo, double hi, const LinearDepth& depth,
                                double inv, double scale) {
