@@ -109,6 +109,47 @@ TEST(IntervalList, HiddenInsertionLeavesTheListUnchanged) {
   expect_same(l, before);
 }
 
+TEST(IntervalList, InsertionBehindEveryPieceFillsExactlyTheGapsItSpans) {
+  // insert_piece's gap fill: an interval behind every piece it overlaps (no crossing) keeps every
+  // old piece as it was and owns exactly the stretches of [t0, t1) that no piece covered, with
+  // the tie records of a full rebuild (none here: the depths are far apart).
+  Rng rng(77);
+  for (int trial = 0; trial < 300; ++trial) {
+    PieceList l;
+    const int n = 1 + int(rng.below(40));  // short lists (linear search) and long ones
+    for (int i = 0; i < n; ++i) {
+      const double a = (2 * i + rng.below(2)) / double(2 * n), b = (2 * i + 1) / double(2 * n);
+      if (a < b) l.push_back(Piece{a, b, uint32_t(i), line(1 + 0.01 * i, 0)});
+    }
+    if (l.empty()) continue;
+    const PieceList before = l;
+    double s = rng.below(1000) / 1000.0, f = rng.below(1000) / 1000.0;
+    if (s > f) std::swap(s, f);
+    if (!(s < f)) continue;
+    const uint32_t id = 1000;
+    std::vector<TieRecord> ties;
+    const bool changed = insert_piece(l, Piece{s, f, id, line(5, 0.5)}, TieRule{1e-6, &ties});
+    EXPECT_TRUE(ties.empty());
+    // The expected list: the old pieces, and the uncovered stretches of [s, f) as pieces of id.
+    PieceList want;
+    double cur = s;
+    for (const Piece& q : before) {
+      if (q.t0 > cur && cur < f) want.push_back(Piece{cur, std::min(q.t0, f), id, line(5, 0.5)});
+      want.push_back(q);
+      cur = std::max(cur, q.t1);
+    }
+    if (cur < f) want.push_back(Piece{cur, f, id, line(5, 0.5)});
+    EXPECT_EQ(changed, want.size() != before.size());
+    ASSERT_TRUE(is_valid(l));
+    expect_same(l, want);
+    for (const Piece& q : l) {
+      if (q.id != id) {
+        EXPECT_TRUE(same_depth(q.depth, line(1 + 0.01 * q.id, 0)));
+      }
+    }
+  }
+}
+
 TEST(IntervalList, ThousandsOfDisjointPiecesAreAllKeptInOrder) {
   // No capacity limit: a list holds as many pieces as the pixel needs (the vector grows).
   const int n = 5000;

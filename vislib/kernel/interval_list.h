@@ -196,6 +196,41 @@ void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t
   out.push_back(p);
 }
 
+// list[k] absorbs list[k + 1] (which continues it).
+template <class D>
+void merge_next(std::vector<PieceT<D>>& list, size_t k) {
+  list[k].t1 = list[k + 1].t1;
+  list.erase(list.begin() + long(k) + 1);
+}
+
+// insert_piece where p loses to every piece of list[first, end) it overlaps, without a depth
+// crossing, so that it only fills the `gaps` stretches of [p.t0, p.t1) that those pieces leave
+// uncovered: each becomes a piece of p, in place (the pieces after `end` move once), and every
+// old piece stays as it was. This is what insert_piece's full pass makes of such an insertion
+// (there each overlapped piece is cut at p's ends, its parts put back and merged again), without
+// its depths.
+template <class D>
+void gap_fill(std::vector<PieceT<D>>& list, const PieceT<D>& p, size_t first, size_t end,
+              int gaps) {
+  list.insert(list.begin() + long(end), size_t(gaps), p);
+  size_t w = end + size_t(gaps);  // one past the next slot to write, from the back
+  double next_t0 = p.t1;          // where the stretch after list[j] ends
+  auto put_gap = [&](double t0, double t1) {
+    PieceT<D>& g = list[--w];
+    g = p;
+    g.t0 = t0;
+    g.t1 = t1;
+  };
+  for (size_t j = end; j-- > first;) {
+    const PieceT<D> I = list[j];
+    if (I.t1 < next_t0) put_gap(I.t1, next_t0);
+    list[--w] = I;
+    next_t0 = I.t0;
+  }
+  if (p.t0 < next_t0) put_gap(p.t0, next_t0);
+  assert(w == first);
+}
+
 }  // namespace detail
 
 // Inserts the coverage interval `p` (p.t0 < p.t1) into `list` (sorted, disjoint, merged).
@@ -221,17 +256,19 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
   }
   double cuts[kMaxCrossings + 2];
   // Read-only pass first: most insertions (front-to-back order) are hidden everywhere and must
-  // leave the list untouched; find that out without rebuilding anything.
+  // leave the list untouched; find that out without rebuilding anything. It goes on past the
+  // gaps of [s, f) (stretches no piece covers) and counts them: when p loses everywhere else, the
+  // insertion only fills those gaps, which needs no depth and no rebuild (gap_fill below).
   const size_t ties_before = ties.sink ? ties.sink->size() : 0;
   {
-    bool changes = false;
+    bool changes = false, own_id = false;
+    int gaps = 0;
     double cur = s;
-    for (size_t i = first; i < list.size() && list[i].t0 < f && !changes; ++i) {
+    size_t i = first;
+    for (; i < list.size() && list[i].t0 < f; ++i) {
       const PieceT<D>& I = list[i];
-      if (cur < I.t0) {
-        changes = true;  // a gap the new interval fills
-        break;
-      }
+      if (cur < I.t0) ++gaps;
+      own_id |= I.id == p.id;  // (never in the kernels: one interval per primitive and pixel)
       double lo = std::max(cur, I.t0), hi = std::min(f, I.t1);
       bool tie_checked = false;
       if constexpr (std::is_same_v<D, LinearDepth>) {
@@ -258,17 +295,32 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
         changes = &detail::front(I, p, 0.5 * (lo + hi)) == &p ||
                   detail::crossings(I, p, lo, hi, cuts) > 0;
       }
-      if (!changes && ties.sink && !tie_checked) detail::record_tie(ties, I, p, lo, hi);
+      if (changes) break;
+      if (ties.sink && !tie_checked) detail::record_tie(ties, I, p, lo, hi);
       cur = hi;
     }
-    if (!changes && cur >= f) return false;
+    if (!changes) {
+      if (cur < f) ++gaps;
+      if (gaps == 0) return false;
+      if (!own_id) {
+        // The tie records of the pass stand: the full pass would make the same ones.
+        if (i == first)
+          list.insert(list.begin() + long(first), p);  // nothing overlaps: one gap, p itself
+        else
+          detail::gap_fill(list, p, first, i, gaps);
+        const size_t count = i - first + size_t(gaps);
+        if (first + count < list.size() &&
+            detail::continues(list[first + count - 1], list[first + count]))
+          detail::merge_next(list, first + count - 1);
+        if (first > 0 && detail::continues(list[first - 1], list[first]))
+          detail::merge_next(list, first - 1);
+        return true;
+      }
+    }
     if (ties.sink) ties.sink->resize(ties_before);  // the full pass below records them again
   }
   size_t count;  // pieces now standing where list[first, i) stood
-  if (first == list.size() || list[first].t0 >= f) {
-    list.insert(list.begin() + first, p);  // nothing overlaps: insert in the gap
-    count = 1;
-  } else {
+  {
     thread_local std::vector<PieceT<D>> out;
     out.clear();
     size_t i = first;
