@@ -259,7 +259,7 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
   // leave the list untouched; find that out without rebuilding anything. It goes on past the
   // gaps of [s, f) (stretches no piece covers) and counts them: when p loses everywhere else, the
   // insertion only fills those gaps, which needs no depth and no rebuild (gap_fill below).
-  const size_t ties_before = ties.sink ? ties.sink->size() : 0;
+  size_t settled = first;  // list[first, settled): pieces p loses to everywhere, no crossing
   {
     bool changes = false, own_id = false;
     int gaps = 0;
@@ -317,7 +317,7 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
         return true;
       }
     }
-    if (ties.sink) ties.sink->resize(ties_before);  // the full pass below records them again
+    settled = i;
   }
   size_t count;  // pieces now standing where list[first, i) stood
   {
@@ -325,6 +325,15 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
     out.clear();
     size_t i = first;
     double cur = s;
+    // The settled pieces stand as they are, p in the gaps before them: what the loop below makes
+    // of them (a piece cut at s and pushed back merges again), without its depths. Their tie
+    // records are the read-only pass's, which come first in the full pass's order too.
+    for (; i < settled; ++i) {
+      const PieceT<D>& I = list[i];
+      if (cur < I.t0) detail::push(out, p, cur, I.t0);
+      detail::push(out, I, I.t0, I.t1);
+      cur = std::min(f, I.t1);
+    }
     while (i < list.size() && list[i].t0 < f) {
       const PieceT<D> I = list[i];
       if (I.t0 < cur) detail::push(out, I, I.t0, cur);
