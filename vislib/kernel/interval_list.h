@@ -268,7 +268,9 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
     for (; i < list.size() && list[i].t0 < f; ++i) {
       const PieceT<D>& I = list[i];
       if (cur < I.t0) ++gaps;
-      own_id |= I.id == p.id;  // (never in the kernels: one interval per primitive and pixel)
+      // A piece of p's own primitive (a sphere's other root, a moving triangle's other
+      // interval at this pixel) may merge with p: such insertions take the full pass.
+      own_id |= I.id == p.id;
       double lo = std::max(cur, I.t0), hi = std::min(f, I.t1);
       bool tie_checked = false;
       if constexpr (std::is_same_v<D, LinearDepth>) {
