@@ -294,7 +294,7 @@ bool footprint_row_span(const Vec2* hull, int k, double m, int n, int y, int& x0
       umax = std::max(umax, a.u);
     }
     if (k == 1) break;
-    Vec2 b = hull[(i + 1) % k];
+    Vec2 b = hull[i + 1 == k ? 0 : i + 1];  // (no integer division: this runs per triangle and row)
     for (double wl : {wlo, whi}) {
       if ((a.w < wl && b.w > wl) || (a.w > wl && b.w < wl)) {
         double u = a.u + (wl - a.w) / (b.w - a.w) * (b.u - a.u);
