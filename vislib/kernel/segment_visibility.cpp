@@ -148,9 +148,10 @@ inline double upper_depth(const PieceList& l) {
 // True when the triangle's plane lies behind `far` along the pixel ray for every t in [0, 1]: its
 // depth there is at(t) of LinearDepth{N0, N1, Dn} (as static_coverage would give), monotone in t,
 // so at(0) and at(1) bound it. Exact culling of a pair whose pixel list covers [0, 1] below `far`.
-inline bool plane_behind(const StaticTriangle& st, double Dn, double inv, double far) {
+inline bool plane_behind(const StaticTriangle& st, double Dn, double far) {
   if (Dn == 0) return true;  // never covers (static_coverage returns false)
   const LinearDepth z{st.N0, st.N1, Dn};
+  const double inv = 1.0 / Dn;
   return std::min(depth_lower(z, inv, 0.0), depth_lower(z, inv, 1.0)) > far;
 }
 
@@ -161,7 +162,8 @@ inline bool plane_behind(const StaticTriangle& st, double Dn, double inv, double
 // on an edge) are redone by the scalar function. AVX2 is chosen at run time; other CPUs and
 // SegmentOptions::simd = false take the scalar loop.
 struct Coverage4 {
-  double lo[4], hi[4], dn[4], inv[4];  // inv = 1 / dn (bounds only)
+  double lo[4], hi[4], dn[4];  // (1 / dn, for the depth bounds, is divided where they need it:
+                               // most pairs never do)
   bool ok[4];
 };
 
@@ -172,7 +174,6 @@ void coverage4_scalar(const StaticTriangle& st, const FaceAxes& ax, const double
     LinearDepth z;
     out.ok[i] = static_coverage(st, d, ax.S, ax.T, near, out.lo[i], out.hi[i], z);
     out.dn[i] = dot(d, st.n);
-    out.inv[i] = 1.0 / out.dn[i];
   }
 }
 
@@ -229,7 +230,6 @@ VISLIB_AVX2 void coverage4_avx2(const StaticTriangle& st, const FaceAxes& ax, co
   _mm256_storeu_pd(out.lo, lo);
   _mm256_storeu_pd(out.hi, hi);
   _mm256_storeu_pd(out.dn, Dn);
-  _mm256_storeu_pd(out.inv, _mm256_div_pd(one, Dn));
   const int gm = _mm256_movemask_pd(good), tm = _mm256_movemask_pd(tie);
   for (int i = 0; i < lanes; ++i) {
     if (tm >> i & 1) {  // persistent on-edge tie in this lane: the scalar rule decides
@@ -408,8 +408,7 @@ class StaticKind {
       for (int i = 0; i < lanes; ++i) {
         const size_t k = kb + size_t(i);
         if (opt_.depth_culling &&
-            (tz > sc.far[k] ||
-             (sc.far[k] < INFINITY && plane_behind(st, cov.dn[i], cov.inv[i], sc.far[k])))) {
+            (tz > sc.far[k] || (sc.far[k] < INFINITY && plane_behind(st, cov.dn[i], sc.far[k])))) {
           ++stats.culled_pairs;
           continue;
         }
@@ -422,7 +421,7 @@ class StaticKind {
         // A covered pixel whose list is one piece tests the interval against it (exact; a
         // list of more pieces leaves the test to insert_piece's read-only pass).
         if (opt_.depth_culling && sc.far[k] < INFINITY && l.size() == 1 &&
-            single_piece_hides(l[0], lo, hi, depth, cov.inv[i], far_scale_)) {
+            single_piece_hides(l[0], lo, hi, depth, 1.0 / depth.dn, far_scale_)) {
           ++stats.hidden_pairs;
           continue;
         }
