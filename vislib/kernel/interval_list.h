@@ -196,11 +196,21 @@ void push(std::vector<PieceT<D>>& out, const PieceT<D>& src, double t0, double t
   out.push_back(p);
 }
 
-// list[k] absorbs list[k + 1] (which continues it).
+// list[k] absorbs list[k + 1] if that continues it.
 template <class D>
-void merge_next(std::vector<PieceT<D>>& list, size_t k) {
-  list[k].t1 = list[k + 1].t1;
-  list.erase(list.begin() + long(k) + 1);
+void merge_at(std::vector<PieceT<D>>& list, size_t k) {
+  if (k + 1 < list.size() && continues(list[k], list[k + 1])) {
+    list[k].t1 = list[k + 1].t1;
+    list.erase(list.begin() + long(k) + 1);
+  }
+}
+
+// After list[first, first + count) was replaced: merges across the range's two ends (higher index
+// first; inside it, the pieces were written merged).
+template <class D>
+void merge_range_ends(std::vector<PieceT<D>>& list, size_t first, size_t count) {
+  merge_at(list, first + count - 1);
+  if (first > 0) merge_at(list, first - 1);
 }
 
 // insert_piece where p loses to every piece of list[first, end) it overlaps, without a depth
@@ -310,12 +320,7 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
           list.insert(list.begin() + long(first), p);  // nothing overlaps: one gap, p itself
         else
           detail::gap_fill(list, p, first, i, gaps);
-        const size_t count = i - first + size_t(gaps);
-        if (first + count < list.size() &&
-            detail::continues(list[first + count - 1], list[first + count]))
-          detail::merge_next(list, first + count - 1);
-        if (first > 0 && detail::continues(list[first - 1], list[first]))
-          detail::merge_next(list, first - 1);
+        detail::merge_range_ends(list, first, i - first + size_t(gaps));
         return true;
       }
     }
@@ -367,15 +372,7 @@ bool insert_piece(std::vector<PieceT<D>>& list, const PieceT<D>& p,
     }
     count = out.size();
   }
-  // `push` merged inside the new range; merge across its two ends (higher index first).
-  auto merge_at = [&list](size_t k) {  // list[k] absorbs list[k+1] if it continues it
-    if (k + 1 < list.size() && detail::continues(list[k], list[k + 1])) {
-      list[k].t1 = list[k + 1].t1;
-      list.erase(list.begin() + k + 1);
-    }
-  };
-  merge_at(first + count - 1);
-  if (first > 0) merge_at(first - 1);
+  detail::merge_range_ends(list, first, count);  // (`push` merged inside the new range)
   return true;
 }
 
