@@ -115,10 +115,10 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
   return v * (1 - std::copysign(0x1p-50, v));
 }
 
-// True when the interval [lo, hi) with depth `depth` (inv = 1 / its dn) lies behind `q`, the one
-// piece of a list that covers [0, 1], over all of [lo, hi): then it loses every comparison that
-// insert_piece makes (front() at any midpoint inside it) and inserting it would leave the list as
-// it is, so skipping it is exact. LinearDepth::at is monotone in t in floating point (each rounded
+// True when the interval [lo, hi) with depth `depth` lies behind `q`, the one piece of a list that
+// covers [0, 1], over all of [lo, hi): then it loses every comparison that insert_piece makes
+// (front() at any midpoint inside it) and inserting it would leave the list as it is, so skipping
+// it is exact. LinearDepth::at is monotone in t in floating point (each rounded
 // operation is), so q's largest depth over [lo, hi) is at an end, as is the interval's smallest;
 // depth_upper and depth_lower bound them (dividing where a product overflows). `scale` (>= 1)
 // widens q's depth so that an interval within the tie tolerance of it (CoplanarRule::Both records
@@ -128,8 +128,8 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
 // faster on the 2 m street, 1.13x on the 20 m one, even on pandora, with 0.5-1.4% more pairs
 // tested; its builds cost more than the insertions it skipped. docs/performance.md.)
 inline bool single_piece_hides(const Piece& q, double lo, double hi, const LinearDepth& depth,
-                               double inv, double scale) {
-  const double qinv = 1.0 / q.depth.dn;
+                               double scale) {
+  const double qinv = 1.0 / q.depth.dn, inv = 1.0 / depth.dn;
   const double m = std::max(depth_upper(q.depth, qinv, lo), depth_upper(q.depth, qinv, hi));
   return std::min(depth_lower(depth, inv, lo), depth_lower(depth, inv, hi)) > m * scale;
 }
@@ -421,7 +421,7 @@ class StaticKind {
         // A covered pixel whose list is one piece tests the interval against it (exact; a
         // list of more pieces leaves the test to insert_piece's read-only pass).
         if (opt_.depth_culling && sc.far[k] < INFINITY && l.size() == 1 &&
-            single_piece_hides(l[0], lo, hi, depth, 1.0 / depth.dn, far_scale_)) {
+            single_piece_hides(l[0], lo, hi, depth, far_scale_)) {
           ++stats.hidden_pairs;
           continue;
         }
