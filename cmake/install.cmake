@@ -32,6 +32,9 @@ if(NOT VISLIB_RUNTIME_ONLY)
   # The image module that vislib::eval loads on first image I/O (vislib/CMakeLists.txt).
   if(TARGET vislib_image_oiio)
     install(TARGETS vislib_image_oiio LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/vislib)
+    # For vislibConfig.cmake's vislib_IMAGE_MODULE, relative to the prefix.
+    set(VISLIB_IMAGE_MODULE_IN_PREFIX
+        ${CMAKE_INSTALL_LIBDIR}/vislib/${CMAKE_SHARED_MODULE_PREFIX}vislib_image_oiio${CMAKE_SHARED_MODULE_SUFFIX})
   endif()
   set(_corner_targets)
   get_directory_property(_corners DIRECTORY ${PROJECT_SOURCE_DIR}/vislib DEFINITION VISLIB_CORNERS)
@@ -57,6 +60,23 @@ write_basic_package_version_file(${PROJECT_BINARY_DIR}/cmake/vislibConfigVersion
 install(FILES ${PROJECT_BINARY_DIR}/cmake/vislibConfig.cmake ${PROJECT_BINARY_DIR}/cmake/vislibConfigVersion.cmake
         DESTINATION ${VISLIB_CMAKE_DIR})
 
-# pkg-config for the C API: `cc app.c $(pkg-config --cflags --libs vislib_runtime)`.
+# pkg-config for the C API: `cc app.c $(pkg-config --cflags --libs vislib_runtime)`. Its paths are
+# relative to the .pc file's own folder (${pcfiledir}), not the configured prefix, so an install
+# works at any `cmake --install --prefix` and after being moved (an absolute libdir or includedir
+# given at configure time stays absolute).
+if(IS_ABSOLUTE "${CMAKE_INSTALL_LIBDIR}")
+  set(VISLIB_PC_PREFIX "${CMAKE_INSTALL_PREFIX}")
+else()
+  file(RELATIVE_PATH _up /p/${CMAKE_INSTALL_LIBDIR}/pkgconfig /p)
+  string(REGEX REPLACE "/$" "" _up "${_up}")
+  set(VISLIB_PC_PREFIX "\${pcfiledir}/${_up}")  # ${pcfiledir}/../..
+endif()
+foreach(_kind LIBDIR INCLUDEDIR)
+  if(IS_ABSOLUTE "${CMAKE_INSTALL_${_kind}}")
+    set(VISLIB_PC_${_kind} "${CMAKE_INSTALL_${_kind}}")
+  else()
+    set(VISLIB_PC_${_kind} "\${prefix}/${CMAKE_INSTALL_${_kind}}")
+  endif()
+endforeach()
 configure_file(${PROJECT_SOURCE_DIR}/cmake/vislib_runtime.pc.in ${PROJECT_BINARY_DIR}/cmake/vislib_runtime.pc @ONLY)
 install(FILES ${PROJECT_BINARY_DIR}/cmake/vislib_runtime.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)

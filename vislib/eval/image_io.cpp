@@ -4,6 +4,7 @@
 #include "vislib/eval/image_io.h"
 
 #include <dlfcn.h>
+#include <link.h>
 #include <unistd.h>
 
 #include <cassert>
@@ -35,36 +36,56 @@ const ImageModule& image_module() {
   return module;
 }
 #else
-// The folder of the running executable (empty if unknown).
-std::filesystem::path executable_dir() {
+// A byte of this file's object: dladdr of its address names the program or shared object that
+// holds this code (the static vislib::eval is linked into `pvs`, pyvislib's module, an engine).
+const char kWhereAmI = 0;
+
+// The file of the program or shared object holding this code (empty if unknown), symbolic links
+// resolved, so that a link to an installed program still leads to its prefix.
+std::filesystem::path holder_file() {
+  Dl_info info{};
+  link_map* map = nullptr;
+  std::filesystem::path file;
+  if (dladdr1(&kWhereAmI, &info, reinterpret_cast<void**>(&map), RTLD_DL_LINKMAP) != 0 && map &&
+      map->l_name && map->l_name[0] != '\0')
+    file = map->l_name;
+  else  // the main program: its link map has no name, dladdr would give argv[0]
+    file = "/proc/self/exe";
   std::error_code ec;
-  auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  return ec ? std::filesystem::path() : exe.parent_path();
+  auto resolved = std::filesystem::canonical(file, ec);
+  return ec ? std::filesystem::path() : resolved;
 }
 
-// Where the module may be, in order: $VISLIB_IMAGE_MODULE; the build tree that compiled this file;
-// the install prefix it was configured for; lib/vislib beside the executable's bin/ (a moved
-// install); the dynamic loader's own search (LD_LIBRARY_PATH, ...).
-std::vector<std::string> module_candidates() {
-  std::vector<std::string> out;
-  if (const char* env = std::getenv("VISLIB_IMAGE_MODULE"); env && *env) out.push_back(env);
-#ifdef VISLIB_IMAGE_MODULE_BUILD_PATH
-  out.push_back(VISLIB_IMAGE_MODULE_BUILD_PATH);
-#endif
-#ifdef VISLIB_IMAGE_MODULE_INSTALL_PATH
-  out.push_back(VISLIB_IMAGE_MODULE_INSTALL_PATH);
-#endif
-#ifdef VISLIB_IMAGE_MODULE_NAME
-  const auto exe_dir = executable_dir();
-  if (!exe_dir.empty()) {
-#ifdef VISLIB_IMAGE_MODULE_RELATIVE_DIR
-    out.push_back((exe_dir / ".." / VISLIB_IMAGE_MODULE_RELATIVE_DIR / VISLIB_IMAGE_MODULE_NAME)
-                      .lexically_normal()
-                      .string());
-#endif
+// A place to look for the module, and what to say when nothing is there.
+struct Candidate {
+  std::string path;
+  std::string absent;  // the message when path is empty or missing
+};
+
+// Where the module may be, in order: $VISLIB_IMAGE_MODULE; <dir>/<libdir>/vislib/<name> for the
+// nearest folder <dir> above the program or shared object holding this code (an install prefix
+// or a build folder: `bin/pvs`, pyvislib in `lib/python3.X/dist-packages`, `build/cli/pvs` all
+// reach it, wherever the prefix was moved); the dynamic loader's own search (LD_LIBRARY_PATH,
+// the RUNPATH of the holder).
+std::vector<Candidate> module_candidates() {
+  std::vector<Candidate> out;
+  if (const char* env = std::getenv("VISLIB_IMAGE_MODULE"); env && *env)
+    out.push_back({env, std::string(env) + " (absent)"});
+  const std::filesystem::path relative =
+      std::filesystem::path(VISLIB_IMAGE_MODULE_RELATIVE_DIR) / VISLIB_IMAGE_MODULE_NAME;
+  const std::filesystem::path holder = holder_file();
+  Candidate above{"", relative.string() + " (in no folder above " +
+                          (holder.empty() ? std::string("this program") : holder.string()) + ")"};
+  for (auto dir = holder.parent_path(); !dir.empty(); dir = dir.parent_path()) {
+    std::error_code ec;
+    if (std::filesystem::exists(dir / relative, ec)) {
+      above.path = (dir / relative).string();
+      break;
+    }
+    if (dir == dir.parent_path()) break;
   }
-  out.push_back(VISLIB_IMAGE_MODULE_NAME);
-#endif
+  out.push_back(above);
+  out.push_back({VISLIB_IMAGE_MODULE_NAME, ""});
   return out;
 }
 
@@ -74,10 +95,11 @@ const ImageModule& image_module() {
   static std::once_flag once;
   std::call_once(once, [] {
     std::string tried;
-    for (const std::string& path : module_candidates()) {
-      const bool bare = path.find('/') == std::string::npos;
-      if (!bare && !std::filesystem::exists(path)) {
-        tried += "\n  " + path + " (absent)";
+    for (const Candidate& c : module_candidates()) {
+      const std::string& path = c.path;
+      const bool bare = !path.empty() && path.find('/') == std::string::npos;
+      if (!bare && (path.empty() || !std::filesystem::exists(path))) {
+        tried += "\n  " + c.absent;
         continue;
       }
       void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
