@@ -17,7 +17,7 @@
 #   scripts/consumer-test.sh --full BUILD_DIR WORK_DIR [PYTHON]
 #     installs the full build BUILD_DIR (`cmake --install BUILD_DIR --prefix TMP`, no new build),
 #     moves the prefix, builds and runs tests/consumer/full (find_package(vislib 0.1 COMPONENTS
-#     vislib): a scene loaded, an image written and read back), runs the installed `pvs`, and, when
+#     vislib): a scene loaded, an image written and read back), runs the installed `pvs` (a one-cell bake and its frame), and, when
 #     PYTHON is given, imports the installed pyvislib with it and renders and saves a frame; the
 #     image module must be loaded from the moved prefix.
 # "No heavy header visible" (runtime mode): Debian puts Embree, TBB, CGAL, ... in /usr/include,
@@ -164,10 +164,9 @@ module_loaded_from() {  # $1: an LD_DEBUG=files log
   sed -nE 's/.*file=([^ ]*vislib_image_oiio[^ ]*) .*dynamically loaded.*/\1/p' "$1" | head -1
 }
 "$MOVED/bin/pvs" --version
-# A generated scene of one building (deterministic), a one-cell bake and the frame of that cell.
-"$MOVED/bin/pvs" generate city --blocks 1 --seed 1 -o "$WORK/tiny.glb" -q
-"$MOVED/bin/pvs" bake "$WORK/tiny.glb" --box -4,1,-4,4,2,4 --grid 1,1,1 --res 16 --runs 1 -o "$WORK/tiny.pvs" -q
-LD_DEBUG=files LD_DEBUG_OUTPUT="$WORK/pvs-ld" "$MOVED/bin/pvs" view "$WORK/tiny.pvs" --scene "$WORK/tiny.glb" \
+# A one-cell bake of the default scene around its centre crossing, and the frame of that cell.
+"$MOVED/bin/pvs" bake "$SRC/data/city.glb" --box -4,1,-4,4,2,4 --grid 1,1,1 --res 16 --runs 1 -o "$WORK/tiny.pvs" -q
+LD_DEBUG=files LD_DEBUG_OUTPUT="$WORK/pvs-ld" "$MOVED/bin/pvs" view "$WORK/tiny.pvs" --scene "$SRC/data/city.glb" \
   --at 0,1.5,0 --look 1,1.5,0 --frame 32x24 -o "$WORK/tiny.png" -q
 loaded=$(cat "$WORK"/pvs-ld.* | module_loaded_from /dev/stdin)
 echo "consumer-test: the installed pvs loaded the image module from $loaded"
@@ -191,7 +190,7 @@ scene = v.load_scene(sys.argv[2])
 frame = v.Renderer(scene).render(eye=(0, 1.5, 0), forward=(1, 0, 0), width=32, height=24)
 frame.save('py.png')
 print('consumer-test: import pyvislib from', v.__file__, '->', scene.triangle_count, 'triangles, frame saved')
-" "$MOVED" "$WORK/tiny.glb")
+" "$MOVED" "$SRC/data/city.glb")
   loaded=$(cat "$WORK"/py-ld.* | module_loaded_from /dev/stdin)
   echo "consumer-test: the installed pyvislib loaded the image module from $loaded"
   case "$loaded" in "$MOVED/lib/vislib/"*) ;; *) fail "the installed pyvislib did not load the moved prefix's image module";; esac
