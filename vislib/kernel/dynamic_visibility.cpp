@@ -390,7 +390,7 @@ struct Run {
   bool diagonal;      // part of the Diagonal mode (its pieces map onto t)
 };
 
-// ---- Compact pixel lists (issue 13, item 2) ----------------------------------------------
+// ---- Compact pixel lists -----------------------------------------------------------------
 // A GeneralDepth is 136 bytes, so a GeneralPiece is 160; the dense lists of vegetation (a grass
 // field ends with 150 pieces a pixel on average, up to 965) spent most of their time moving them
 // (vector growth, memmove on insertion, page faults). Inside a tile the lists hold a 32-byte
@@ -459,7 +459,7 @@ class DynamicKind {
     zmax_.resize(nprim);
     keep_ties_ = opt.coplanar == CoplanarRule::Both;
     far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
-    // The faces each triangle can reach (issue 13, item 4).
+    // The faces each triangle can reach.
     faces_ = classify_faces(ntri_, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
   }
 

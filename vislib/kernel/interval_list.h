@@ -7,8 +7,8 @@
 // surfaces split at their depth crossings, depth ties go to the lower id. In exact arithmetic the
 // resulting list depends only on the set of inserted intervals. In floating point it does not
 // quite: where three or more depth functions cross near one t, the rounded crossing times of the
-// pairs disagree, and the tiny pieces between them depend on the order of insertion (measured in
-// session 6: the 20 m city street at N = 256 ends with 5,252,188 final pieces in the kernel's
+// pairs disagree, and the tiny pieces between them depend on the order of insertion (measured:
+// the 20 m city street at N = 256 ends with 5,252,188 final pieces in the kernel's
 // order and 5,245,807 in the reverse one, the same visible set and witnesses). The kernel
 // therefore always inserts in one fixed order (nearest depth, then id: tile_driver.h), whatever
 // the thread count, the tiles, or the BVH.
@@ -74,7 +74,7 @@ struct TieRecord {
   uint32_t hidden = 0, front = 0;
 };
 
-// The tie rule of insert_piece. With `sink` null (the default) nothing is recorded: the old rule,
+// The tie rule of insert_piece. With `sink` null (the default) nothing is recorded (rule First):
 // ties settled by depth and then by the lower id alone. The list itself never depends on the rule.
 struct TieRule {
   double eps_z = 0;                        // relative depth tolerance (unitless, >= 0)
@@ -103,7 +103,7 @@ void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& l
   rule.sink->push_back(TieRecord{t0, t1, loser.id, winner.id});
 }
 
-// ---- Division-free decisions for linear depths (issue 13, item 2) ---------------------------
+// ---- Division-free decisions for linear depths ----------------------------------------------
 // The read-only pass of insert_piece asks, per overlapped piece, three questions whose answers
 // come from rounded quotients: is there a depth crossing in (lo, hi) (depth_crossings), which
 // piece is in front at the midpoint (front), and is the loser within eps_z there (record_tie).

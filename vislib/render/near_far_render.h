@@ -1,4 +1,4 @@
-// near_far_render.h: a CPU reference renderer of the near-far frame (issue 7, deliverable 4) and
+// near_far_render.h: a CPU reference renderer of the near-far frame and
 // the metrics that compare it with the full-scene frame.
 //
 // Papers (../shared/papers/): near-far-partitioning.txt §3 (the near, intermediate and far regions
