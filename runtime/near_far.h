@@ -1,6 +1,6 @@
 // near_far.h: near-far partition of a cell's visible set, with the continuous morph, and the
 // progressive near region, as pure functions an engine or a reference renderer calls
-// (issue 7, deliverables 2-3). Standard library only.
+// Standard library only.
 //
 // Papers (../shared/papers/):
 //  - near-far-partitioning.txt §3-4 ("Continuous near-far partitioning"): two co-axial vertical
