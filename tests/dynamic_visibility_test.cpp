@@ -527,7 +527,7 @@ Scene dense_spheres(int count, double extent, uint64_t seed) {
 
 }  // namespace
 
-// Issue 12 item 1. With the eye inside overlapping spheres, a sphere's pixel list holds touching
+// With the eye inside overlapping spheres, a sphere's pixel list holds touching
 // pieces of the same sphere on its entry root and then on its exit root; joining them by id alone
 // kept the entry depth over both, so a sphere behind another's exit surface won (witness of sphere
 // 0 in the repro at t = 0.7162, face 1, pixel (15, 31), where sphere 1's exit lies in front).
@@ -606,7 +606,7 @@ TEST(DynamicVisibility, GeneratedThreeHundredSpheresHaveOnlyTrueWitnesses) {
   }
 }
 
-// Issue 12 item 3: the decoupled mode checked like the diagonal one, at random (eye position s,
+// The decoupled mode checked like the diagonal one, at random (eye position s,
 // animation time tau) pairs on moving triangles and spheres. Pairs on what the mode computes (the
 // diagonal s = tau, the eye fixed at either end while the scene animates, the scene frozen at a
 // key state while the eye moves): every unambiguous first hit of every pixel is in the set.

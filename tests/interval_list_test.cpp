@@ -179,7 +179,7 @@ TEST(IntervalList, ValidityCheckRejectsOverlapsUnmergedNeighboursAndEmptyPieces)
 }
 
 // The read-only pass of insert_piece decides crossings, the nearer piece and the tie test for
-// linear depths from products instead of quotients (issue 13). Wherever those decide, the answer
+// linear depths from products instead of quotients. Wherever those decide, the answer
 // must be the one the divisions give; checked on random depths and on near-equal ones (the same
 // plane scaled, depths one rounding apart, crossings at the interval ends), where they must mostly
 // stay undecided rather than guess.

@@ -217,7 +217,7 @@ TEST(SegmentHardCases, H9_CoplanarDuplicatesGoToTheLowerIdAndACloserOffsetWins) 
   }
 }
 
-// H9 with the tie rule (issue 12 item 2): the list is the same as under the old rule, and the tie
+// H9 with the tie rule: the list is the same as under rule First, and the tie
 // records make both ids visible, for exact duplicates and for a 1e-12 offset; a 1e-3 offset is no
 // tie (eps_z = 1e-6 of the depth 5).
 TEST(SegmentHardCases, H9_CoplanarTiesWithinEpsZMakeBothTrianglesVisibleInEitherOrder) {

@@ -231,7 +231,7 @@ TEST(SegmentOracle, ClosedWavyGridsWithBackgroundHaveNoMissAndNoFalsePositive) {
   check_scene("grids", s, 4, 64, 6, 2);
 }
 
-// The done-when of the from-segment issue: every static scene of ../shared at N = 256.
+// The oracle on real scenes: every static scene of ../shared at N = 256.
 class SharedSceneOracle : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SharedSceneOracle, HasNoMissAndNoFalsePositiveAtN256) {
