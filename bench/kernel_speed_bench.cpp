@@ -1,4 +1,4 @@
-// kernel_speed_bench.cpp: the speed suite of issue 13 (docs/performance.md).
+// kernel_speed_bench.cpp: the kernel speed suite (docs/performance.md).
 //
 // For each case, one from-segment run (6 faces, N = 512) against ONE from-point Embree cubemap at
 // the same eye (v0), resolution and orientation (point_cubemap: first hits by rtcIntersect1M with
