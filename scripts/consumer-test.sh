@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Consumer tests (issue 16): what an engine does with vislib, on a runtime-only build.
+# Consumer tests: what an engine does with vislib, on a runtime-only build.
 #   scripts/consumer-test.sh WORK_DIR
 # 1. configures a fresh VISLIB_RUNTIME_ONLY build of this tree in WORK_DIR/runtime-build and
 #    installs it into WORK_DIR/prefix;
