@@ -1,6 +1,6 @@
 // The dynamic kernel (moving triangles, spheres, the two modes) against a double-precision
-// brute-force ray caster at sampled times (math note §8 with §3-4), plus the hard cases H14, H15
-// and the sphere cases of the dynamic-scenes issue.
+// brute-force ray caster at sampled times (docs/visibility-math.md §8 with §3-4), plus the hard
+// cases H14, H15 and the sphere cases of the dynamic-scenes issue.
 #include "vislib/kernel/dynamic_visibility.h"
 
 #include <gtest/gtest.h>
@@ -579,9 +579,9 @@ TEST(DynamicVisibility, EyeInsideOverlappingSpheresReproHasOnlyTrueWitnesses) {
   }
 }
 
-// The 300-sphere scene of the issue (generate spheres --count 300 --radius 1.5 --area 40 --states 6
-// --max-height 6 --speed 4, the repro's segment): 5 of 136 (diagonal) and 5 of 295 (decoupled)
-// witnesses failed before the fix.
+// A 300-sphere scene (generate spheres --count 300 --radius 1.5 --area 40 --states 6
+// --max-height 6 --speed 4, the repro's segment): merging by id alone made 5 of 136 (diagonal)
+// and 5 of 295 (decoupled) witnesses fail.
 TEST(DynamicVisibility, GeneratedThreeHundredSpheresHaveOnlyTrueWitnesses) {
   SphereOptions so;
   so.count = 300;
