@@ -1,6 +1,6 @@
-// Per-pixel compositing of coverage intervals (interval_list.h, math note §7): insertion-order
-// independence with crossings and ties, interpenetrating surfaces, merging, hidden insertions and
-// lists far longer than any pixel holds in practice.
+// Per-pixel compositing of coverage intervals (interval_list.h, docs/visibility-math.md §7):
+// insertion-order independence with crossings and ties, interpenetrating surfaces, merging, hidden
+// insertions and lists far longer than any pixel holds in practice.
 #include "vislib/kernel/interval_list.h"
 
 #include <gtest/gtest.h>

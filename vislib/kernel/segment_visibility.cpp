@@ -1,6 +1,6 @@
 // segment_visibility.cpp: from-segment visibility for static triangles.
 // Paper: "Complex VEs on All-In-One VR Headsets Through Continuous From-Segment Visibility
-// Computation", §3.1, Alg. 1. Math: shared/design/visibility-math.md §1, §2, §5.1, §6, §7.
+// Computation", §3.1, Alg. 1. Math: docs/visibility-math.md §1, §2, §5.1, §6, §7.
 //
 // The faces, tiles, front-to-back order and per-tile culling are the tile driver's
 // (tile_driver.h, shared with the dynamic kernel). This file is the static kind: the faces each
@@ -37,7 +37,7 @@ namespace vislib {
 StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1) {
   StaticTriangle st;
   const Vec3 delta = v1 - v0;
-  Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (math note §6)
+  Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (docs/visibility-math.md §6)
   for (int e = 0; e < 3; ++e) {
     int i = e, j = (e + 1) % 3;
     // Canonical orientation: P is the lexicographically smaller world endpoint (§2.5).

@@ -1,7 +1,7 @@
 // segment_visibility.h: continuous from-segment visibility for static triangles.
 //
 // Implements §3.1 (Alg. 1) of "Complex VEs on All-In-One VR Headsets Through Continuous
-// From-Segment Visibility Computation" as specified in shared/design/visibility-math.md
+// From-Segment Visibility Computation" as specified in docs/visibility-math.md
 // (§1-2 coverage, §5.1 footprint, §6 numerics, §7 compositing): for every pixel centre of a
 // cubemap that translates (without rotating) along v(t) = v0 + t(v1 - v0), t in [0,1], the exact
 // list of pieces of t during which each triangle is the first hit (lambda > near), composited by
@@ -37,7 +37,8 @@ namespace vislib {
 //    the perimeter is of a view rectangle.
 enum class DynamicMode { Diagonal, Decoupled };
 
-// Depth ties between surfaces (math note H9, docs/visibility.md "Coplanar surfaces"):
+// Depth ties between surfaces (docs/visibility-math.md §7, H9, docs/visibility.md "Coplanar
+// surfaces"):
 //  Both: where the loser of a depth test lies within eps_z (relative) of the winner over a stretch
 //    of the segment, both are visible there (a z-buffer z-fights); the default.
 //  First: the nearer depth wins and exact ties go to the lower id; the set then
