@@ -1,6 +1,6 @@
 // The dynamic kernel (moving triangles, spheres, the two modes) against a double-precision
 // brute-force ray caster at sampled times (docs/visibility-math.md §8 with §3-4), plus the hard
-// cases H14, H15 and the sphere cases of the dynamic-scenes issue.
+// cases H14, H15 and the sphere cases of docs/visibility-math.md §4.
 #include "vislib/kernel/dynamic_visibility.h"
 
 #include <gtest/gtest.h>
