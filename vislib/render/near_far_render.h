@@ -11,8 +11,8 @@
 //     they are; the triangles with some vertex inside r2 and some beyond r1 (intermediate) get each
 //     vertex displaced by pvs_runtime::morph_vertex (Eq. 1; vertices beyond r2 take Eq. 2's
 //     U + P - O, its w_U = 0 end), or, with morph off, stay where they are (the comparison
-//     `pvs view` reports). These triangles are put into one Embree scene and the eye ray is cast against it
-//     exactly as render_frame does (same camera, shading and depth).
+//     `pvs view` reports). These triangles are put into one Embree scene and the eye ray is cast
+//     against it exactly as render_frame does (same camera, shading and depth).
 //  2. Environment map: the visible triangles with a vertex at or beyond r2 (far, plus the
 //     intermediate ones crossing r2: the paper's SF bin) are rendered once from O into a cube map
 //     (vislib/base/cubemap.h convention, identity orientation, `env_size` pixels a side): per pixel
