@@ -6,7 +6,7 @@
 # believing a difference of a few percent.
 #
 #   bench/alternate.sh ROUNDS CASES BIN_A BIN_B
-#   bench/alternate.sh 5 city2,city20,pandora /tmp/ksb_before build/bench/kernel_speed_bench
+#   bench/alternate.sh 5 city2,city20,pandora ../base/build/bench/kernel_speed_bench build/bench/kernel_speed_bench
 #
 # Prints "A case seconds" and "B case seconds" lines (kern_cpu of `--reps 1 --cores 1`).
 # Check that both give the same results first: `BIN --digest FILE --res 256 --cases ...`, then

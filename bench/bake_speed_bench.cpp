@@ -1,5 +1,5 @@
-// bake_speed_bench.cpp: the bake of issue 13 item 6 in cells per minute, with and without the
-// shared edges of item 5 (segment_run_cache.h).
+// bake_speed_bench.cpp: a bake's speed in cells per minute, with and without the
+// edges shared between cells (segment_run_cache.h).
 //
 // A third configuration runs long segments (--long L, default 8; 1 skips it): up to L cell edges
 // end to end as one split run. Its file records the setting in the metadata, so its sets are

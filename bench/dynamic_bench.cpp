@@ -1,4 +1,4 @@
-// dynamic_bench.cpp: the dynamic kernel's two comparisons (dynamic-scenes issue, item 8), each
+// dynamic_bench.cpp: the dynamic kernel's two comparisons, each
 // measured in one process:
 //  1. spheres handled directly against the same spheres tessellated into icospheres (moving
 //     triangles), same segment, same N (the paper reports an order of magnitude);

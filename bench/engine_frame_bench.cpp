@@ -1,5 +1,5 @@
 // engine_frame_bench: the C API's per-frame cost of what an engine's loop does with a PVS
-// (issue 16): find the cell of the eye; on entering a cell, read its visible ids, partition them
+// in order: find the cell of the eye; on entering a cell, read its visible ids, partition them
 // near/far around the cell's default cylinders and start a CloVR growth; every frame, advance the
 // CloVR scheduler (and fetch its near set when it changed). Geometry comes from the scene file
 // (as an engine's own buffers would), everything else through runtime/near_far_c.h.

@@ -1,4 +1,4 @@
-// kernel_speed_bench.cpp: the speed suite of issue 13 (docs/performance.md).
+// kernel_speed_bench.cpp: the kernel speed suite (docs/performance.md).
 //
 // For each case, one from-segment run (6 faces, N = 512) against ONE from-point Embree cubemap at
 // the same eye (v0), resolution and orientation (point_cubemap: first hits by rtcIntersect1M with
@@ -7,7 +7,7 @@
 // processes on the machine falls on both alike and cancels in the ratio. "1 core" runs both inside
 // a one-thread tbb::task_arena; "all cores" in the default arena.
 //
-// Cases (the issue's three, a dynamic and a sphere case):
+// Cases (three static ones, a dynamic and a sphere case):
 //   city2    generate city --target-triangles 300000 --seed 1, 0,1.7,-1 -> 0,1.7,1
 //   city20   same city, 0,1.7,-10 -> 0,1.7,10
 //   pandora  ../shared/scenes/sauer_pandora/pandora.obj, -200,40,0 -> -100,40,0 (if present)

@@ -1,5 +1,5 @@
 // ods_accuracy_bench: the ODS raster method's error against the ray-cast reference by distance
-// (issue 14, deliverable 6), paper formula (Eq. 5) against the exact tangent-ray projection.
+// and the paper formula (Eq. 5) against the exact tangent-ray projection.
 // A plain program (no Google Benchmark timing): prints a Markdown table.
 //
 //   build/bench/ods_accuracy_bench [width]      (default 3840; height = width / 2)

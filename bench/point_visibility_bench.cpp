@@ -1,7 +1,7 @@
-// point_visibility_bench.cpp: one from-point first-hit cubemap (math note §8, Embree baseline) at
-// N = 512 (6*512*512 = 1,572,864 rays) on a generated city: a 150 x 150 grid of boxes (12
-// triangles each, heights 2..30 m, 10 m pitch, 6 m footprint) on a ground quad, 270,002 triangles.
-// The eye is at street level (1.7 m) near the middle; orientation fixed (seed 1).
+// point_visibility_bench.cpp: one from-point first-hit cubemap (docs/visibility-math.md §8, Embree
+// baseline) at N = 512 (6*512*512 = 1,572,864 rays) on a generated city: a 150 x 150 grid of boxes
+// (12 triangles each, heights 2..30 m, 10 m pitch, 6 m footprint) on a ground quad, 270,002
+// triangles. The eye is at street level (1.7 m) near the middle; orientation fixed (seed 1).
 // Argument: TBB thread count (tbb::global_control), 1 and 2.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>

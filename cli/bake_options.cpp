@@ -108,7 +108,7 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
   }
 }
 
-// The preset fills the options not given (issue 17 item 2) and says so on stderr.
+// The preset fills the options not given and says so on stderr.
 void apply_preset(BakeArgs& a, const CLI::App& cmd) {
   const Preset preset = preset_values(a.preset);
   if (cmd.count("--res") == 0) a.resolution = preset.resolution;

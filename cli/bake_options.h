@@ -37,7 +37,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a);
 // --shard i/N.
 vislib::Shard parse_shard(const std::string& text);
 
-// The preset fills the options not given (issue 17 item 2) and says so on stderr (not -q).
+// The preset fills the options not given and says so on stderr (not -q).
 void apply_preset(BakeArgs& a, const CLI::App& cmd);
 
 // The view cells of the options over `scene` (vislib::place_view_cells); a refused placement is

@@ -81,7 +81,7 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
   info.runs = a.runs;
   if (a.grid.empty()) info.cell_size = a.cell_size;
   info.shard = shard;
-  // Every output is checked before any work (issue 17 item 1).
+  // Every output is checked before any work.
   check_output_file(a.output, "--output");
   check_output_file(a.checkpoint.empty() ? a.output + ".ckpt" : a.checkpoint, "--checkpoint");
   if (!a.json_out.empty()) check_output_file(a.json_out, "--json", true);

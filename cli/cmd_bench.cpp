@@ -70,7 +70,7 @@ std::vector<std::string> make_plots(const BenchArgs& a) {
 }
 
 void run(BenchArgs& a) {
-  check_output_dir(a.out, "--out");  // before any work (issue 17 item 1)
+  check_output_dir(a.out, "--out");  // before any work
   std::unique_ptr<tbb::global_control> limit;
   if (a.threads > 0)
     limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,

@@ -31,7 +31,7 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 }
 
 void run_export(const ExportOptions& o) {
-  check_output_file(o.out, "--output");  // before any work (issue 17 item 1)
+  check_output_file(o.out, "--output");  // before any work
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
   double tau = o.time.value_or(0.0);

@@ -47,7 +47,7 @@ void run_inspect(const InspectArgs& a) {
     if (a.scene.empty()) throw CLI::ValidationError("--export-gltf", "needs --scene");
     if (a.cell < 0 && a.at.empty())
       throw CLI::ValidationError("--export-gltf", "needs --cell or --at");
-    check_output_file(a.gltf, "--export-gltf");  // before any work (issue 17 item 1)
+    check_output_file(a.gltf, "--export-gltf");  // before any work
   }
   if (!a.render_dir.empty()) {
     if (a.scene.empty()) throw CLI::ValidationError("--render", "needs --scene");
@@ -90,7 +90,7 @@ void run_inspect(const InspectArgs& a) {
       j["file"] = a.file;
       std::vector<uint32_t> enclosed;
       if (!a.scene.empty()) {
-        // Cells whose view-region centre is enclosed by the scene (issue 17 item 6).
+        // Cells whose view-region centre is enclosed by the scene.
         for (uint32_t k = 0; k < r.cell_count(); ++k)
           if (vislib::point_enclosed(scene, vislib::view_region_centre(info.layout, k)))
             enclosed.push_back(k);
@@ -134,7 +134,7 @@ void run_inspect(const InspectArgs& a) {
     const vislib::Granularity g = vislib::granularity_of(info);
     vislib::CellFreeSpace free_space;
     if (!a.scene.empty()) {
-      // Points of the view region enclosed by the scene (issue 17 item 6).
+      // Points of the view region enclosed by the scene.
       free_space = vislib::cell_free_space(scene, vislib::to_box3(info.layout.view_region(c)));
       j["free_space"] = {{"samples", free_space.samples},
                          {"enclosed", free_space.enclosed},
@@ -164,7 +164,7 @@ void run_inspect(const InspectArgs& a) {
       }
       if (!a.render_dir.empty()) {
         // The viewpoint: the --at point, else the centre of the cell's view region, else (the
-        // centre is enclosed by the scene) the free sample nearest it (issue 17 item 6).
+        // centre is enclosed by the scene) the free sample nearest it.
         vislib::Vec3 eye = vislib::view_region_centre(info.layout, c);
         if (!a.at.empty()) {
           eye = parse_vec3(a.at, "--at");

@@ -23,7 +23,7 @@ void add_merge(CLI::App& app) {
   cmd->add_option("SHARD", *shards, "Shard files, any order")->required();
   cmd->add_option("-o,--output", *out, "Output PVS file")->required();
   cmd->callback([shards, out] {
-    check_output_file(*out, "--output");  // before any work (issue 17 item 1)
+    check_output_file(*out, "--output");  // before any work
     std::vector<pvs::Reader> readers;
     for (const auto& path : *shards)
       readers.push_back(vislib::reading_pvs(path, [&] { return pvs::Reader::from_file(path); }));

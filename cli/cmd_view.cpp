@@ -51,7 +51,7 @@ vislib::CellViewSet read_view_cell(const ViewArgs& a, const vislib::Scene& full_
   return v;
 }
 
-// --centre, or the cell's default (never a point inside a building, issue 17 item 6).
+// --centre, or the cell's default (never a point inside a building).
 vislib::Vec3 view_centre(const ViewArgs& a, const vislib::Scene& full_scene,
                          const vislib::CellViewSet& v) {
   if (!a.centre.empty()) return parse_vec3(a.centre, "--centre");
@@ -204,7 +204,7 @@ void add_view(CLI::App& app) {
   add_ods_view_options(cmd, ods);
   std::shared_ptr<ViewStereoArgs> stereo = add_view_stereo_options(cmd);
   cmd->callback([a, ods, stereo] {
-    // Every output checked before any work, --ods and --stereo too (issue 17 item 1).
+    // Every output checked before any work, --ods and --stereo too.
     check_output_file(a->output, "--output");
     if (!a->json_path.empty()) check_output_file(a->json_path, "--json", true);
     if (ods->enabled && stereo->enabled())

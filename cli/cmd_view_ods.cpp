@@ -1,4 +1,4 @@
-// pvs view --ods: the omnidirectional stereo panoramas (omnidirectional-stereo.txt, issue 14) of
+// pvs view --ods: the omnidirectional stereo panoramas (omnidirectional-stereo.txt) of
 // the PVS cells that cover the viewing disc at --at, the full-scene truth with the same settings,
 // and the metrics. Options and output documented in docs/ods.md.
 #include "cli/cmd_view_ods.h"

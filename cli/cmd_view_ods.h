@@ -1,4 +1,4 @@
-// cmd_view_ods.h: `pvs view --ods`, the omnidirectional stereo panoramas of a cell (issue 14):
+// cmd_view_ods.h: `pvs view --ods`, the omnidirectional stereo panoramas of a cell:
 // the options it adds to `pvs view` (registered by view_options.cpp) and the run. cmd_view.cpp
 // hands over to run_view_ods when --ods is given; docs/ods.md documents the command.
 #pragma once

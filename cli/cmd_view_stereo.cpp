@@ -1,4 +1,4 @@
-// pvs view --stereo: single-render stereo by reprojection (issue 15; YORO, MobiSys '25, with the
+// pvs view --stereo: single-render stereo by reprojection (YORO, MobiSys '25, with the
 // fixes of docs/stereo.md). The dominant eye is rendered from the visible set of the cells that
 // hold the eyes; the other eye is reprojected (vislib/render/stereo.h), its holes patched; both
 // are compared with true renders of that eye from the same set (the method's error) and from the

@@ -1,5 +1,5 @@
-// cmd_view_stereo.h: `pvs view ... --stereo`: single-render stereo by reprojection (issue 15,
-// YORO) after the PVS: the dominant eye draws the cells' visible set, the other eye is reprojected
+// cmd_view_stereo.h: `pvs view ... --stereo`: single-render stereo by reprojection (YORO)
+// after the PVS: the dominant eye draws the cells' visible set, the other eye is reprojected
 // and patched. Options are registered by view_options.cpp, the run lives in cmd_view_stereo.cpp;
 // cmd_view.cpp only hooks them in.
 #pragma once

@@ -41,7 +41,7 @@ void add_segment(CLI::App& app) {
       ->excludes(o_opt);
   cmd->add_flag("--witness", *witness, "Add one witness (face, x, y, t) per visible triangle");
   cmd->callback([=] {
-    check_output_file(a->json_out, "--json", true);  // before any work (issue 17 item 1)
+    check_output_file(a->json_out, "--json", true);  // before any work
     auto limit = thread_limit(a->threads);
     vislib::SegmentOptions so = segment_options(*a);
     so.want_witnesses = *witness;
@@ -116,7 +116,7 @@ void add_region(CLI::App& app) {
                 "Add one witness per id of the union: the perimeter segment and run that saw it, "
                 "and its (face, x, y, t, tau) in that run");
   cmd->callback([=] {
-    check_output_file(a->json_out, "--json", true);  // before any work (issue 17 item 1)
+    check_output_file(a->json_out, "--json", true);  // before any work
     auto limit = thread_limit(a->threads);
     auto b = parse_doubles(*box, "--box", 6);
     vislib::Box3 region;

@@ -1,4 +1,4 @@
-// options.h: the conventions every `pvs` subcommand shares (issue 17 items 1 and 2): verbosity
+// options.h: the conventions every `pvs` subcommand shares: verbosity
 // (-v/-q), output paths checked before any work, validators whose messages name the bounds
 // readably, and the unknown-option check that runs before "--x is required".
 #pragma once

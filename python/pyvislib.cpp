@@ -1,4 +1,4 @@
-// pyvislib.cpp: the Python module `pyvislib` (issue 16, item 6), pybind11 bindings of the vislib
+// pyvislib.cpp: the Python module `pyvislib`, pybind11 bindings of the vislib
 // library as it is: load a scene, from-segment and from-region visibility, read a PVS file through
 // the runtime, render frames with the Embree reference renderer and compare them with the frame
 // metrics. Nothing is recomputed here: every function calls the library function named in its

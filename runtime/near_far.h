@@ -1,13 +1,13 @@
 // near_far.h: near-far partition of a cell's visible set, with the continuous morph, and the
 // progressive near region, as pure functions an engine or a reference renderer calls
-// (issue 7, deliverables 2-3). Standard library only.
+// Standard library only.
 //
 // Papers (../shared/papers/):
 //  - near-far-partitioning.txt §3-4 ("Continuous near-far partitioning"): two co-axial vertical
 //    cylinders of radii r1 < r2 around a centre O split the scene into near (r <= r1), intermediate
 //    and far (r >= r2); Eq. 1 morphs intermediate vertices, Eq. 2 displaces dynamic far vertices,
 //    Eq. 3 depth-tests their fragments against a per-pixel range cube map rendered from O.
-//    Misprint fixed (../shared/design/visibility-math.md, appendix): in Eq. 1 the undefined `a`
+//    Misprint fixed (docs/visibility-math.md, appendix): in Eq. 1 the undefined `a`
 //    is r2 - r, r = distance of the vertex to the cylinder axis.
 //  - clovr-progressive-near-region.txt §3-4 (CloVR): the near region grows ring by ring (equal-area
 //    rings, then merged), new geometry injected with Alg. 1. Misprint fixed: Alg. 1 line 8 is

@@ -1,5 +1,5 @@
 // ods.h: omnidirectional stereo (ODS) equirectangular panoramas with pole merging, as pure
-// functions an engine or a reference renderer calls (issue 14, deliverable 1). Standard library
+// functions an engine or a reference renderer calls. Standard library
 // only, like near_far.h.
 //
 // Paper (../shared/papers/omnidirectional-stereo.txt, Marrinan & Papka): Eq. 1-3 equirectangular
@@ -216,7 +216,7 @@ struct ProjTriangle {
 std::vector<ProjTriangle> split_seam_pole(const std::array<ProjVertex, 3>& v, int pole,
                                           double pole_range);
 
-// ---- The viewing disc and the PVS cells (issue 14, deliverable 4) ---------------------------
+// ---- The viewing disc and the PVS cells -----------------------------------------------------
 
 // The eyes of an ODS panorama centred at c lie on the horizontal disc of radius `radius` (IPD/2)
 // about c. A cell's visible set is valid for eyes in its view region (an axis-aligned box

@@ -1,4 +1,4 @@
-// pvs_runtime.h: what an engine embeds to apply a PVS at run time (issue 7, deliverable 1).
+// pvs_runtime.h: what an engine embeds to apply a PVS at run time.
 //
 // Opens a PVS file (docs/pvs-format.md) memory-mapped, checks that it was baked for the engine's
 // scene (the 64-bit scene fingerprint), finds the view cell of the eye position and the cells

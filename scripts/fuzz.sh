@@ -8,7 +8,7 @@
 #   FUZZ_SECONDS_PER_TARGET=600 bash scripts/fuzz.sh ply_loader_fuzz   # one target, 10 minutes
 #   bash scripts/fuzz.sh merge [TARGET]   # minimise seeds + new inputs into fuzz/corpus/<name>
 #
-# Before fuzzing, every seed (the issue-18 repros among them) is run once through its target, and
+# Before fuzzing, every seed (the crash repros among them) is run once through its target, and
 # when ../shared/repros and build/cli/pvs exist, `pvs info` must exit 2 on each repro.
 # Needs clang++ and the libFuzzer runtime (Debian: clang, libclang-rt-14-dev), and for the scene
 # loaders the Debian packages of tinygltf, meshoptimizer and nlohmann-json (as vislib itself).
@@ -43,7 +43,7 @@ if [[ $mode == merge ]]; then
   exit 0
 fi
 
-# The repros of issue 18 through the CLI: exit 2 with a message, quickly.
+# The crash repros of ../shared/repros through the CLI: exit 2 with a message, quickly.
 if [[ -d ../shared/repros && -x build/cli/pvs ]]; then
   for f in ../shared/repros/ply-*.ply ../shared/repros/off-oom.off; do
     [[ -e $f ]] || continue

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Slurm, run for real (issue 18): starts a single-node Slurm on this machine (Debian's slurmctld +
+# Slurm, run for real: starts a single-node Slurm on this machine (Debian's slurmctld +
 # slurmd + munge, every file and socket in a private temporary folder), submits the job-array bake
 # of docs/bake.md for a generated city as shards, merges them with `pvs merge`, and checks that the
 # bytes equal a single-process bake of the same cells. Prints the wall time of both.

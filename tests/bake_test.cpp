@@ -1,5 +1,5 @@
 // Tests of the bake (library): byte-identical output for any thread count, shards merged into
-// the same bytes, edges shared between cells computed once (issue 13 item 5), resume from a
+// the same bytes, edges shared between cells computed once, resume from a
 // checkpoint (including one torn at any byte), refusal of another bake's checkpoint, and the scene
 // fingerprint and subset the PVS relies on.
 #include "vislib/bake/bake.h"
@@ -227,9 +227,9 @@ std::string checkpoint_of_38(const std::string& path, std::vector<size_t>& ends,
 
 }  // namespace
 
-// Issue 18: one flipped byte at a quarter of a 38-record checkpoint used to drop the valid records
-// after it. Now only the damaged record is dropped (skipped by its size field), whatever byte of
-// it is hit, and appending continues after the last record.
+// One flipped byte at a quarter of a 38-record checkpoint drops only the damaged record (skipped by
+// its size field), never the valid records after it, whatever byte of it is hit, and appending
+// continues after the last record.
 TEST(Checkpoint, FlippedByteAtAQuarterKeepsEveryOtherRecord) {
   std::string dir = temp_dir("checkpoint_flip");
   std::string path = dir + "/c.ckpt";
@@ -443,7 +443,7 @@ TEST(CellSet, UnionOfSetsIsEveryTriangleOfAnySetAscending) {
                               Granularity::Object));
 }
 
-// Shared edges (issue 13 item 5): run 0 of an edge common to two cells is computed once
+// Shared edges: run 0 of an edge common to two cells is computed once
 // (segment_run_cache.h), and the file is byte-identical to a bake that computes every cell alone.
 TEST(BakeSharedSegments, SetsEqualBakingEachCellAloneWithFewerRuns) {
   const Scene scene = small_city();
@@ -543,7 +543,7 @@ TEST(SegmentRunCache, AnExceptionReachesEveryWaitingCaller) {
   EXPECT_EQ(cache.entries_held(), 0u);
 }
 
-// Long segments (issue 13 item 5): end-to-end edges on one line form chains of at most max_parts;
+// Long segments: end-to-end edges on one line form chains of at most max_parts;
 // one computation per chain, split at the junctions, each edge gets its part.
 TEST(SegmentRunCache, ChainsOfEdgesEndToEndRunOnceAndHandEachEdgeItsPart) {
   SegmentRunCache cache;

@@ -299,7 +299,7 @@ std::string sphere_scene(const std::string& dir, bool ground) {
 
 }  // namespace
 
-// Issue 12 items 5 and 6: one id rule for bake, inspect and view, on a sphere scene and on a
+// One id rule for bake, inspect and view, on a sphere scene and on a
 // scene of a mesh plus spheres given from the command line (a `mesh` line in the sphere file).
 TEST(CliBake, SphereAndMixedScenesBakeInspectAndViewWithOneIdUniverse) {
   std::string dir = temp_dir("cli_spheres");
@@ -347,7 +347,7 @@ TEST(CliBake, SphereAndMixedScenesBakeInspectAndViewWithOneIdUniverse) {
   }
 }
 
-// Issue 12 item 8: an animated glTF without --states warns and names the option; a scene far from
+// An animated glTF without --states warns and names the option; a scene far from
 // the origin warns; `pvs info` makes no units claim.
 TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
   VISLIB_REQUIRE_SHARED(shared);
@@ -369,7 +369,7 @@ TEST(CliBake, LoadingTrapsWarnAndNameWhatToDo) {
   EXPECT_TRUE(json::parse(out.substr(brace))["far_from_origin"].get<bool>());
 }
 
-// Long segments (issue 13 item 5, --long-segments L): the summary counts the kernel runs, the
+// Long segments (--long-segments L): the summary counts the kernel runs, the
 // metadata records the setting, the sets equal those of the default (edges only), and an
 // out-of-range value is refused naming the option.
 TEST(CliBake, LongSegmentsRunFewerSegmentsForTheSameSets) {
@@ -427,7 +427,7 @@ TEST(CliBake, LongSegmentsAutoReportsItsPilotAndBakesTheChosenLength) {
   EXPECT_EQ(vislib::read_file(dir + "/auto.pvs"), vislib::read_file(dir + "/fixed.pvs"));
 }
 
-// Issue 13 item 4: the BVH every run walks changes nothing in the file; pvs segment and pvs
+// The BVH every run walks changes nothing in the file; pvs segment and pvs
 // region give the same sets with and without it, and report its build time.
 TEST(CliBake, TheBvhWalkGivesTheSameFileAndTheSameSets) {
   std::string dir = temp_dir("cli_bake_bvh");

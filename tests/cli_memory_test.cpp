@@ -1,4 +1,4 @@
-// Out of memory through the command line (issue 18 item 6): an allocation that fails names the
+// Out of memory through the command line: an allocation that fails names the
 // stage that was running and the size of the failed request, exits 1 and leaves no output file.
 // The limit is an address-space cap (prlimit --as) on the `pvs` process alone.
 #include <gtest/gtest.h>

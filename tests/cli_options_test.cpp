@@ -1,4 +1,4 @@
-// Tests of the conventions every `pvs` command shares (issue 17 items 1 and 2), run as a user runs
+// Tests of the conventions every `pvs` command shares, run as a user runs
 // them: outputs checked before any work (exit 2 naming the path and the problem, parent folders
 // created, no checkpoint left), -v/-q on every command, -j, --preset, the unknown option named
 // first, validator messages without DBL_MAX, and progress inside a long cell.
@@ -161,7 +161,7 @@ TEST(CliConventions, QuietSilencesProgressAndWarnings) {
   EXPECT_GT(verbose.size(), normal.size()) << verbose;
 }
 
-// Issue 17 item 2 (audit of -q): every command run with -q on inputs that make it warn and report
+// The -q audit: every command run with -q on inputs that make it warn and report
 // progress leaves stderr empty, and commands whose results go to files leave stdout empty too;
 // each input is first run without -q to show that it does warn (so the check can fail). Errors
 // still print with -q.

@@ -1,6 +1,6 @@
 // The dynamic kernel (moving triangles, spheres, the two modes) against a double-precision
-// brute-force ray caster at sampled times (math note §8 with §3-4), plus the hard cases H14, H15
-// and the sphere cases of the dynamic-scenes issue.
+// brute-force ray caster at sampled times (docs/visibility-math.md §8 with §3-4), plus the hard
+// cases H14, H15 and the sphere cases of docs/visibility-math.md §4.
 #include "vislib/kernel/dynamic_visibility.h"
 
 #include <gtest/gtest.h>
@@ -527,7 +527,7 @@ Scene dense_spheres(int count, double extent, uint64_t seed) {
 
 }  // namespace
 
-// Issue 12 item 1. With the eye inside overlapping spheres, a sphere's pixel list holds touching
+// With the eye inside overlapping spheres, a sphere's pixel list holds touching
 // pieces of the same sphere on its entry root and then on its exit root; joining them by id alone
 // kept the entry depth over both, so a sphere behind another's exit surface won (witness of sphere
 // 0 in the repro at t = 0.7162, face 1, pixel (15, 31), where sphere 1's exit lies in front).
@@ -579,9 +579,9 @@ TEST(DynamicVisibility, EyeInsideOverlappingSpheresReproHasOnlyTrueWitnesses) {
   }
 }
 
-// The 300-sphere scene of the issue (generate spheres --count 300 --radius 1.5 --area 40 --states 6
-// --max-height 6 --speed 4, the repro's segment): 5 of 136 (diagonal) and 5 of 295 (decoupled)
-// witnesses failed before the fix.
+// A 300-sphere scene (generate spheres --count 300 --radius 1.5 --area 40 --states 6
+// --max-height 6 --speed 4, the repro's segment): merging by id alone made 5 of 136 (diagonal)
+// and 5 of 295 (decoupled) witnesses fail.
 TEST(DynamicVisibility, GeneratedThreeHundredSpheresHaveOnlyTrueWitnesses) {
   SphereOptions so;
   so.count = 300;
@@ -606,7 +606,7 @@ TEST(DynamicVisibility, GeneratedThreeHundredSpheresHaveOnlyTrueWitnesses) {
   }
 }
 
-// Issue 12 item 3: the decoupled mode checked like the diagonal one, at random (eye position s,
+// The decoupled mode checked like the diagonal one, at random (eye position s,
 // animation time tau) pairs on moving triangles and spheres. Pairs on what the mode computes (the
 // diagonal s = tau, the eye fixed at either end while the scene animates, the scene frozen at a
 // key state while the eye moves): every unambiguous first hit of every pixel is in the set.

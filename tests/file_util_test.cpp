@@ -40,8 +40,8 @@ void age(const std::string& path, int seconds) {
 
 }  // namespace
 
-// The attack of issue 18: a symbolic link planted at the temporary name the old writer predicted
-// (`path.tmp.<pid>`) made it overwrite the link's target.
+// The attack: a symbolic link planted at a predictable temporary name (`path.tmp.<pid>`) makes a
+// writer that uses that name overwrite the link's target.
 TEST(AtomicFile, PlantedSymlinkAtThePredictableTempNameIsNotFollowed) {
   std::string dir = temp_dir("atomic_symlink");
   std::string victim = dir + "/victim", out = dir + "/out.pvs";

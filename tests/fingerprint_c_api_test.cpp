@@ -1,4 +1,4 @@
-// The scene fingerprint from an engine's own buffers (pvs_rt_scene_fingerprint, issue 16) equals
+// The scene fingerprint from an engine's own buffers (pvs_rt_scene_fingerprint) equals
 // the bake's (vislib::scene_fingerprint, what `pvs bake` writes into the PVS header), with the
 // meshes taken as the id map's runs (vislib/scene/id_map.h, `pvs export --id-map`).
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
-// Conservative pixel footprints (footprint.h, math note §5.1): every pixel whose ray hits the
-// triangle from some eye position on the segment lies in the footprint's pixel bounds and row
-// spans (brute force over sampled eye positions), also for triangles cut by the near plane.
+// Conservative pixel footprints (footprint.h, docs/visibility-math.md §5.1): every pixel whose ray
+// hits the triangle from some eye position on the segment lies in the footprint's pixel bounds and
+// row spans (brute force over sampled eye positions), also for triangles cut by the near plane.
 #include "vislib/kernel/footprint.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Tests of the glTF export of a visible set (pvs inspect --export-gltf; issue 17 item 5): what a
+// Tests of the glTF export of a visible set (pvs inspect --export-gltf): what a
 // viewer needs survives (materials, textures, normals, UVs, copyright), the triangles come back
 // in order, and the Khronos glTF validator finds no error in the export of every shared scene.
 #include <gtest/gtest.h>

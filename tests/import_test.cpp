@@ -319,7 +319,7 @@ TEST(ImportSpheres, MalformedLineNamesTheLineNumber) {
   }
 }
 
-// Issue 12 item 6: a `mesh` line adds a static mesh before the spheres (triangles first, then
+// A `mesh` line adds a static mesh before the spheres (triangles first, then
 // spheres); a bad mesh line names the sphere file and its line.
 TEST(ImportSpheres, MeshLineAddsAGroundBeforeTheSpheres) {
   std::string dir = temp_dir("spheres_mesh");

@@ -1,6 +1,6 @@
 // Tests of the project's own PLY, OFF and STL readers (vislib/scene/import_{ply,off,stl}.cpp):
 // well-formed files in every encoding, the hand-made malformed files in tests/data/malformed, and
-// the crash/hang/out-of-memory repros of issue 18 in ../shared/repros (skipped when absent).
+// the crash/hang/out-of-memory repros in ../shared/repros (skipped when absent).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -176,8 +176,8 @@ TEST(ImportStl, HandMadeMalformedFilesGiveInputErrors) {
   expect_input_error(d + "stl-ascii-short-vertex.stl", "'endloop' is not a number");
 }
 
-// The inputs of issue 18 crashed (signal 11), hung with memory growing to 3.5 GB, or threw
-// std::bad_alloc through OpenMesh. Through `pvs info` each must now exit 2 naming the file.
+// The repros crashed (signal 11), hung with memory growing to 3.5 GB, or threw std::bad_alloc
+// through OpenMesh's readers. Through `pvs info` each must exit 2 naming the file.
 TEST(ImportRepros, SharedReprosExitTwoWithAMessage) {
   VISLIB_REQUIRE_SHARED(shared);
   const std::string dir = shared + "/repros";

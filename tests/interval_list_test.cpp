@@ -1,6 +1,6 @@
-// Per-pixel compositing of coverage intervals (interval_list.h, math note §7): insertion-order
-// independence with crossings and ties, interpenetrating surfaces, merging, hidden insertions and
-// lists far longer than any pixel holds in practice.
+// Per-pixel compositing of coverage intervals (interval_list.h, docs/visibility-math.md §7):
+// insertion-order independence with crossings and ties, interpenetrating surfaces, merging, hidden
+// insertions and lists far longer than any pixel holds in practice.
 #include "vislib/kernel/interval_list.h"
 
 #include <gtest/gtest.h>
@@ -179,7 +179,7 @@ TEST(IntervalList, ValidityCheckRejectsOverlapsUnmergedNeighboursAndEmptyPieces)
 }
 
 // The read-only pass of insert_piece decides crossings, the nearer piece and the tie test for
-// linear depths from products instead of quotients (issue 13). Wherever those decide, the answer
+// linear depths from products instead of quotients. Wherever those decide, the answer
 // must be the one the divisions give; checked on random depths and on near-equal ones (the same
 // plane scaled, depths one rounding apart, crossings at the interval ends), where they must mostly
 // stay undecided rather than guess.

@@ -1,4 +1,4 @@
-// The speed work of issue 13 must not change any result: footprint bounds without the hull, the
+// The kernel's speed techniques must not change any result: footprint bounds without the hull, the
 // per-pixel depth culling, and the vectorised coverage are checked against the plain paths.
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -209,7 +209,7 @@ TEST(KernelSpeed, MarksWithoutWitnessesGiveTheVisibleSetOfTheWitnessRun) {
   }
 }
 
-// Issue 13 item 5, long segments: one run along a segment split at s_1 < s_2 < ... gives, for
+// Long segments: one run along a segment split at s_1 < s_2 < ... gives, for
 // each part, the set of a run over that part alone. The end points are chosen so that every
 // junction v0 + s (v1 - v0) is exactly representable (dyadic s, integer coordinates).
 TEST(SplitSegment, EachPartGivesTheSetOfARunOverThatPartAlone) {

@@ -294,9 +294,9 @@ TEST(OdsProjection, IpdZeroGivesTheMonoProjectionForBothEyes) {
 
 // The paper's Eq. 5 against the exact tangent ray, 3840 px wide (10.67 px a degree both ways),
 // IPD 6.4 cm. On the equator only the longitude differs: atan vs asin of h/r_h, 0.08 px at
-// r_h = 0.5 m, 1.24 px at 0.2 m, 9.8 px at 0.1 m (the "10 px at 0.1 m"). Off the
+// r_h = 0.5 m, 1.24 px at 0.2 m, 9.8 px at 0.1 m (about 10 px at 0.1 m). Off the
 // equator the latitude differs too (sqrt(r_h^2 + h^2) vs sqrt(r_h^2 - h^2)), worst near 45 deg:
-// 1.25 px at 0.5 m (the "1 px"), 7.9 px at 0.2 m (not the "3 px") and 33 px at
+// 1.25 px at 0.5 m (about 1 px), 7.9 px at 0.2 m (more than the 3 px one might expect) and 33 px at
 // 0.1 m.
 TEST(OdsProjection, Eq5ErrorAgainstTheTangentRayInPixels) {
   const double px_per_rad = 3840 / (2 * kPi), h = 0.032;

@@ -93,7 +93,7 @@ TEST(PointVisibility, CubemapConventionPutsTriangleAtTheTablePixel) {
   const double sc = pixel_center(x, n), tc = pixel_center(y, n);
   struct Case {
     int face;
-    Vec3 d;  // the binding table of cubemap.h / math note §1, written out by hand
+    Vec3 d;  // the binding table of cubemap.h / docs/visibility-math.md §1, written out by hand
     int axis;
   };
   const Case cases[] = {{0, {1, -tc, -sc}, 0}, {5, {-sc, -tc, -1}, 2}, {2, {sc, 1, tc}, 1}};

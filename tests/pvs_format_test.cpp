@@ -441,7 +441,7 @@ TEST(PvsFormat, FuzzCorpusIsReadOrRejectedCleanly) {
   EXPECT_GE(files, 2u);
 }
 
-// docs/pvs-format.md, RunLength: the worked byte example, both ways (issue 17 item 4): the
+// docs/pvs-format.md, RunLength: the worked byte example, both ways: the
 // writer gives the doc's bytes, and the doc's decoder (pseudocode, transcribed) gives the ids back.
 TEST(PvsFormat, RunLengthWorkedExampleOfTheSpecIsExact) {
   const std::vector<uint32_t> ids = {3, 4, 5, 9, 200, 201, 202};

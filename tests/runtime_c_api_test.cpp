@@ -1,4 +1,4 @@
-// The consumer side of the C API (runtime/near_far_c.h, issue 16): the near-far partition, the
+// The consumer side of the C API (runtime/near_far_c.h): the near-far partition, the
 // Eq. 1/4/5 morph, Eq. 2/3, the CloVR scheduler, version and fingerprint argument checks. Every
 // call goes through the C functions; expectations are computed here from the papers' formulas.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The hard cases H1-H13 of shared/design/visibility-math.md §6, one named test each, with an
+// The hard cases H1-H13 of docs/visibility-math.md §6, one named test each, with an
 // exact CGAL oracle where arithmetic is the point.
 #include <CGAL/Gmpq.h>
 #include <gtest/gtest.h>
@@ -81,8 +81,8 @@ TEST(SegmentHardCases, H2_PersistentOnEdgeTieGivesExactlyOneTriangleAtEveryPixel
     EXPECT_TRUE(std::isfinite(w.depth.at(0)) && std::isfinite(w.depth.at(1)));
   }
   // With the binding table, T = (0,-1,0) on +Z: the perturbation d + eps S + eps^2 T tilts the
-  // ray towards -y, so T2 (the lower triangle) wins. (The math note's first-draft table has +y
-  // and names T1.)
+  // ray towards -y, so T2 (the lower triangle) wins. (An earlier table with +y named
+  // T1: docs/visibility-math.md §6.)
   EXPECT_EQ(winners_t2, N);
   // A = 0, B != 0: constant coverage over [0,1], no NaN/inf.
   Cov c = coverage(t1, v0, v1, Vec3{0.1, 0.2, 1});
@@ -186,8 +186,8 @@ TEST(SegmentHardCases, H8_InterpenetratingTrianglesSplitAtTheDepthCrossingInEith
     ASSERT_EQ(l.size(), 2u);
     EXPECT_EQ(l[0].id, 2u);
     EXPECT_EQ(l[0].t0, 0.0);
-    // The crossing from P = N_i D_j - N_j D_i (math note §3.4) is exactly 0.5 here; the slope and
-    // offset form (L0 = N0/Dn, L1 = -N1/Dn) gave 0.49999999999998934.
+    // The crossing from P = N_i D_j - N_j D_i (docs/visibility-math.md §3.4) is exactly 0.5 here;
+    // the slope and offset form (L0 = N0/Dn, L1 = -N1/Dn) gave 0.49999999999998934.
     EXPECT_EQ(l[0].t1, 0.5);
     EXPECT_EQ(l[1].id, 1u);
     EXPECT_EQ(l[1].t0, l[0].t1);
@@ -217,7 +217,7 @@ TEST(SegmentHardCases, H9_CoplanarDuplicatesGoToTheLowerIdAndACloserOffsetWins) 
   }
 }
 
-// H9 with the tie rule (issue 12 item 2): the list is the same as under the old rule, and the tie
+// H9 with the tie rule: the list is the same as under rule First, and the tie
 // records make both ids visible, for exact duplicates and for a 1e-12 offset; a 1e-3 offset is no
 // tie (eps_z = 1e-6 of the depth 5).
 TEST(SegmentHardCases, H9_CoplanarTiesWithinEpsZMakeBothTrianglesVisibleInEitherOrder) {
@@ -296,7 +296,8 @@ Q qdot(const QV& a, const QV& b) {
 QV qcross(const QV& a, const QV& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-// Exact event time of edge P->Q for eye v0 -> v1 and direction d: -B/A (math note §2.1).
+// Exact event time of edge P->Q for eye v0 -> v1 and direction d: -B/A (docs/visibility-math.md
+// §2.1).
 Q exact_event(Vec3 P, Vec3 Qp, Vec3 v0, Vec3 v1, Vec3 d) {
   QV e = qv(Qp) - qv(P), D = qv(v1) - qv(v0), w = qv(v0) - qv(P), dd = qv(d);
   Q A = qdot(dd, qcross(e, D)), B = qdot(dd, qcross(e, w));

@@ -1,8 +1,8 @@
-// The independent oracle of math note §8 for the from-segment kernel: Embree ray casts at random
-// t through every pixel centre (forward check: nothing missed) and a re-cast at the middle of
-// every final piece (converse check: nothing extra, so every witness holds). Samples the oracle
-// calls ambiguous (float vs double, edges, coplanar surfaces, the near plane) are skipped and
-// counted; everything else must agree exactly.
+// The independent oracle of docs/visibility-math.md §8 for the from-segment kernel: Embree ray
+// casts at random t through every pixel centre (forward check: nothing missed) and a re-cast at the
+// middle of every final piece (converse check: nothing extra, so every witness holds). Samples the
+// oracle calls ambiguous (float vs double, edges, coplanar surfaces, the near plane) are skipped
+// and counted; everything else must agree exactly.
 #include <gtest/gtest.h>
 #include <tbb/parallel_for.h>
 
@@ -231,7 +231,7 @@ TEST(SegmentOracle, ClosedWavyGridsWithBackgroundHaveNoMissAndNoFalsePositive) {
   check_scene("grids", s, 4, 64, 6, 2);
 }
 
-// The done-when of the from-segment issue: every static scene of ../shared at N = 256.
+// The oracle on real scenes: every static scene of ../shared at N = 256.
 class SharedSceneOracle : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(SharedSceneOracle, HasNoMissAndNoFalsePositiveAtN256) {

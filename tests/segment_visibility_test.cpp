@@ -274,8 +274,8 @@ Scene coplanar_rooms(uint64_t seed) {
 
 }  // namespace
 
-// Issue 12 item 2: the same scene moved 1e5 m, rotated and scaled (units changed) gives the same
-// set (ids are kept) on random segments, the cube rotated with it. Under the old rule the coplanar
+// The same scene moved 1e5 m, rotated and scaled (units changed) gives the same
+// set (ids are kept) on random segments, the cube rotated with it. Under rule First the coplanar
 // overlaps are settled by rounding, which the transform changes.
 TEST(SegmentVisibility, MovedRotatedScaledCopyGivesTheSameSetWithCoplanarTies) {
   Scene a = coplanar_rooms(3);
@@ -317,11 +317,11 @@ TEST(SegmentVisibility, MovedRotatedScaledCopyGivesTheSameSetWithCoplanarTies) {
       "[moved copy] %zu ids over 6 segments; symmetric difference %zu with coplanar ties, %zu with "
       "the old rule\n",
       ids, diff_ties, diff_first);
-  // The scene must exercise the rule: the old rule differs between the two copies.
+  // The scene must exercise the rule: rule First differs between the two copies.
   EXPECT_GT(diff_first, 0u);
 }
 
-// Issue 12 item 4: a region's union carries a witness per id, which one double-precision ray
+// A region's union carries a witness per id, which one double-precision ray
 // cast from outside confirms (run orientation re-derived from the seed, as a user would).
 TEST(RegionVisibility, EveryIdOfTheUnionHasAWitnessThatRecastsToIt) {
   Scene s = random_soup(400, 43, 10, 0.8);

@@ -1,4 +1,4 @@
-// Tests of vislib/render/stereo.h: single-render stereo by reprojection (YORO, issue 15).
+// Tests of vislib/render/stereo.h: single-render stereo by reprojection (YORO).
 // The oracle is independent of the reprojection: the true second eye is rendered by Embree, and a
 // pixel is a true hole iff its world point is outside the source eye's image or hidden from the
 // source eye (an Embree ray from the source eye towards it hits another triangle first).

@@ -1,4 +1,4 @@
-// The BVH walk of the tile driver (issue 13, item 4): the tree is well formed, a node's
+// The BVH walk of the tile driver: the tree is well formed, a node's
 // rectangle and depth bound those of every triangle inside it, and a run that walks the tree gives
 // bit-identical lists, sets and witnesses to a run that bins every triangle.
 #include "vislib/kernel/triangle_bvh.h"

@@ -207,7 +207,7 @@ TEST(ViewCells, CellVisibilityIsTheSameWithOneAndTwoThreads) {
   EXPECT_NE(cell_seed(7, 0), cell_seed(7, 1));
 }
 
-// Issue 17 item 6: a walkable column that straddles a building holds points inside it.
+// A walkable column that straddles a building holds points inside it.
 TEST(ViewCellsFreeSpace, PointInsideClosedBoxIsEnclosedAndStreetPointIsNot) {
   Scene s = test_level();  // floor 10 x 10, box 4 x 5 x 4 at the corner
   EXPECT_TRUE(point_enclosed(s, {2, 1.6, 2}));

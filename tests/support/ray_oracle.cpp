@@ -1,5 +1,5 @@
-// ray_oracle.cpp: the ray-cast oracle of math note §8 (Embree with ambiguity tests, and a
-// double-precision brute-force reference).
+// ray_oracle.cpp: the ray-cast oracle of docs/visibility-math.md §8 (Embree with ambiguity tests,
+// and a double-precision brute-force reference).
 #include "tests/support/ray_oracle.h"
 
 #include <algorithm>

@@ -1,4 +1,5 @@
-// ray_oracle.h: the ray-cast test oracle of math note §8 for the from-segment algorithm.
+// ray_oracle.h: the ray-cast test oracle of docs/visibility-math.md §8 for the from-segment
+// algorithm.
 //
 // Two independent first-hit answers for the ray (v(t), d) of a cubemap pixel, v(t) = v0 + t(v1-v0),
 // d = pixel_direction(face_axes(face, R), x, y, n), hits at lambda > z_near:
@@ -28,7 +29,7 @@ constexpr double kOracleDepthGap = 1e-6;    // next surface within this gap, rel
 constexpr double kOracleNearBand =
     1e-6;  // a surface within this band of z_near, relative to z_near
 
-// Tolerances of brute_force_first_hit (math note §8 "Reference").
+// Tolerances of brute_force_first_hit (docs/visibility-math.md §8 "Reference").
 constexpr double kReferenceBarycentric = 1e-9;  // smallest barycentric (unitless)
 constexpr double kReferenceDepthGap = 1e-7;     // gap to the next hit, relative to lambda
 constexpr double kReferenceNear = 1e-9;         // |lambda - z_near|, absolute (depth units)

@@ -254,7 +254,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                   with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
                 }));
   } catch (...) {
-    // A bake that recorded nothing leaves no checkpoint behind (issue 17 item 1).
+    // A bake that recorded nothing leaves no checkpoint behind.
     if (checkpoint && done == 0) checkpoint->remove();
     throw;
   }

@@ -26,7 +26,7 @@ struct BakeSettings {
   // Compute each world-aligned run (run 0) of an edge shared by several cells once
   // (segment_run_cache.h). Never changes the sets; false recomputes it for every cell.
   bool share_segments = true;
-  // Long segments (issue 13 item 5; with share_segments, static scenes without spheres): run 0 of
+  // Long segments (with share_segments, static scenes without spheres): run 0 of
   // up to this many cell edges lying end to end on one line runs as one segment whose per-pixel
   // lists are split per edge (segment_run_cache.h); at most kMaxSplitParts. 1 = off. Recorded in
   // the file's metadata when on: a set can differ from the per-edge runs where an event falls
@@ -38,7 +38,7 @@ struct BakeSettings {
   int long_segments = 1;
   // Static scenes without spheres: build one BVH of the triangles (triangle_bvh.h) that every run
   // of the bake walks per tile, instead of each run computing footprint bounds for every
-  // triangle on every face (issue 13, item 4). The file is byte-identical either way.
+  // triangle on every face. The file is byte-identical either way.
   bool bvh = true;
 };
 

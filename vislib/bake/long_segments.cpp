@@ -26,7 +26,7 @@ double estimated_work(const SegmentStats& s) {
   // (triangle, tile) pair costs the setup and the row spans of a triangle; a BVH node opened, the
   // footprint rectangles of its children. Per-pixel and per-piece terms did not improve the fit.
   // Without a BVH (--bvh off) every run bounds every triangle on every face: 0.4 per (triangle,
-  // face), fitted (session 12) to 15 pilot runs on four bakes with --bvh off at the weights above
+  // face), fitted to 15 pilot runs on four bakes with --bvh off at the weights above
   // (rms 3.7%; 8.0% with this term left out, which kept L = 4 where L = 8 was faster).
   return double(s.covered_pairs) + 4.0 * double(s.triangle_tiles) +
          6.0 * double(s.bvh_nodes_opened) + 0.4 * double(s.primitives_bounded);

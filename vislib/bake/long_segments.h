@@ -1,5 +1,5 @@
 // long_segments.h: the automatic choice of a bake's long-segment length (`pvs bake
-// --long-segments auto`, BakeSettings::long_segments = 0; issue 13 item 5).
+// --long-segments auto`, BakeSettings::long_segments = 0).
 //
 // Long segments pay where a run's cost grows more slowly than its length (many small cells over
 // a large scene) and cost where it grows faster (large cells: more pieces per pixel, less

@@ -154,7 +154,7 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
                                const RegionOptions& options,
                                const std::function<void(double)>& progress = {});
 
-// --- Free space (issue 17 item 6) ---------------------------------------------------------------
+// --- Free space ---------------------------------------------------------------------------------
 // Walkable cells are columns over floor: a column that straddles a building holds points inside
 // it. These functions find such points without Embree (brute force over the triangles, so cost is
 // O(triangles) per ray: meant for a few points per cell, not for whole bakes).

@@ -1,4 +1,4 @@
-// cubemap.cpp: random cube orientations (math note §1).
+// cubemap.cpp: random cube orientations (docs/visibility-math.md §1).
 #include "vislib/base/cubemap.h"
 
 #include <cmath>

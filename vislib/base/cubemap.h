@@ -1,5 +1,6 @@
-// cubemap.h: the binding cubemap convention (math note §1). Every kernel (from-segment,
-// from-point, renderer, oracle) uses exactly these faces, pixel centres and directions.
+// cubemap.h: the binding cubemap convention (docs/visibility-math.md §1). Every kernel
+// (from-segment, from-point, renderer, oracle) uses exactly these faces, pixel centres and
+// directions.
 //
 // Faces 0..5 = +X, -X, +Y, -Y, +Z, -Z (OpenGL cube-map table). Face k has a forward axis F and the
 // axes S, T along which the pixel-centre coordinates sc, tc grow. For pixel (x, y) of an N x N face

@@ -1,5 +1,5 @@
-// polynomial.h: numerically careful real roots of low-degree polynomials (math note §6), for the
-// quadratic events of moving triangles and spheres.
+// polynomial.h: numerically careful real roots of low-degree polynomials (docs/visibility-math.md
+// §6), for the quadratic events of moving triangles and spheres.
 #pragma once
 
 #include <cmath>
@@ -57,9 +57,9 @@ inline double poly_eval(const double* c, int deg, double t) {
 // Roots of c[0..deg] (deg <= 6) strictly inside (lo, hi), ascending, written to out (at most
 // deg). Degree <= 2: closed form (solve_quadratic; may include a double root). Higher: the roots
 // of the derivative cut (lo, hi) into monotone pieces, and each piece whose ends differ in sign is
-// bisected to the last bit (Yuksel, HPG 2022, math note §3.4). Leading zero coefficients are
-// dropped. Callers classify the pieces between roots by their midpoints.
-// False when c[0..deg] certainly has no root in [lo, hi] (0 <= lo <= hi): interval Horner.
+// bisected to the last bit (Yuksel, HPG 2022, docs/visibility-math.md §3.4). Leading zero
+// coefficients are dropped. Callers classify the pieces between roots by their midpoints. False
+// when c[0..deg] certainly has no root in [lo, hi] (0 <= lo <= hi): interval Horner.
 inline bool poly_may_vanish(const double* c, int deg, double lo, double hi) {
   double a = c[deg], b = c[deg];
   for (int k = deg - 1; k >= 0; --k) {

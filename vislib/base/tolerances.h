@@ -1,19 +1,21 @@
 // tolerances.h: every tolerance of the visibility kernels, named, with its unit and the direction
-// in which it errs (house style §5). Predicates themselves compare with 0 exactly (math note §6).
+// in which it errs (house style §5). Predicates themselves compare with 0 exactly
+// (docs/visibility-math.md §6).
 #pragma once
 
 namespace vislib {
 
 // Final pieces of a pixel's list shorter than this (in segment parameter t, unitless in [0,1]) do
-// not make their triangle visible. Removes T-junction leaks of ~1e-16 (math note §2.5, §7).
-// Errs towards hidden for pieces that short; 0 = exact mode.
+// not make their triangle visible. Removes T-junction leaks of ~1e-16 (docs/visibility-math.md
+// §2.5, §7). Errs towards hidden for pieces that short; 0 = exact mode.
 constexpr double kDefaultEpsLen = 1e-12;
 
-// Depth tie tolerance eps_z (math note H9), relative (unitless): where two surfaces covering a
-// pixel have view depths within eps_z * lambda of each other (lambda = the front depth; 1e-6 is
-// 1 micrometre at 1 m, 0.1 mm at 100 m), both count as visible, as a headset's z-buffer may show
-// either (z-fighting). Makes coplanar overlaps (decals, doubled walls) independent of placement,
-// rotation and units. Errs towards visible; 0 = exactly equal depths only.
+// Depth tie tolerance eps_z (docs/visibility-math.md §7, H9), relative (unitless): where two
+// surfaces covering a pixel have view depths within eps_z * lambda of each other (lambda = the
+// front depth; 1e-6 is 1 micrometre at 1 m, 0.1 mm at 100 m), both count as visible, as a headset's
+// z-buffer may show either (z-fighting). Makes coplanar overlaps (decals, doubled walls)
+// independent of placement, rotation and units. Errs towards visible; 0 = exactly equal depths
+// only.
 constexpr double kDefaultEpsZ = 1e-6;
 
 // Margin added around a footprint in face coordinates (u, w) in [-1,1] (one pixel = 2/N). Errs
@@ -31,8 +33,9 @@ constexpr double kFootprintRelativeMargin = 1e-12;
 constexpr double kFrustumRejectWidening = 1e-6;
 
 // Two moving spheres whose centres stay farther apart than (1 + this) times the sum of their radii
-// (relative, unitless) keep their depth order, and their crossing search is skipped (math note §4).
-// Errs towards searching (a pair within the band is searched exactly).
+// (relative, unitless) keep their depth order, and their crossing search is skipped
+// (docs/visibility-math.md §4). Errs towards searching (a pair within the band is searched
+// exactly).
 constexpr double kDisjointSpheresSlack = 1e-9;
 
 // Default near plane: view-space depth (scene units, metres for our scenes) below which hits do

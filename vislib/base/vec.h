@@ -1,5 +1,6 @@
 // vec.h: the small double-precision vector type used everywhere in vislib.
-// Plain data, free functions; all arithmetic in double (math note §6: re-centre, then double).
+// Plain data, free functions; all arithmetic in double (docs/visibility-math.md §6: re-centre, then
+// double).
 #pragma once
 
 #include <cmath>
@@ -33,7 +34,8 @@ inline bool operator==(Vec3 a, Vec3 b) {
 inline bool operator!=(Vec3 a, Vec3 b) {
   return !(a == b);
 }
-// Lexicographic order (x, then y, then z): the canonical edge order of math note §2.5.
+// Lexicographic order (x, then y, then z): the canonical edge order of docs/visibility-math.md
+// §2.5.
 inline bool lex_less(Vec3 a, Vec3 b) {
   if (a.x != b.x) return a.x < b.x;
   if (a.y != b.y) return a.y < b.y;

@@ -1,4 +1,5 @@
-// embree_scene.cpp: the Embree 3 wrapper (house style §7; math note §8, "Embree" bullet).
+// embree_scene.cpp: the Embree 3 wrapper (house style §7; docs/visibility-math.md §8, "Embree"
+// bullet).
 #include "vislib/eval/embree_scene.h"
 
 #include <embree3/rtcore.h>

@@ -5,8 +5,8 @@
 // in order). The scene is built with RTC_SCENE_FLAG_ROBUST, build quality high, and
 // RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION (used only by first_hit_excluding).
 //
-// Precision (math note §6, §8): Embree works in float. The wrapper stores each vertex as
-// float(p - origin) with the subtraction done in double, and every query subtracts the same
+// Precision (docs/visibility-math.md §6, §8): Embree works in float. The wrapper stores each vertex
+// as float(p - origin) with the subtraction done in double, and every query subtracts the same
 // origin from its eye position in double before rounding to float. Choose the origin near the
 // eyes (e.g. v0 of a segment): float error then scales with the distance to the eye, not with
 // the distance to the world origin.

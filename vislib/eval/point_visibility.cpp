@@ -1,4 +1,5 @@
-// point_visibility.cpp: from-point cubemaps and sampled region baselines (math note §8).
+// point_visibility.cpp: from-point cubemaps and sampled region baselines (docs/visibility-math.md
+// §8).
 #include "vislib/eval/point_visibility.h"
 
 #include <tbb/blocked_range.h>

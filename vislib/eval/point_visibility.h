@@ -1,6 +1,7 @@
-// point_visibility.h: from-point visibility with Embree (math note §8, "Embree" bullet) and the
-// sampled region baselines built on it (math note §8, item 3: a union of from-point sets is a
-// subset of the from-segment set and tends to it as the number of viewpoints grows).
+// point_visibility.h: from-point visibility with Embree (docs/visibility-math.md §8, "Embree"
+// bullet) and the sampled region baselines built on it (docs/visibility-math.md §8, item 3: a union
+// of from-point sets is a subset of the from-segment set and tends to it as the number of
+// viewpoints grows).
 //
 // All functions take an already built EmbreeScene (build it once, reuse it for every viewpoint).
 // Eyes are world coordinates in double; the scene subtracts its own origin.

@@ -1,6 +1,6 @@
 // dynamic_visibility.cpp: from-segment visibility of moving triangles and spheres.
 // Paper: §3.2 (moving triangles) and §3.3 (spheres) of "Complex VEs on All-In-One VR Headsets
-// Through Continuous From-Segment Visibility Computation". Math: shared/design/
+// Through Continuous From-Segment Visibility Computation". Math: docs/
 // visibility-math.md §3 (edge quadratics, rational depth, two-branch coverage), §4 (spheres, with
 // the in-front and eye-inside conditions), §5 (footprints), §3.4 (crossings), E10 (modes).
 //
@@ -146,7 +146,7 @@ constexpr int kMaxIntervals = std::max(kMaxTriangleBreakpoints, kMaxSphereBreakp
 void sort_small(double* a, int n) {
   for (int i = 1; i < n; ++i)
     for (int j = i; j > 0 && a[j] < a[j - 1]; --j) std::swap(a[j], a[j - 1]);
-}  // math note §3.3: at most 5 per moving triangle and pixel
+}  // docs/visibility-math.md §3.3: at most 5 per moving triangle and pixel
 
 // ---- Moving triangles (§3.1-3.3) ------------------------------------------------------------
 
@@ -175,7 +175,7 @@ MovingTriangle prepare_moving(const std::array<Vec3, 3>& c0, const std::array<Ve
     mt.lin = prepare_static_triangle(c, e0, e1);
     return mt;
   }
-  Vec3 r0[3], r1[3];  // re-centred at e0 (math note §6)
+  Vec3 r0[3], r1[3];  // re-centred at e0 (docs/visibility-math.md §6)
   for (int k = 0; k < 3; ++k) {
     r0[k] = c0[k] - e0;
     r1[k] = c1[k] - e0;
@@ -390,7 +390,7 @@ struct Run {
   bool diagonal;      // part of the Diagonal mode (its pieces map onto t)
 };
 
-// ---- Compact pixel lists (issue 13, item 2) ----------------------------------------------
+// ---- Compact pixel lists -----------------------------------------------------------------
 // A GeneralDepth is 136 bytes, so a GeneralPiece is 160; the dense lists of vegetation (a grass
 // field ends with 150 pieces a pixel on average, up to 965) spent most of their time moving them
 // (vector growth, memmove on insertion, page faults). Inside a tile the lists hold a 32-byte
@@ -459,7 +459,7 @@ class DynamicKind {
     zmax_.resize(nprim);
     keep_ties_ = opt.coplanar == CoplanarRule::Both;
     far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
-    // The faces each triangle can reach (issue 13, item 4).
+    // The faces each triangle can reach.
     faces_ = classify_faces(ntri_, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
   }
 

@@ -1,4 +1,4 @@
-// footprint.cpp: math note §5.1 (clipped convex hull of the six eye-relative points).
+// footprint.cpp: docs/visibility-math.md §5.1 (clipped convex hull of the six eye-relative points).
 #include "vislib/kernel/footprint.h"
 
 #include <algorithm>

@@ -1,5 +1,6 @@
-// footprint.h: conservative pixel footprints of a triangle seen from a moving eye (math note
-// §5.1; the paper's ConvexHull, Alg. 1 line 6, made safe at the near plane).
+// footprint.h: conservative pixel footprints of a triangle seen from a moving eye
+// (docs/visibility-math.md §5.1; the paper's ConvexHull, Alg. 1 line 6, made safe at the near
+// plane).
 //
 // For a static triangle abc and an eye moving v0 -> v1, the eye-relative triangle at any t lies in
 // W = conv{a-v0, b-v0, c-v0, a-v1, b-v1, c-v1}. The footprint on one cube face is the 2D convex

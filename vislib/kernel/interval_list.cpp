@@ -1,4 +1,4 @@
-// interval_list.cpp: the linear depth of static triangles (math note §2.4, §7).
+// interval_list.cpp: the linear depth of static triangles (docs/visibility-math.md §2.4, §7).
 #include "vislib/kernel/interval_list.h"
 
 namespace vislib {

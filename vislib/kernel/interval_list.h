@@ -1,5 +1,5 @@
-// interval_list.h: per-pixel depth compositing of coverage intervals (math note §7; the paper's
-// DepthComposite, Alg. 1 line 9, with the corrections of the note).
+// interval_list.h: per-pixel depth compositing of coverage intervals (docs/visibility-math.md §7;
+// the paper's DepthComposite, Alg. 1 line 9, with the corrections given there).
 //
 // A pixel's list is a sorted vector of disjoint pieces [t0, t1) of the segment parameter, each
 // holding the id of the front-most primitive there and that primitive's depth function. Inserting
@@ -7,8 +7,8 @@
 // surfaces split at their depth crossings, depth ties go to the lower id. In exact arithmetic the
 // resulting list depends only on the set of inserted intervals. In floating point it does not
 // quite: where three or more depth functions cross near one t, the rounded crossing times of the
-// pairs disagree, and the tiny pieces between them depend on the order of insertion (measured in
-// session 6: the 20 m city street at N = 256 ends with 5,252,188 final pieces in the kernel's
+// pairs disagree, and the tiny pieces between them depend on the order of insertion (measured:
+// the 20 m city street at N = 256 ends with 5,252,188 final pieces in the kernel's
 // order and 5,245,807 in the reverse one, the same visible set and witnesses). The kernel
 // therefore always inserts in one fixed order (nearest depth, then id: tile_driver.h), whatever
 // the thread count, the tiles, or the BVH.
@@ -21,9 +21,9 @@
 // and a free function `bool same_depth(const D&, const D&)`: true when two pieces of one primitive
 // follow the same depth function. Touching pieces are merged only when they have the same id AND
 // the same depth function: one primitive can own touching pieces on different surfaces (a
-// sphere's entry and exit roots when the eye enters it, math note §4), and a merged piece would
-// carry the first one's depth over both, so later insertions would be compared with the wrong
-// surface.
+// sphere's entry and exit roots when the eye enters it, docs/visibility-math.md §4), and a merged
+// piece would carry the first one's depth over both, so later insertions would be compared with the
+// wrong surface.
 #pragma once
 
 #include <algorithm>
@@ -42,9 +42,9 @@ namespace vislib {
 constexpr int kMaxCrossings = 8;
 
 // Depth along the pixel ray (view-space depth lambda, scene units) as a function of t.
-// Static triangles: lambda(t) = (n0 - n1 t) / dn, linear in t (math note §2.4, (I3)), with
-// n0 = n.(a - v0), n1 = n.Delta, dn = d.n. Kept as the three numbers (not a slope and offset) so
-// that depth crossings come from P = N_i D_j - N_j D_i (§3.4), exact for exact inputs.
+// Static triangles: lambda(t) = (n0 - n1 t) / dn, linear in t (docs/visibility-math.md §2.4, (I3)),
+// with n0 = n.(a - v0), n1 = n.Delta, dn = d.n. Kept as the three numbers (not a slope and offset)
+// so that depth crossings come from P = N_i D_j - N_j D_i (§3.4), exact for exact inputs.
 struct LinearDepth {
   double n0 = 0, n1 = 0, dn = 1;
   double at(double t) const { return (n0 - n1 * t) / dn; }
@@ -64,17 +64,18 @@ struct PieceT {
 using Piece = PieceT<LinearDepth>;
 using PieceList = std::vector<Piece>;
 
-// A depth tie (math note H9, the option "treat |dlambda| <= eps_z lambda as a tie"): over [t0, t1)
-// primitive `hidden` lost the depth test to `front` although their depths differed by at most
-// eps_z times the front depth (checked at both ends and the middle of the stretch). A z-buffer
-// z-fights there and may show either, so `hidden` counts as visible wherever `front` (or anything
-// `front` is tied with) is in the final list over that stretch (see for_each_visible).
+// A depth tie (docs/visibility-math.md §7, H9, the option "treat |dlambda| <= eps_z lambda as a
+// tie"): over [t0, t1) primitive `hidden` lost the depth test to `front` although their depths
+// differed by at most eps_z times the front depth (checked at both ends and the middle of the
+// stretch). A z-buffer z-fights there and may show either, so `hidden` counts as visible wherever
+// `front` (or anything `front` is tied with) is in the final list over that stretch (see
+// for_each_visible).
 struct TieRecord {
   double t0 = 0, t1 = 0;
   uint32_t hidden = 0, front = 0;
 };
 
-// The tie rule of insert_piece. With `sink` null (the default) nothing is recorded: the old rule,
+// The tie rule of insert_piece. With `sink` null (the default) nothing is recorded (rule First):
 // ties settled by depth and then by the lower id alone. The list itself never depends on the rule.
 struct TieRule {
   double eps_z = 0;                        // relative depth tolerance (unitless, >= 0)
@@ -103,7 +104,7 @@ void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& l
   rule.sink->push_back(TieRecord{t0, t1, loser.id, winner.id});
 }
 
-// ---- Division-free decisions for linear depths (issue 13, item 2) ---------------------------
+// ---- Division-free decisions for linear depths ----------------------------------------------
 // The read-only pass of insert_piece asks, per overlapped piece, three questions whose answers
 // come from rounded quotients: is there a depth crossing in (lo, hi) (depth_crossings), which
 // piece is in front at the midpoint (front), and is the loser within eps_z there (record_tie).

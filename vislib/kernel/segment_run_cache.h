@@ -1,5 +1,5 @@
-// segment_run_cache.h: from-segment runs shared between the view cells of a bake (issue 13 item
-// 5). Neighbouring cells share the edges of their eye-band rectangles, and run 0 of every segment
+// segment_run_cache.h: from-segment runs shared between the view cells of a bake.
+// Neighbouring cells share the edges of their eye-band rectangles, and run 0 of every segment
 // is world-aligned (region_visibility.h), so a shared edge's run 0 is the same computation with
 // bit-identical inputs: the cache computes it once and hands the result to every cell that uses
 // it. The sets are those of baking each cell alone, byte for byte (test

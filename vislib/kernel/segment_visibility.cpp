@@ -1,6 +1,6 @@
 // segment_visibility.cpp: from-segment visibility for static triangles.
 // Paper: "Complex VEs on All-In-One VR Headsets Through Continuous From-Segment Visibility
-// Computation", §3.1, Alg. 1. Math: shared/design/visibility-math.md §1, §2, §5.1, §6, §7.
+// Computation", §3.1, Alg. 1. Math: docs/visibility-math.md §1, §2, §5.1, §6, §7.
 //
 // The faces, tiles, front-to-back order and per-tile culling are the tile driver's
 // (tile_driver.h, shared with the dynamic kernel). This file is the static kind: the faces each
@@ -37,7 +37,7 @@ namespace vislib {
 StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1) {
   StaticTriangle st;
   const Vec3 delta = v1 - v0;
-  Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (math note §6)
+  Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (docs/visibility-math.md §6)
   for (int e = 0; e < 3; ++e) {
     int i = e, j = (e + 1) % 3;
     // Canonical orientation: P is the lexicographically smaller world endpoint (§2.5).
@@ -123,10 +123,10 @@ inline double depth_lower(const LinearDepth& z, double inv, double t) {
 // depth_upper and depth_lower bound them (dividing where a product overflows). `scale` (>= 1)
 // widens q's depth so that an interval within the tie tolerance of it (CoplanarRule::Both records
 // such ties) is never skipped.
-// (Sessions 3-13 kept a depth envelope over t-bins for covered lists of two or more pieces, built
-// again at the first test after every change. Session 14 measured the kernel without it: 1.09x
-// faster on the 2 m street, 1.13x on the 20 m one, even on pandora, with 0.5-1.4% more pairs
-// tested; its builds cost more than the insertions it skipped. docs/performance.md.)
+// (No depth envelope over t-bins is kept for lists of two or more pieces: rebuilt at the first
+// test after every change, it costs more than the insertions it skips. Without it the kernel is
+// 1.09x faster on the 2 m street, 1.13x on the 20 m one, even on pandora, with 0.5-1.4% more
+// pairs tested. docs/performance.md.)
 inline bool single_piece_hides(const Piece& q, double lo, double hi, const LinearDepth& depth,
                                double scale) {
   const double qinv = 1.0 / q.depth.dn, inv = 1.0 / depth.dn;
@@ -155,7 +155,7 @@ inline bool plane_behind(const StaticTriangle& st, double Dn, double far) {
   return std::min(depth_lower(z, inv, 0.0), depth_lower(z, inv, 1.0)) > far;
 }
 
-// ---- Coverage of one triangle at 4 consecutive pixels of a row (issue 13, item 3) ----------
+// ---- Coverage of one triangle at 4 consecutive pixels of a row -----------------------------
 // The same operations as static_coverage, lane by lane and in the same order (no FMA, IEEE
 // division, max/min with the operand order of std::max/std::min), so every lane's interval and
 // depth are bit-identical to the scalar function's; lanes that hit the tie rule of §2.5 (A = B = 0
@@ -299,7 +299,7 @@ class StaticKind {
 #else
     coverage4_ = coverage4_scalar;
 #endif
-    // The faces each triangle can reach (issue 13, item 4); with a BVH, only the triangles its
+    // The faces each triangle can reach; with a BVH, only the triangles its
     // walk reaches get bounds, so nothing is classified up front.
     if (!opt.bvh)
       faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
@@ -340,7 +340,7 @@ class StaticKind {
   // pixel still gets its insertions in the tile's order (the batch's order within a row).
   // Per-pixel culling reads the pixel's state when the pair is composited, and the tile driver
   // flushes the batch before it recomputes its bounds, so every culling is as strong as without
-  // batches. Measured (session 7): 1.02-1.06x on the kernel suite; the search in insert_piece
+  // batches. Measured: 1.02-1.06x on the kernel suite; the search in insert_piece
   // no longer waits for memory, but most of that time moved elsewhere (docs/performance.md).
   void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {

@@ -1,7 +1,7 @@
 // segment_visibility.h: continuous from-segment visibility for static triangles.
 //
 // Implements §3.1 (Alg. 1) of "Complex VEs on All-In-One VR Headsets Through Continuous
-// From-Segment Visibility Computation" as specified in shared/design/visibility-math.md
+// From-Segment Visibility Computation" as specified in docs/visibility-math.md
 // (§1-2 coverage, §5.1 footprint, §6 numerics, §7 compositing): for every pixel centre of a
 // cubemap that translates (without rotating) along v(t) = v0 + t(v1 - v0), t in [0,1], the exact
 // list of pieces of t during which each triangle is the first hit (lambda > near), composited by
@@ -37,10 +37,11 @@ namespace vislib {
 //    the perimeter is of a view rectangle.
 enum class DynamicMode { Diagonal, Decoupled };
 
-// Depth ties between surfaces (math note H9, docs/visibility.md "Coplanar surfaces"):
+// Depth ties between surfaces (docs/visibility-math.md §7, H9, docs/visibility.md "Coplanar
+// surfaces"):
 //  Both: where the loser of a depth test lies within eps_z (relative) of the winner over a stretch
 //    of the segment, both are visible there (a z-buffer z-fights); the default.
-//  First: the old rule, the nearer depth wins and exact ties go to the lower id; the set then
+//  First: the nearer depth wins and exact ties go to the lower id; the set then
 //    depends on rounding, hence on placement and units, for coplanar overlaps.
 enum class CoplanarRule { Both, First };
 
@@ -67,7 +68,7 @@ struct SegmentOptions {
   DynamicMode mode = DynamicMode::Diagonal;    // dynamic scenes (moving vertices or spheres)
   CoplanarRule coplanar = CoplanarRule::Both;  // depth ties: both visible, or the first (lower id)
   double eps_z = kDefaultEpsZ;                 // tie tolerance, relative to the front depth; >= 0
-  // Split points of a long segment (issue 13 item 5; static scenes only): 0 < s_1 < ... < 1, at
+  // Split points of a long segment (static scenes only): 0 < s_1 < ... < 1, at
   // most kMaxSplitParts - 1 of them. Part i is [s_i, s_i+1] (s_0 = 0, s_m = 1); a triangle is
   // visible from part i when it owns a final piece whose overlap with the part is longer than
   // eps_len times the part's length, the test a run over that part alone makes. The result then
@@ -76,7 +77,7 @@ struct SegmentOptions {
   std::vector<double> splits;
   // Static scenes: a BVH of the scene's triangles in key state `state` (build_triangle_bvh), so
   // that each tile walks the tree front to back instead of every triangle getting footprint
-  // bounds on every face (issue 13, item 4). Null: no tree. The results are the same either way;
+  // bounds on every face. Null: no tree. The results are the same either way;
   // a tree built for another scene or state is refused (std::invalid_argument).
   const TriangleBvh* bvh = nullptr;
 };

@@ -1,7 +1,7 @@
 // static_coverage.h: the coverage step of the from-segment kernel for one static triangle and one
-// pixel (math note §2: triple products with canonically oriented edges, the §2.5 tie rule). Used
-// by the static kernel (segment_visibility.cpp), by the dynamic kernel for triangles that do not
-// move (dynamic_visibility.cpp), and tested directly on hard cases.
+// pixel (docs/visibility-math.md §2: triple products with canonically oriented edges, the §2.5 tie
+// rule). Used by the static kernel (segment_visibility.cpp), by the dynamic kernel for triangles
+// that do not move (dynamic_visibility.cpp), and tested directly on hard cases.
 #pragma once
 
 #include "vislib/base/vec.h"

@@ -1,4 +1,4 @@
-// tile_driver.h: the one tile driver of the from-segment kernels (issue 13, item 1). Static
+// tile_driver.h: the one tile driver of the from-segment kernels. Static
 // triangles (segment_visibility.cpp) and the runs of moving triangles and spheres
 // (dynamic_visibility.cpp) share it; the primitive kind is its template parameter.
 //

@@ -1,5 +1,5 @@
 // triangle_bvh.h: a bounding volume hierarchy over the static triangles of one key state, for the
-// front-to-back traversal of the tile driver (issue 13, item 4: hidden work never touched).
+// front-to-back traversal of the tile driver (hidden work never touched).
 //
 // Without it, every run of the kernel computes, for each cube face, the footprint bounds of every
 // triangle that can reach the face and bins them into tiles: O(triangles) per run, most of a run

@@ -16,7 +16,7 @@ namespace vislib {
 
 namespace {
 // State 0's vertex positions, or none for a scene without triangles (a sphere scene has no
-// positions at all: issue 12, pvs view of a sphere bake crashed here).
+// positions at all: `pvs view` of a sphere bake must not index them).
 const std::vector<Vec3>& rest_positions(const Scene& scene) {
   static const std::vector<Vec3> none;
   return scene.positions.empty() ? none : scene.positions[0];

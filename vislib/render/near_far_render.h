@@ -1,4 +1,4 @@
-// near_far_render.h: a CPU reference renderer of the near-far frame (issue 7, deliverable 4) and
+// near_far_render.h: a CPU reference renderer of the near-far frame and
 // the metrics that compare it with the full-scene frame.
 //
 // Papers (../shared/papers/): near-far-partitioning.txt §3 (the near, intermediate and far regions
@@ -10,9 +10,9 @@
 //  1. Geometry: the visible triangles with every vertex within r1 of O's axis (near) are used as
 //     they are; the triangles with some vertex inside r2 and some beyond r1 (intermediate) get each
 //     vertex displaced by pvs_runtime::morph_vertex (Eq. 1; vertices beyond r2 take Eq. 2's
-//     U + P - O, its w_U = 0 end), or, with morph off, stay where they are (the comparison of the
-//     issue). These triangles are put into one Embree scene and the eye ray is cast against it
-//     exactly as render_frame does (same camera, shading and depth).
+//     U + P - O, its w_U = 0 end), or, with morph off, stay where they are (the comparison
+//     `pvs view` reports). These triangles are put into one Embree scene and the eye ray is cast
+//     against it exactly as render_frame does (same camera, shading and depth).
 //  2. Environment map: the visible triangles with a vertex at or beyond r2 (far, plus the
 //     intermediate ones crossing r2: the paper's SF bin) are rendered once from O into a cube map
 //     (vislib/base/cubemap.h convention, identity orientation, `env_size` pixels a side): per pixel

@@ -1,5 +1,5 @@
 // ods_render.h: omnidirectional stereo (ODS) equirectangular panoramas of a triangle set (a cell's
-// PVS or the full scene), by two methods (issue 14, deliverable 2), and the measures `pvs view
+// PVS or the full scene), by two methods, and the measures `pvs view
 // --ods` reports.
 //
 // Paper: ../shared/papers/omnidirectional-stereo.txt (Marrinan & Papka). The conventions (y up,

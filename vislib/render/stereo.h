@@ -1,4 +1,4 @@
-// stereo.h: single-render stereo by reprojection (issue 15): render one eye, build the other eye
+// stereo.h: single-render stereo by reprojection: render one eye, build the other eye
 // by moving every pixel to where its world point projects in the other eye, then fill the holes.
 //
 // Paper: ../shared/papers/yoro-single-render-stereo.txt (YORO, MobiSys '25) §5-7, Alg. 1-3,

@@ -178,7 +178,7 @@ void decode_meshopt(Ctx& ctx, int view, const json& ext) {
     ctx.fail(who + "bad byteStride " + std::to_string(stride) + " or count " +
              std::to_string(count));
   // meshoptimizer's codecs compress at most 64:1 (2 header bits per 16 bytes of zero deltas):
-  // a larger claim is rejected before the output is allocated (issue 18: memory amplification).
+  // a larger claim is rejected before the output is allocated (no memory amplification).
   if (count * stride > 128 * length + 4096)
     ctx.fail(who + std::to_string(count) + " elements of " + std::to_string(stride) +
              " bytes cannot come from " + std::to_string(length) + " compressed bytes");
@@ -335,7 +335,7 @@ std::vector<double> read_accessor(Ctx& ctx, int index, const std::string& what, 
     ctx.fail(who + ": unexpected type with " + std::to_string(ncomp) + " components");
   if (a.count > (size_t(1) << 28))
     ctx.fail(who + ": count " + std::to_string(a.count) + " is too large");
-  // Bound the count by the data before allocating (issue 18): with a bufferView, the elements must
+  // Bound the count by the data before allocating: with a bufferView, the elements must
   // fit in it (checked exactly by read_elements); without one (zeros, maybe sparse), at most 2^24
   // values, so that a small file cannot ask for gigabytes.
   if (a.bufferView >= 0 && a.count > 0) {
@@ -653,7 +653,7 @@ void check_extensions(const Ctx& ctx) {
                               "geometry that relies on it is missing");
 }
 
-// --- External resources stay inside the asset's folder (issue 18) -------------------------------
+// --- External resources stay inside the asset's folder ------------------------------------------
 // A buffer or image `uri` that is not a data URI names a file relative to the folder of the .gltf
 // or .glb. tinygltf would open whatever it names ("../../../../etc/hostname", "/etc/passwd", a
 // symbolic link to anywhere) and its error would echo the size of that file. We reject, before
@@ -764,7 +764,7 @@ bool fs_write(std::string* err, const std::string&, const std::vector<unsigned c
 
 // Parses the container, rewrites meshopt fallback buffers and hands the file to tinygltf.
 void parse_file(Ctx& ctx) {
-  // Memory (issue 18: a 200 MB .glb peaked at 1.29 GB): the file is read once and the GLB handed to
+  // Memory: the file is read once and the GLB handed to
   // tinygltf is rebuilt inside the same string (the BIN chunk is never copied); tinygltf's own copy
   // of the BIN chunk is the only other one.
   std::string bytes = read_file(ctx.path);

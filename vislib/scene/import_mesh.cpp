@@ -1,6 +1,6 @@
 // import_mesh.cpp: polygon-soup formats, all read by the project's own readers: OBJ below, PLY,
 // OFF and STL in vislib/scene/import_{ply,off,stl}.cpp. (OpenMesh's PLY and OFF readers crashed,
-// hung or allocated gigabytes on small malformed files, issue 18.)
+// hung or allocated gigabytes on small malformed files.)
 //
 // Why our own OBJ reader: OpenMesh's OBJ reader drops `g`/`o` statements, so the groups that name
 // the objects of a level (Sauerbraten exports one group per material slot) would be lost, and it

@@ -1,4 +1,4 @@
-// import_off.cpp: the project's own OFF reader (issue 18). OpenMesh's OFF reader allocated what a
+// import_off.cpp: the project's own OFF reader. OpenMesh's OFF reader allocated what a
 // 23-byte header asked for; this one checks the counts against the bytes left before allocating.
 //
 // Format (ASCII, line based): an optional first line `[ST][C][N]OFF` (the counts may follow on the

@@ -1,4 +1,4 @@
-// import_ply.cpp: the project's own PLY reader (issue 18). OpenMesh's PLY reader crashed (signal
+// import_ply.cpp: the project's own PLY reader. OpenMesh's PLY reader crashed (signal
 // 11) on a misspelt header, grew to 3.5 GB on a 75-byte file and threw std::bad_alloc on a header
 // claiming 2*10^9 vertices; this one checks every header count against the bytes left in the file
 // before it allocates, and reports the byte offset or line of what is wrong.

@@ -1,4 +1,4 @@
-// import_stl.cpp: the project's own STL reader (issue 18), binary and ASCII, replacing OpenMesh's.
+// import_stl.cpp: the project's own STL reader, binary and ASCII, replacing OpenMesh's.
 //
 // Binary: an 80-byte header, u32 triangle count n (little-endian), n records of 50 bytes (normal,
 // 3 vertices as float32 x,y,z, u16 attribute); the file must be exactly 84 + 50 n bytes (a count

@@ -2,7 +2,7 @@
 //
 // Coordinates are double everywhere (not float with an origin): a 1 cm triangle 1e5 m from the
 // origin keeps ~1e-11 m resolution, and the visibility kernels re-centre at the eye in double
-// (math note §6).
+// (docs/visibility-math.md §6).
 //
 // Triangle ids are the indices into `triangles`. Their order is stable and documented in
 // docs/scene-model.md: importers append triangles in file order (glTF: default scene's root nodes
