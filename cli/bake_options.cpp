@@ -198,6 +198,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "run. The file is the same either way")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+  add_import_options(cmd, a.import);
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")
       ->check(in_range(1, 100000));

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include "cli/load_scene.h"
 #include "vislib/bake/bake.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/scene/scene.h"
@@ -26,6 +27,7 @@ struct BakeArgs {
   std::string coplanar = "both";
   double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
+  ImportArgs import;
   std::string preset = "default";
   std::string bvh = "on";           // --bvh on|off
   std::string long_segments = "1";  // --long-segments: 1..8 or auto

@@ -103,7 +103,7 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     throw Exit{2};
   }
   auto t0 = std::chrono::steady_clock::now();
-  vislib::Scene scene = load_scene_for_cli(a.scene, a.states);
+  vislib::Scene scene = load_scene_for_cli(a.scene, a.states, a.import);
   if (scene.triangle_count() + scene.sphere_count() >= 0xFFFFFFFFull)
     throw vislib::InputError(a.scene, "more than 2^32-1 triangles and spheres");
   vislib::ViewCells cells =

@@ -22,6 +22,7 @@ struct ExportOptions {
   std::string scene, out, id_map;
   int states = 1;
   std::optional<double> time;
+  ImportArgs import;
 };
 
 void append_f(std::string& s, const char* fmt, double a, double b, double c) {
@@ -33,7 +34,7 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 void run_export(const ExportOptions& o) {
   check_output_file(o.out, "--output");  // before any work
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
-  vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
+  vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
   double tau = o.time.value_or(0.0);
   std::string obj = "# pvs export of " + o.scene + ": face i is triangle id i\n";
   for (uint32_t v = 0; v < scene.vertex_count(); ++v) {
@@ -92,6 +93,7 @@ const Registration reg("export", [](CLI::App& app) {
       ->check(positive());
   cmd->add_option("--time", o->time, "Animation time in [0,1] (default: state 0)")
       ->check(in_range(0.0, 1.0));
+  add_import_options(cmd, o->import);
   cmd->add_option(
       "--id-map", o->id_map,
       "Also write FILE.json: runs of consecutive triangle ids of one object and their vertex "

@@ -5,6 +5,7 @@
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "vislib/base/file_util.h"
 #include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
@@ -14,10 +15,11 @@ struct InfoOptions {
   std::string scene;
   bool json = false;
   int states = 1;
+  ImportArgs import;
 };
 
 void run_info(const InfoOptions& o) {
-  vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
+  vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
   vislib::SceneInfo info = vislib::scene_info(scene);
   if (o.json) {
     std::printf("%s\n", vislib::to_json(info).c_str());
@@ -50,7 +52,12 @@ void run_info(const InfoOptions& o) {
                   info.far_from_origin ? ": far (float32 consumers lose precision)" : "");
     row("placement", buf);
   }
-  row("units", "not recorded by mesh formats (glTF: metres); vislib makes no guess");
+  if (vislib::file_extension(o.scene) == ".bsp")
+    row("units",
+        "Quake units (1 unit is about 2.5 cm), kept; z-up converted to y-up: (x, y, z) -> "
+        "(x, z, -y)");
+  else
+    row("units", "not recorded by mesh formats (glTF: metres); vislib makes no guess");
   row("degenerate triangles", num(info.degenerate_triangles));
   row("non-finite vertices", num(info.nonfinite_vertices));
   row("duplicate vertices", num(info.duplicate_vertices));
@@ -60,11 +67,12 @@ void run_info(const InfoOptions& o) {
 const Registration reg("info", [](CLI::App& app) {
   auto o = std::make_shared<InfoOptions>();
   auto* cmd = app.add_subcommand("info", "Print scene statistics and a hygiene report");
-  cmd->add_option("scene", o->scene, "Scene file (.gltf .glb .obj .ply .off .stl .spheres)")
+  cmd->add_option("scene", o->scene, "Scene file (.gltf .glb .obj .ply .off .stl .spheres .bsp)")
       ->required();
   cmd->add_flag("--json", o->json, "Machine-readable JSON on stdout");
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
       ->check(positive());
+  add_import_options(cmd, o->import);
   cmd->callback([o] { run_info(*o); });
 });
 

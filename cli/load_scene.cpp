@@ -9,11 +9,26 @@
 
 namespace pvs_cli {
 
-vislib::Scene load_scene_for_cli(const std::string& path, int states) {
+void add_import_options(CLI::App* cmd, ImportArgs& args) {
+  cmd->add_option("--bsp-models", args.bsp_models,
+                  "Quake maps: 'world' (model 0, default) or 'all' (brush entities too)")
+      ->check(CLI::IsMember({"world", "all"}));
+  cmd->add_option("--bsp-liquids", args.bsp_liquids,
+                  "Quake maps, faces with '*' textures: 'opaque' (default), 'omit' or "
+                  "'see-through' (not supported yet)")
+      ->check(CLI::IsMember({"opaque", "omit", "see-through"}));
+}
+
+vislib::Scene load_scene_for_cli(const std::string& path, int states, const ImportArgs& import) {
   if (states < 1)
     throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
   vislib::LoadOptions options;
   options.states = states;
+  options.bsp_models =
+      import.bsp_models == "all" ? vislib::BspModels::all : vislib::BspModels::world;
+  options.bsp_liquids = import.bsp_liquids == "omit"          ? vislib::BspLiquids::omit
+                        : import.bsp_liquids == "see-through" ? vislib::BspLiquids::see_through
+                                                              : vislib::BspLiquids::opaque;
   std::vector<std::string> warnings;
   const auto t0 = std::chrono::steady_clock::now();
   vislib::Scene scene = vislib::load_scene(path, options, &warnings);

@@ -1,14 +1,25 @@
 // load_scene.h (cli): loading a scene for a subcommand: option check, warnings to stderr.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <string>
 
 #include "vislib/scene/import.h"
 
 namespace pvs_cli {
 
+// Options of the importers that have them (.bsp: docs/scene-model.md), as every command that
+// loads a scene may take them.
+struct ImportArgs {
+  std::string bsp_models = "world";    // world | all
+  std::string bsp_liquids = "opaque";  // opaque | omit | see-through
+};
+// Adds --bsp-models and --bsp-liquids to `cmd`.
+void add_import_options(CLI::App* cmd, ImportArgs& args);
+
 // Loads `path` with `states` key states (throws CLI::ValidationError naming --states if < 1;
 // InputError from the importer passes through). Importer warnings go to stderr.
-vislib::Scene load_scene_for_cli(const std::string& path, int states = 1);
+vislib::Scene load_scene_for_cli(const std::string& path, int states = 1,
+                                 const ImportArgs& import = {});
 
 }  // namespace pvs_cli

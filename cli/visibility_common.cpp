@@ -35,6 +35,7 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
                   "with moving triangles or spheres")
       ->check(in_range(0, 4096))
       ->capture_default_str();
+  add_import_options(cmd, a.import);
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")
       ->check(in_range(1, 100000));
@@ -144,7 +145,7 @@ void write_json(const std::string& path, const json& j) {
 
 vislib::Scene load(const VisibilityArgs& a, double& seconds) {
   auto t0 = std::chrono::steady_clock::now();
-  vislib::Scene scene = load_scene_for_cli(a.scene, a.states);
+  vislib::Scene scene = load_scene_for_cli(a.scene, a.states, a.import);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return scene;
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/load_scene.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/kernel/segment_visibility.h"
 #include "vislib/scene/scene.h"
@@ -26,6 +27,7 @@ struct VisibilityArgs {
   int threads = 0;
   int tile = 0;
   int states = 1;
+  ImportArgs import;
   std::string granularity = "triangle";
   std::string mode = "diagonal";
   std::string coplanar = "both";

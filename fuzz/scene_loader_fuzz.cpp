@@ -1,10 +1,10 @@
 // scene_loader_fuzz.cpp: libFuzzer targets for the scene loaders (vislib::load_scene, import.h),
 // one executable per format: the same source built with VISLIB_FUZZ_EXT = ".glb", ".gltf", ".obj",
-// ".ply", ".off", ".stl" or ".spheres" (fuzz/CMakeLists.txt). The input is written to a file with
-// that extension in a private temporary folder (beside a 64-byte "buffer.bin", so that external
-// glTF buffers are reached) and loaded. Any input must either load into a scene that keeps the
-// contract of scene.h or be rejected with vislib::InputError; a crash, an out-of-bounds access, a
-// leak, another exception, or an allocation above -malloc_limit_mb (libFuzzer) is a finding.
+// ".ply", ".off", ".stl", ".spheres" or ".bsp" (fuzz/CMakeLists.txt). The input is written to a
+// file with that extension in a private temporary folder (beside a 64-byte "buffer.bin", so that
+// external glTF buffers are reached) and loaded. Any input must either load into a scene that keeps
+// the contract of scene.h or be rejected with vislib::InputError; a crash, an out-of-bounds access,
+// a leak, another exception, or an allocation above -malloc_limit_mb (libFuzzer) is a finding.
 //
 // Build and run: scripts/fuzz.sh (clang++ -fsanitize=fuzzer,address,undefined).
 #include <unistd.h>
@@ -64,6 +64,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::fclose(f);
   vislib::LoadOptions options;
   options.states = (size % 3) + 1;  // also sample animations into 2 and 3 key states
+  // Quake maps: every model or the world only, liquids kept or omitted.
+  options.bsp_models = size % 2 ? vislib::BspModels::all : vislib::BspModels::world;
+  options.bsp_liquids = size % 4 < 2 ? vislib::BspLiquids::opaque : vislib::BspLiquids::omit;
   try {
     vislib::Scene s = vislib::load_scene(path, options);
     // The contract of scene.h, checked here even though load_scene checks it too (NDEBUG).

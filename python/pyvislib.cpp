@@ -262,7 +262,7 @@ PYBIND11_MODULE(pyvislib, m) {
         return s;
       },
       py::arg("path"), py::arg("states") = 1, py::arg("animation") = -1,
-      "Loads .glb .gltf .obj .ply .off .stl .spheres (vislib::load_scene). Raises "
+      "Loads .glb .gltf .obj .ply .off .stl .spheres .bsp (vislib::load_scene). Raises "
       "pyvislib.InputError naming the file on a missing or malformed file.");
 
   // ---- Visibility -----------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets with clang (ASan + UBSan) and runs each for a bounded time on its
 # committed seed corpus: the PVS reader and the scene loaders of every format (glb gltf obj ply off
-# stl spheres). Exit status non-zero on a finding; the crashing input is saved as
+# stl spheres bsp). Exit status non-zero on a finding; the crashing input is saved as
 # build-fuzz/<target>/crash-* (reproduce: build-fuzz/<target> build-fuzz/<target>/crash-...).
 #
 #   bash scripts/fuzz.sh                  # every target, FUZZ_SECONDS (default 240) split evenly
@@ -15,7 +15,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR=${FUZZ_BUILD_DIR:-build-fuzz}
-ALL_TARGETS="pvs_reader_fuzz glb_loader_fuzz gltf_loader_fuzz obj_loader_fuzz ply_loader_fuzz off_loader_fuzz stl_loader_fuzz spheres_loader_fuzz"
+ALL_TARGETS="pvs_reader_fuzz glb_loader_fuzz gltf_loader_fuzz obj_loader_fuzz ply_loader_fuzz off_loader_fuzz stl_loader_fuzz spheres_loader_fuzz bsp_loader_fuzz"
 mode=run
 if [[ "${1:-}" == "merge" ]]; then mode=merge; shift; fi
 TARGETS=${*:-$ALL_TARGETS}
@@ -53,6 +53,14 @@ if [[ -d ../shared/repros && -x build/cli/pvs ]]; then
     [[ $rc == 2 ]] || { echo "fuzz: repro $f: exit $rc (expected 2) after $ms ms: $msg"; exit 1; }
     echo "fuzz: repro $(basename "$f"): exit 2 in $ms ms: $msg"
   done
+fi
+
+# The Quake maps of ../shared (too large to fuzz from: megabytes) run once through the BSP target:
+# none may crash the loader. The committed seeds are small maps the tests generate (tests/quake_bsp_test.cpp).
+if [[ " $TARGETS " == *" bsp_loader_fuzz "* && -d ../shared/scenes/librequake ]]; then
+  "$BUILD_DIR/bsp_loader_fuzz" -runs=1 ../shared/scenes/librequake/*.bsp > "$BUILD_DIR/bsp_shared.log" 2>&1 \
+    || { tail -40 "$BUILD_DIR/bsp_shared.log"; echo "fuzz: bsp_loader_fuzz: a shared map failed"; exit 1; }
+  echo "fuzz: bsp_loader_fuzz: the maps of ../shared/scenes/librequake ran without a finding"
 fi
 
 echo "fuzz: $ntargets target(s), ${PER_TARGET} s each"

@@ -59,10 +59,12 @@ Scene load_scene(const std::string& path, const LoadOptions& options,
       scene = load_mesh(path, warn);
     } else if (ext == ".spheres") {
       scene = load_spheres(path, warn);
+    } else if (ext == ".bsp") {
+      scene = load_bsp(path, options, warn);
     } else {
       throw InputError(path, "unsupported file format '" +
                                  (ext.empty() ? std::string("(none)") : ext) +
-                                 "' (supported: .gltf .glb .obj .ply .off .stl .spheres)");
+                                 "' (supported: .gltf .glb .obj .ply .off .stl .spheres .bsp)");
     }
     check_scene(path, scene);
     return scene;

@@ -7,6 +7,7 @@
 //   .obj .ply .off .stl  our own readers (import_mesh.cpp, scene/import_{ply,off,stl}.cpp); every
 //                     count in a header is checked against the file size before allocating
 //   .spheres          the sphere text format of docs/sphere-format.md (import_spheres.cpp)
+//   .bsp              compiled Quake maps, BSP29, BSP2 and 2PSB (import_bsp.cpp, quake_bsp.h)
 #pragma once
 
 #include <string>
@@ -15,11 +16,26 @@
 
 namespace vislib {
 
+// Quake maps: which brush models become triangles.
+enum class BspModels {
+  world,  // model 0 only (the world; what the compiler's vis treats as occluding)
+  all,    // every model in model order (doors, lifts, triggers too)
+};
+// Quake maps: what becomes of faces with a '*' texture (water, slime, lava, teleporters).
+enum class BspLiquids {
+  opaque,       // ordinary triangles: they occlude
+  omit,         // left out of the scene
+  see_through,  // seen but not occluding: not supported yet (load_scene throws InputError)
+};
+
 struct LoadOptions {
   // Key states to sample node animations into (glTF). 1 = the rest pose only. Must be >= 1.
   int states = 1;
   // glTF: index of the animation to sample (-1 = all animations together, on a common clock).
   int animation = -1;
+  // .bsp: brush models and liquid faces (docs/scene-model.md).
+  BspModels bsp_models = BspModels::world;
+  BspLiquids bsp_liquids = BspLiquids::opaque;
 };
 
 // Loads any supported format. Throws InputError on a missing, unreadable, malformed or

@@ -26,4 +26,8 @@ Scene load_stl(const std::string& path, std::vector<std::string>& warnings);
 // The sphere text format of docs/sphere-format.md (import_spheres.cpp).
 Scene load_spheres(const std::string& path, std::vector<std::string>& warnings);
 
+// Compiled Quake maps, .bsp (import_bsp.cpp).
+Scene load_bsp(const std::string& path, const LoadOptions& options,
+               std::vector<std::string>& warnings);
+
 }  // namespace vislib
