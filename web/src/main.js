@@ -1,0 +1,340 @@
+// main.js: the web client. Opens a scene (GLB from `pvs export SCENE -o scene.glb`: triangles in
+// vislib's id order) and a PVS (read by range requests through the runtime in WebAssembly), and
+// per frame asks the runtime for the eye's cell and draws only that cell's visible triangles.
+//
+// URL parameters: scene=URL (GLB), pvs=URL, at=x,y,z and look=x,y,z (start), fov=degrees
+// (vertical, default 60), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
+// frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size).
+//
+// Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
+// scene), and the overlay says so in red.
+//
+// Shading is the CPU reference renderer's (vislib/eval/render.h): albedo = the object's colour
+// from a hash of its id (vislib::object_colour, glb.js), shade = 0.1 + 0.9 |n.v| with n the
+// geometric normal of the triangle and v the direction from the eye to the point (two-sided
+// headlight), background RGB (150, 170, 195); no colour management, no tone mapping. The CPU
+// renderer samples pixel centres by ray casting and rounds albedo and result to 8 bits; WebGL
+// rasterises the same triangles with the same camera, so frames agree up to rasterisation on
+// triangle edges and one 8-bit step.
+import * as THREE from "three";
+import {parseGlb, objectColour} from "./glb.js";
+import {PvsClient} from "./pvs_client.js";
+
+const params = new URLSearchParams(location.search);
+const overlay = document.getElementById("overlay");
+const mapCanvas = document.getElementById("map");
+const canvas = document.getElementById("view");
+
+function vec3(text) {
+  const v = text.split(",").map(Number);
+  if (v.length !== 3 || v.some((x) => !Number.isFinite(x))) throw new Error(`bad point "${text}"`);
+  return v;
+}
+
+// "x,y,z[@lx,ly,lz];..." -> [{eye, look|null}]
+export function parsePath(text) {
+  return text.split(";").filter((s) => s.trim()).map((s) => {
+    const [e, l] = s.split("@");
+    return {eye: vec3(e), look: l ? vec3(l) : null};
+  });
+}
+
+const VERTEX = `in vec3 position; in vec3 normal; in vec3 colour;
+uniform mat4 projectionMatrix, viewMatrix;
+out vec3 vWorld; out vec3 vNormal; out vec3 vColour;
+void main() {
+  vWorld = position; vNormal = normal; vColour = colour;
+  gl_Position = projectionMatrix * viewMatrix * vec4(position, 1.0);
+}`;
+const FRAGMENT = `precision highp float;
+uniform vec3 eye;
+in vec3 vWorld; in vec3 vNormal; in vec3 vColour;
+out vec4 outColour;
+void main() {
+  vec3 v = vWorld - eye;
+  float nl = length(vNormal), vl = length(v);
+  float lambert = nl > 0.0 && vl > 0.0 ? abs(dot(vNormal, v)) / (nl * vl) : 0.0;
+  float shade = 0.1 + 0.9 * min(lambert, 1.0);
+  outColour = vec4(vColour * shade, 1.0);
+}`;
+
+async function fetchBytes(url) {
+  const r = await fetch(url);
+  if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
+  return r.arrayBuffer();
+}
+
+function buildGeometry(scene) {
+  const T = scene.triangleObject.length;
+  const normals = new Float32Array(9 * T);
+  const colours = new Float32Array(9 * T);
+  const palette = new Map();
+  const p = scene.positions;
+  for (let t = 0; t < T; ++t) {
+    const o = 9 * t;
+    const ax = p[o + 3] - p[o], ay = p[o + 4] - p[o + 1], az = p[o + 5] - p[o + 2];
+    const bx = p[o + 6] - p[o], by = p[o + 7] - p[o + 1], bz = p[o + 8] - p[o + 2];
+    const n = [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx];
+    const ob = scene.triangleObject[t];
+    if (!palette.has(ob)) palette.set(ob, objectColour(ob).map((c) => c / 255));
+    const c = palette.get(ob);
+    for (let k = 0; k < 3; ++k) {
+      normals.set(n, o + 3 * k);
+      colours.set(c, o + 3 * k);
+    }
+  }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute("position", new THREE.BufferAttribute(scene.positions, 3));
+  g.setAttribute("normal", new THREE.BufferAttribute(normals, 3));
+  g.setAttribute("colour", new THREE.BufferAttribute(colours, 3));
+  g.computeBoundingSphere();
+  return g;
+}
+
+// The index buffer drawing triangles `ids` of the de-indexed geometry (triangle t = vertices
+// 3t, 3t+1, 3t+2).
+function indexOf(ids) {
+  const idx = new Uint32Array(3 * ids.length);
+  for (let i = 0; i < ids.length; ++i) {
+    idx[3 * i] = 3 * ids[i];
+    idx[3 * i + 1] = 3 * ids[i] + 1;
+    idx[3 * i + 2] = 3 * ids[i] + 2;
+  }
+  return new THREE.BufferAttribute(idx, 1);
+}
+
+class Viewer {
+  async init() {
+    THREE.ColorManagement.enabled = false;
+    const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
+    if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
+    this.fov = Number(params.get("fov") || 60);
+    const size = params.get("size");
+    if (size) {
+      const [w, h] = size.split("x").map(Number);
+      canvas.style.width = `${w}px`;
+      canvas.style.height = `${h}px`;
+      canvas.width = w;
+      canvas.height = h;
+    }
+    this.client = new PvsClient();
+    const [glb, opened] = await Promise.all([fetchBytes(sceneUrl), this.client.open(pvsUrl)]);
+    this.sceneBytes = glb.byteLength;
+    this.scene = parseGlb(glb);
+    this.pvs = opened;
+    this.total = this.scene.triangleObject.length;
+    if (opened.info.granularity !== 0)
+      throw new Error("this PVS holds object ids; the viewer draws triangle ids");
+    if (opened.info.universe !== this.total)
+      throw new Error(`the PVS has ${opened.info.universe} triangle ids, the scene ${this.total} triangles: not this scene's PVS`);
+    this.bytes = opened.bytes;
+    this.requests = opened.requests;
+
+    this.renderer = new THREE.WebGLRenderer({canvas, antialias: false, preserveDrawingBuffer: true});
+    this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+    this.renderer.setPixelRatio(1);
+    this.renderer.setSize(canvas.clientWidth || canvas.width, canvas.clientHeight || canvas.height, false);
+    this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
+    this.geometry = buildGeometry(this.scene);
+    this.material = new THREE.RawShaderMaterial({
+      vertexShader: VERTEX, fragmentShader: FRAGMENT, side: THREE.DoubleSide,
+      glslVersion: THREE.GLSL3,
+      uniforms: {eye: {value: new THREE.Vector3()}},
+    });
+    this.mesh = new THREE.Mesh(this.geometry, this.material);
+    this.mesh.frustumCulled = false;
+    this.world = new THREE.Scene();
+    this.world.add(this.mesh);
+    const r = this.geometry.boundingSphere.radius;
+    const aspect = this.renderer.domElement.width / this.renderer.domElement.height;
+    this.camera = new THREE.PerspectiveCamera(this.fov, aspect, 0.05, 4 * r + 10);
+    this.cell = -1;  // the cell whose set is drawn (-1: none yet, the whole scene)
+    this.found = -1;  // the cell found this frame
+    this.path = params.get("path") ? parsePath(params.get("path")) : null;
+    const at = params.get("at") ? vec3(params.get("at")) : this.path ? this.path[0].eye : [0, 1.6, 0];
+    this.camera.position.set(...at);
+    if (params.get("look")) this.camera.lookAt(...vec3(params.get("look")));
+    else this.camera.lookAt(at[0] + 1, at[1], at[2]);
+    this.setDrawList(null);
+    this.drawMapBase();
+    return this;
+  }
+
+  setDrawList(ids) {
+    if (ids) {
+      this.geometry.setIndex(indexOf(ids));
+      this.drawn = ids.length;
+    } else {
+      this.geometry.setIndex(null);
+      this.drawn = this.total;
+    }
+  }
+
+  // One frame from the camera's current pose: the runtime's cell, the draw list, the render.
+  async frame() {
+    const t0 = performance.now();
+    const p = this.camera.position;
+    const r = await this.client.lookup([p.x, p.y, p.z], this.cell);
+    this.found = r.cell;
+    if (r.cell >= 0 && r.cell !== this.cell) {
+      this.cell = r.cell;
+      this.setDrawList(r.ids);
+    }
+    this.bytes = r.bytes;
+    this.requests = r.requests;
+    this.material.uniforms.eye.value.copy(p);
+    this.renderer.render(this.world, this.camera);
+    const gl = this.renderer.getContext();
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the GPU
+    const ms = performance.now() - t0;
+    this.showOverlay(ms);
+    this.drawMap();
+    return {cell: this.found, drawn_cell: this.cell, triangles_drawn: this.drawn,
+            triangles_total: this.total, ms, bytes_fetched: this.bytes,
+            range_requests: this.requests, eye: [p.x, p.y, p.z]};
+  }
+
+  // Replay: frame i of the path.
+  async step(i) {
+    const f = this.path[i];
+    this.camera.position.set(...f.eye);
+    let look = f.look;
+    if (!look) {
+      const next = this.path[i + 1] || null, prev = this.path[i - 1] || null;
+      if (next) look = next.eye;
+      else if (prev) look = f.eye.map((v, k) => 2 * v - prev.eye[k]);
+      else look = [f.eye[0] + 1, f.eye[1], f.eye[2]];
+      look = [look[0], f.eye[1], look[2]];
+      if (look[0] === f.eye[0] && look[2] === f.eye[2]) look[0] += 1;
+    }
+    this.camera.up.set(0, 1, 0);
+    this.camera.lookAt(...look);
+    const rec = await this.frame();
+    rec.frame = i;
+    return rec;
+  }
+
+  showOverlay(ms) {
+    const outside = this.found < 0;
+    const cellText = outside
+      ? `<span class="outside">outside every cell: ${this.cell >= 0 ? `keeping cell ${this.cell}'s set` : "drawing the whole scene"}</span>`
+      : `cell ${this.found} of ${this.pvs.info.cell_count}`;
+    overlay.innerHTML =
+      `${cellText}\ntriangles drawn ${this.drawn} / ${this.total}` +
+      ` (${(100 * this.drawn / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
+      `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
+      `\nscene ${this.sceneBytes} bytes`;
+  }
+
+  // Top view of the cells, coloured by PVS size (dark blue: smallest, yellow: largest).
+  drawMapBase() {
+    const b = this.pvs.boxes, n = this.pvs.info.cell_count;
+    let x0 = Infinity, z0 = Infinity, x1 = -Infinity, z1 = -Infinity, cmax = 1, cmin = Infinity;
+    for (let c = 0; c < n; ++c) {
+      x0 = Math.min(x0, b[6 * c]); z0 = Math.min(z0, b[6 * c + 2]);
+      x1 = Math.max(x1, b[6 * c + 3]); z1 = Math.max(z1, b[6 * c + 5]);
+      cmax = Math.max(cmax, this.pvs.counts[c]); cmin = Math.min(cmin, this.pvs.counts[c]);
+    }
+    const W = mapCanvas.width, s = (W - 10) / Math.max(x1 - x0, z1 - z0, 1e-9);
+    this.map = {x0, z0, s, cmin, cmax};
+    const ctx = mapCanvas.getContext("2d");
+    const base = document.createElement("canvas");
+    base.width = base.height = W;
+    const bc = base.getContext("2d");
+    for (let c = 0; c < n; ++c) {
+      const f = (this.pvs.counts[c] - cmin) / Math.max(1, cmax - cmin);
+      bc.fillStyle = `rgb(${Math.round(40 + 215 * f)},${Math.round(40 + 180 * f)},${Math.round(140 - 110 * f)})`;
+      const [x, y, w, h] = this.mapRect(c);
+      bc.fillRect(x, y, w, h);
+    }
+    this.mapBase = base;
+    ctx.drawImage(base, 0, 0);
+  }
+
+  mapRect(c) {
+    const b = this.pvs.boxes, m = this.map;
+    return [5 + (b[6 * c] - m.x0) * m.s, 5 + (b[6 * c + 2] - m.z0) * m.s,
+            Math.max(1, (b[6 * c + 3] - b[6 * c]) * m.s), Math.max(1, (b[6 * c + 5] - b[6 * c + 2]) * m.s)];
+  }
+
+  drawMap() {
+    const ctx = mapCanvas.getContext("2d"), m = this.map;
+    ctx.clearRect(0, 0, mapCanvas.width, mapCanvas.height);
+    ctx.drawImage(this.mapBase, 0, 0);
+    if (this.cell >= 0) {
+      ctx.strokeStyle = "#fff";
+      ctx.lineWidth = 2;
+      ctx.strokeRect(...this.mapRect(this.cell));
+    }
+    const p = this.camera.position;
+    ctx.fillStyle = this.found >= 0 ? "#fff" : "#f44";
+    ctx.beginPath();
+    ctx.arc(5 + (p.x - m.x0) * m.s, 5 + (p.z - m.z0) * m.s, 3, 0, 2 * Math.PI);
+    ctx.fill();
+  }
+
+  // WASD + mouse drag; Q/E down/up; shift for speed.
+  startWalking() {
+    const keys = new Set();
+    addEventListener("keydown", (e) => keys.add(e.key.toLowerCase()));
+    addEventListener("keyup", (e) => keys.delete(e.key.toLowerCase()));
+    let dragging = false, yaw = 0, pitch = 0;
+    const d = new THREE.Vector3();
+    this.camera.getWorldDirection(d);
+    yaw = Math.atan2(d.x, -d.z);
+    pitch = Math.asin(Math.max(-1, Math.min(1, d.y)));
+    canvas.addEventListener("mousedown", () => (dragging = true));
+    addEventListener("mouseup", () => (dragging = false));
+    addEventListener("mousemove", (e) => {
+      if (!dragging) return;
+      yaw += e.movementX * 0.004;
+      pitch = Math.max(-1.5, Math.min(1.5, pitch - e.movementY * 0.004));
+    });
+    addEventListener("resize", () => {
+      this.renderer.setSize(canvas.clientWidth, canvas.clientHeight, false);
+      this.camera.aspect = canvas.clientWidth / canvas.clientHeight;
+      this.camera.updateProjectionMatrix();
+    });
+    let last = performance.now();
+    const loop = async () => {
+      const now = performance.now(), dt = Math.min(0.1, (now - last) / 1000);
+      last = now;
+      const speed = (keys.has("shift") ? 20 : 6) * dt;
+      const fwd = new THREE.Vector3(Math.sin(yaw), 0, -Math.cos(yaw));
+      const right = new THREE.Vector3(Math.cos(yaw), 0, Math.sin(yaw));
+      const p = this.camera.position;
+      if (keys.has("w")) p.addScaledVector(fwd, speed);
+      if (keys.has("s")) p.addScaledVector(fwd, -speed);
+      if (keys.has("d")) p.addScaledVector(right, speed);
+      if (keys.has("a")) p.addScaledVector(right, -speed);
+      if (keys.has("e")) p.y += speed;
+      if (keys.has("q")) p.y -= speed;
+      const look = new THREE.Vector3(Math.sin(yaw) * Math.cos(pitch), Math.sin(pitch),
+                                     -Math.cos(yaw) * Math.cos(pitch));
+      this.camera.lookAt(p.clone().add(look));
+      await this.frame();
+      requestAnimationFrame(loop);
+    };
+    requestAnimationFrame(loop);
+  }
+}
+
+const viewer = new Viewer();
+window.viewer = viewer;
+window.viewerReady = viewer.init().then(
+  async () => {
+    if (viewer.path) {
+      await viewer.step(0);
+      if (params.get("autoplay") !== null) {
+        for (let i = 0; i < viewer.path.length; ++i) await viewer.step(i);
+      }
+    } else {
+      viewer.startWalking();
+    }
+    return {triangles: viewer.total, cells: viewer.pvs.info.cell_count,
+            file_size: viewer.pvs.info.file_size, scene_bytes: viewer.sceneBytes};
+  },
+  (e) => {
+    overlay.innerHTML = `<span class="outside">error: ${e.message}</span>`;
+    throw e;
+  });
