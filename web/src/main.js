@@ -18,26 +18,13 @@
 // triangle edges and one 8-bit step.
 import * as THREE from "three";
 import {parseGlb, objectColour} from "./glb.js";
+import {parsePath, vec3} from "./path.js";
 import {PvsClient} from "./pvs_client.js";
 
 const params = new URLSearchParams(location.search);
 const overlay = document.getElementById("overlay");
 const mapCanvas = document.getElementById("map");
 const canvas = document.getElementById("view");
-
-function vec3(text) {
-  const v = text.split(",").map(Number);
-  if (v.length !== 3 || v.some((x) => !Number.isFinite(x))) throw new Error(`bad point "${text}"`);
-  return v;
-}
-
-// "x,y,z[@lx,ly,lz];..." -> [{eye, look|null}]
-export function parsePath(text) {
-  return text.split(";").filter((s) => s.trim()).map((s) => {
-    const [e, l] = s.split("@");
-    return {eye: vec3(e), look: l ? vec3(l) : null};
-  });
-}
 
 const VERTEX = `in vec3 position; in vec3 normal; in vec3 colour;
 uniform mat4 projectionMatrix, viewMatrix;

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Headless test of the web client (ctest web_check_city): the quick start's bake of data/city.glb
+# (at --res 32 for speed), replayed in chromium along a path through at least 5 cells. For every
+# frame, the cell the runtime found in the browser must equal `pvs inspect --at`'s (or both find
+# none), and the triangles drawn must equal that cell's PVS count.
+# Usage: web-check-test.sh PVS_EXE WORKDIR. Exit 0 pass, 1 fail, 2 missing build, 77 chromium
+# cannot start. Time budget: the bake about 20 s on 2 cores, the replay about 10 s.
+set -euo pipefail
+pvs=$1 work=$2
+root=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$work"
+start=$(date +%s)
+if [[ ! -f $work/city.pvs ]]; then
+  "$pvs" bake "$root/data/city.glb" --walkable --cell-size 24 --box -120,-1,-120,120,1,120 \
+    --res 32 --runs 1 -q -o "$work/city.pvs"
+fi
+echo "web-check-test: bake $work/city.pvs ($(($(date +%s) - start)) s)"
+# Along the east-west street through the centre crossing, then north along the cross street,
+# looking ahead; the last point looks back at the crossing.
+path="-100,1.6,0;-80,1.6,0;-60,1.6,0;-40,1.6,0;-20,1.6,0;0,1.6,0;20,1.6,0;40,1.6,0;60,1.6,0"
+path+=";80,1.6,0;0,1.6,20;0,1.6,40;0,1.6,60;0,1.6,80@0,1.6,0"
+set +e
+PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" \
+  --path "$path" --json "$work/web_check.json" --png "$work/png" --png-frames 0,5,13 --size 640x400
+rc=$?
+set -e
+[[ $rc -eq 77 ]] && { echo "web-check-test: SKIPPED: chromium cannot start"; exit 77; }
+[[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh exited $rc"; exit 1; }
+python3 - "$pvs" "$work/city.pvs" "$work/web_check.json" "$path" <<'PY'
+import json, subprocess, sys
+pvs, pvs_file, check, path = sys.argv[1:5]
+frames = json.load(open(check))["frames"]
+points = [p.split("@")[0] for p in path.split(";")]
+ok = len(frames) == len(points)
+cells = set()
+for f, p in zip(frames, points):
+    r = subprocess.run([pvs, "inspect", pvs_file, "--at", p, "--json", "-q"], capture_output=True,
+                       text=True)
+    if r.returncode == 2 and "no cell contains" in r.stderr:
+        want, count = -1, None
+    else:
+        j = json.loads(r.stdout)
+        want, count = j["cell"], j["visible_count"]
+    good = f["cell"] == want and (count is None or f["triangles_drawn"] == count)
+    ok = ok and good
+    if want >= 0:
+        cells.add(want)
+    print("  frame %2d at %-14s browser cell %4d, pvs inspect %4d; drawn %5d, PVS count %5s; %5.1f ms %s"
+          % (f["frame"], p, f["cell"], want, f["triangles_drawn"], count, f["ms"],
+             "" if good else "MISMATCH"))
+if len(cells) < 5:
+    print("web-check-test: FAIL: the path crosses %d cells, fewer than 5" % len(cells))
+    ok = False
+print("web-check-test: %s: %d frames through %d cells" % ("pass" if ok else "FAIL", len(frames),
+                                                           len(cells)))
+sys.exit(0 if ok else 1)
+PY
