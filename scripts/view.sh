@@ -9,6 +9,6 @@ pvs=${2:-$root/out/city.pvs}
 source "$root/scripts/web_stage.sh"
 trap web_unstage EXIT
 WEB_PORT=${WEB_PORT:-8035} web_stage "$scene" "$pvs"
-echo "Open $PAGE&at=0,1.6,0"
+echo "Open $PAGE&at=0,1.6,0&prefetch=0"
 echo "(WASD to walk, drag to look; the server logs each request to $SERVER_LOG; Ctrl-C stops)"
 wait "$SERVER_PID"

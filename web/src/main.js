@@ -3,7 +3,8 @@
 // per frame asks the runtime for the eye's cell and draws only that cell's visible triangles.
 //
 // URL parameters: scene=URL (GLB), pvs=URL, at=x,y,z and look=x,y,z (start), fov=degrees
-// (vertical, default 60), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
+// (vertical, default 60), prefetch=MARGIN (on entering a cell, fetch the blocks of its neighbours
+// within MARGIN scene units; off by default, so that only visited cells are fetched), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
 // frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size).
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
@@ -96,6 +97,7 @@ class Viewer {
     const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
     if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
     this.fov = Number(params.get("fov") || 60);
+    this.prefetch = params.has("prefetch") ? Number(params.get("prefetch") || 0) : -1;
     const size = params.get("size");
     if (size) {
       const [w, h] = size.split("x").map(Number);
@@ -161,7 +163,7 @@ class Viewer {
   async frame() {
     const t0 = performance.now();
     const p = this.camera.position;
-    const r = await this.client.lookup([p.x, p.y, p.z], this.cell);
+    const r = await this.client.lookup([p.x, p.y, p.z], this.cell, this.prefetch);
     this.found = r.cell;
     if (r.cell >= 0 && r.cell !== this.cell) {
       this.cell = r.cell;

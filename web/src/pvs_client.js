@@ -20,6 +20,9 @@ export class PvsClient {
   }
   // Opens the PVS at `url` (header, layout and index by range request).
   open(url) { return this.call({op: "open", url}); }
-  // The cell containing `position` (-1: none) and, when it is not `have`, its visible ids.
-  lookup(position, have) { return this.call({op: "lookup", position, have}); }
+  // The cell containing `position` (-1: none) and, when it is not `have`, its visible ids; on a
+  // cell change with `prefetch` >= 0, the worker then fetches the neighbours' blocks.
+  lookup(position, have, prefetch = -1) {
+    return this.call({op: "lookup", position, have, prefetch});
+  }
 }

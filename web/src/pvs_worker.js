@@ -4,7 +4,13 @@
 // synchronous XMLHttpRequests, so each range is one blocking HTTP range request here and the
 // WebAssembly needs no ASYNCIFY. The page talks to this worker by messages (pvs_client.js):
 //   {op: "open", url}            -> {info, boxes: Float64Array(6 * cells), counts: Uint32Array}
-//   {op: "lookup", position}     -> {cell (-1: outside every cell), ids?: Uint32Array, bytes}
+//   {op: "lookup", position, have, prefetch}
+//                                -> {cell (-1: outside every cell), ids?: Uint32Array (when the
+//                                    cell is not `have`), bytes, requests}
+// With `prefetch` = a margin (scene units) on a cell change, after the reply the worker fetches
+// the blocks of the cells the runtime names as neighbours within that margin
+// (pvs_rt_neighbours, pvs_rt_block_range), so that crossing into one costs no request; their
+// Delta chains are fetched when a cell is entered (they are known only from the block).
 // Each range fetched is kept (a cell's block is fetched once); `bytes` counts every byte the
 // server sent for this file, so the page can show what streaming cost.
 /* global createPvsRuntime, importScripts */
@@ -104,6 +110,23 @@ function visibleIds(cell) {
   return ids;
 }
 
+function prefetchNeighbours(cell, margin) {
+  const cap = 4096;
+  const out = rt._malloc(4 * cap + 32);
+  const countP = out + 4 * cap, offP = countP + 8, sizeP = countP + 16;
+  if (rt._pvs_rt_neighbours(handle, cell, margin, out, cap, countP) === 0) {
+    const n = new Uint32Array(rt.HEAPU8.buffer, countP, 1)[0];
+    const cells = new Uint32Array(rt.HEAPU8.buffer, out, n).slice();
+    for (const c of cells) {
+      if (idCache.has(c) || rt._pvs_rt_block_range(handle, c, offP, sizeP) !== 0) continue;
+      const off = Number(new BigUint64Array(rt.HEAPU8.buffer, offP, 1)[0]);
+      const size = new Uint32Array(rt.HEAPU8.buffer, sizeP, 1)[0];
+      readRange(off, size);
+    }
+  }
+  rt._free(out);
+}
+
 function lookup(position) {
   const p = rt._malloc(32);
   new Float64Array(rt.HEAPU8.buffer, p, 3).set(position);
@@ -127,6 +150,7 @@ self.onmessage = async (ev) => {
       reply.bytes = bytesFetched;
       reply.requests = requests;
       self.postMessage(reply);
+      if (cell >= 0 && m.have !== cell && m.prefetch >= 0) prefetchNeighbours(cell, m.prefetch);
     }
   } catch (e) {
     self.postMessage({id: m.id, ok: false, error: String(e && e.message ? e.message : e)});
