@@ -37,20 +37,24 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 }
 
 void run_export(const ExportOptions& o) {
+  const bool glb = vislib::file_extension(o.out) == ".glb";
+  if (glb && o.time)
+    throw CLI::ValidationError("--time", "a .glb export keeps every key state (morph targets)");
+  if (glb && !o.id_map.empty())
+    throw CLI::ValidationError("--id-map", "goes with an .obj export (a .glb keeps the id order)");
   check_output_file(o.out, "--output");  // before any work (issue 17 item 1)
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
-  if (vislib::file_extension(o.out) == ".glb") {
-    if (o.time)
-      throw vislib::InputError("--time: a .glb export keeps every key state (morph targets)");
+  if (glb) {
     for (size_t t = 1; t < scene.triangle_count(); ++t)
       if (scene.triangle_object[t] < scene.triangle_object[t - 1])
-        throw vislib::InputError(
-            o.scene + ": triangle " + std::to_string(t) + " of object " +
-            std::to_string(scene.triangle_object[t]) + " follows one of object " +
-            std::to_string(scene.triangle_object[t - 1]) +
-            ": the objects are not in id order, so a .glb export would not keep the triangle ids "
-            "(export .obj instead)");
+        throw vislib::InputError(o.scene, "triangle " + std::to_string(t) + " of object " +
+                                              std::to_string(scene.triangle_object[t]) +
+                                              " follows one of object " +
+                                              std::to_string(scene.triangle_object[t - 1]) +
+                                              ": the objects are not in id order, so a .glb export "
+                                              "would not keep the triangle ids "
+                                              "(export .obj instead)");
     vislib::write_file_atomic(o.out, vislib::scene_to_glb(scene));
     if (show_progress())
       std::fprintf(stderr, "pvs: wrote %s (%zu objects, %zu triangles in id order)\n",

@@ -27,12 +27,29 @@ const overlay = document.getElementById("overlay");
 const mapCanvas = document.getElementById("map");
 const canvas = document.getElementById("view");
 
-const VERTEX = `in vec3 position; in vec3 normal; in vec3 colour;
+// Near-far (near-far paper §4.1, Eq. 1 with a = r2 - r, runtime/near_far.h morph_vertex): with
+// nearFar on, a vertex at axis distance r from the centre O is kept (r <= r1), sent to
+// U + |OP| d_O (r >= r2: where O's environment map shows it) or, in between, to U + t d with
+// d = normalize(w d_U + (1 - w) d_O), t = w |UP| + (1 - w) |OP|, w = (r2 - r) / (r2 - r1).
+const VERTEX = `
+in vec3 position; in vec3 normal; in vec3 colour;
 uniform mat4 projectionMatrix, viewMatrix;
+uniform vec3 eye, centre;
+uniform float r1, r2;
+uniform bool nearFar;
 out vec3 vWorld; out vec3 vNormal; out vec3 vColour;
+vec3 morph(vec3 p) {
+  float r = length(p.xz - centre.xz);
+  if (!nearFar || r <= r1) return p;
+  vec3 up = p - eye, op = p - centre;
+  if (r >= r2) return eye + length(op) * normalize(op);
+  float w = (r2 - r) / (r2 - r1);
+  vec3 d = normalize(w * normalize(up) + (1.0 - w) * normalize(op));
+  return eye + (w * length(up) + (1.0 - w) * length(op)) * d;
+}
 void main() {
-  vWorld = position; vNormal = normal; vColour = colour;
-  gl_Position = projectionMatrix * viewMatrix * vec4(position, 1.0);
+  vWorld = morph(position); vNormal = normal; vColour = colour;
+  gl_Position = projectionMatrix * viewMatrix * vec4(vWorld, 1.0);
 }`;
 const FRAGMENT = `precision highp float;
 uniform vec3 eye;
@@ -97,6 +114,9 @@ class Viewer {
     const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
     if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
     this.fov = Number(params.get("fov") || 60);
+    // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size.
+    this.nearFar = params.get("nearfar") ? params.get("nearfar").split(",").map(Number) : null;
+    this.envSize = Number(params.get("envsize") || 512);
     this.prefetch = params.has("prefetch") ? Number(params.get("prefetch") || 0) : -1;
     const size = params.get("size");
     if (size) {
@@ -128,7 +148,8 @@ class Viewer {
     this.material = new THREE.RawShaderMaterial({
       vertexShader: VERTEX, fragmentShader: FRAGMENT, side: THREE.DoubleSide,
       glslVersion: THREE.GLSL3,
-      uniforms: {eye: {value: new THREE.Vector3()}},
+      uniforms: {eye: {value: new THREE.Vector3()}, centre: {value: new THREE.Vector3()},
+                 r1: {value: 0}, r2: {value: 1}, nearFar: {value: false}},
     });
     this.mesh = new THREE.Mesh(this.geometry, this.material);
     this.mesh.frustumCulled = false;
@@ -144,12 +165,15 @@ class Viewer {
     this.camera.position.set(...at);
     if (params.get("look")) this.camera.lookAt(...vec3(params.get("look")));
     else this.camera.lookAt(at[0] + 1, at[1], at[2]);
+    if (this.nearFar) this.initNearFar();
     this.setDrawList(null);
     this.drawMapBase();
     return this;
   }
 
   setDrawList(ids) {
+    this.far = 0;
+    if (ids && this.nearFar) ids = this.partitionNearFar(ids);
     if (ids) {
       this.geometry.setIndex(indexOf(ids));
       this.drawn = ids.length;
@@ -157,6 +181,51 @@ class Viewer {
       this.geometry.setIndex(null);
       this.drawn = this.total;
     }
+  }
+
+  // Near-far: the environment cube map (colour) is rendered from the centre O of the cell's view
+  // region on entering the cell, from the cell's far triangles (every vertex at axis distance
+  // >= r2); the main pass draws the others (near and intermediate, morphed) over it.
+  initNearFar() {
+    const [r1, r2] = this.nearFar;
+    if (!(r1 >= 0 && r2 > r1)) throw new Error(`nearfar=${this.nearFar}: need 0 <= r1 < r2`);
+    this.envTarget = new THREE.WebGLCubeRenderTarget(this.envSize);
+    this.cubeCamera = new THREE.CubeCamera(0.05, this.camera.far, this.envTarget);
+    this.envGeometry = new THREE.BufferGeometry();
+    for (const name of ["position", "normal", "colour"])
+      this.envGeometry.setAttribute(name, this.geometry.getAttribute(name));
+    this.envMaterial = this.material.clone();
+    this.envMaterial.uniforms.nearFar.value = false;
+    this.envMesh = new THREE.Mesh(this.envGeometry, this.envMaterial);
+    this.envMesh.frustumCulled = false;
+    this.envWorld = new THREE.Scene();
+    this.envWorld.add(this.envMesh);
+    this.material.uniforms.r1.value = r1;
+    this.material.uniforms.r2.value = r2;
+  }
+
+  partitionNearFar(ids) {
+    const [, r2] = this.nearFar;
+    const b = this.pvs.boxes, c = this.cell, p = this.scene.positions;
+    const o = [(b[6 * c] + b[6 * c + 3]) / 2, (b[6 * c + 1] + b[6 * c + 4]) / 2,
+               (b[6 * c + 2] + b[6 * c + 5]) / 2];
+    const near = [], far = [];
+    for (const t of ids) {
+      let allFar = true;
+      for (let k = 0; k < 3 && allFar; ++k)
+        allFar = Math.hypot(p[9 * t + 3 * k] - o[0], p[9 * t + 3 * k + 2] - o[2]) >= r2;
+      (allFar ? far : near).push(t);
+    }
+    this.material.uniforms.centre.value.set(...o);
+    this.material.uniforms.nearFar.value = true;
+    this.envGeometry.setIndex(indexOf(far));
+    this.envMaterial.uniforms.eye.value.set(...o);
+    this.cubeCamera.position.set(...o);
+    this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
+    this.cubeCamera.update(this.renderer, this.envWorld);
+    this.world.background = this.envTarget.texture;
+    this.far = far.length;
+    return near;
   }
 
   // One frame from the camera's current pose: the runtime's cell, the draw list, the render.
@@ -179,6 +248,7 @@ class Viewer {
     this.showOverlay(ms);
     this.drawMap();
     return {cell: this.found, drawn_cell: this.cell, triangles_drawn: this.drawn,
+            triangles_far: this.far,
             triangles_total: this.total, ms, bytes_fetched: this.bytes,
             range_requests: this.requests, eye: [p.x, p.y, p.z]};
   }
@@ -209,8 +279,8 @@ class Viewer {
       ? `<span class="outside">outside every cell: ${this.cell >= 0 ? `keeping cell ${this.cell}'s set` : "drawing the whole scene"}</span>`
       : `cell ${this.found} of ${this.pvs.info.cell_count}`;
     overlay.innerHTML =
-      `${cellText}\ntriangles drawn ${this.drawn} / ${this.total}` +
-      ` (${(100 * this.drawn / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
+      `${cellText}\ntriangles drawn ${this.drawn}${this.nearFar ? ` near + ${this.far} far (environment map)` : ""} / ${this.total}` +
+      ` (${(100 * (this.drawn + this.far) / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
       `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
       `\nscene ${this.sceneBytes} bytes`;
   }
