@@ -16,9 +16,10 @@ if [[ ! -f $work/city.pvs ]]; then
 fi
 echo "web-check-test: bake $work/city.pvs ($(($(date +%s) - start)) s)"
 # Along the east-west street through the centre crossing, then north along the cross street,
-# looking ahead; the last point looks back at the crossing.
+# looking ahead; then looking back at the crossing; then from 40 m up, outside every cell (the
+# page keeps the last cell's set: the cell found must be none there, as for pvs inspect).
 path="-100,1.6,0;-80,1.6,0;-60,1.6,0;-40,1.6,0;-20,1.6,0;0,1.6,0;20,1.6,0;40,1.6,0;60,1.6,0"
-path+=";80,1.6,0;0,1.6,20;0,1.6,40;0,1.6,60;0,1.6,80@0,1.6,0"
+path+=";80,1.6,0;0,1.6,20;0,1.6,40;0,1.6,60;0,1.6,80@0,1.6,0;0,40,60@0,0,0"
 set +e
 PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" \
   --path "$path" --json "$work/web_check.json" --png "$work/png" --png-frames 0,5,13 --size 640x400

@@ -31,7 +31,10 @@ web_stage() {
 }
 
 web_unstage() {
-  [[ -n ${SERVER_PID:-} ]] && kill "$SERVER_PID" 2>/dev/null && wait "$SERVER_PID" 2>/dev/null
-  [[ -n ${STAGE:-} && -d $STAGE ]] && rm -rf "$STAGE"
+  if [[ -n ${SERVER_PID:-} ]]; then
+    kill "$SERVER_PID" 2>/dev/null || true
+    wait "$SERVER_PID" 2>/dev/null || true
+  fi
+  if [[ -n ${STAGE:-} && -d $STAGE ]]; then rm -rf "$STAGE"; fi
   return 0
 }

@@ -430,7 +430,9 @@ TEST(RuntimeCApi, OpenRangesAnswersLikeOpenByPath) {
     uint32_t ca = 99, cb = 98;
     const pvs_rt_status sa = pvs_rt_find_cell(by_path, p, &ca);
     ASSERT_EQ(sa, pvs_rt_find_cell(by_ranges, p, &cb));
-    if (sa == PVS_RT_OK) EXPECT_EQ(ca, cb);
+    if (sa == PVS_RT_OK) {
+      EXPECT_EQ(ca, cb);
+    }
   }
   for (uint32_t c = 0; c < a.cell_count; ++c) EXPECT_EQ(ids_of(by_path, c), ids_of(by_ranges, c));
   pvs_rt_close(by_path);
