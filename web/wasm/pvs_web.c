@@ -11,7 +11,7 @@
  * failed request. Offsets travel as doubles (exact below 2^53). */
 EM_JS(int, pvs_web_read_js, (double offset, double size, void* out), {
   var bytes = Module.readRange(offset, size);
-  if (!bytes || bytes.length != = size) return 1;
+  if (!bytes || bytes.length != size) return 1;  // both numbers: != compares values
   HEAPU8.set(bytes, out);
   return 0;
 });
