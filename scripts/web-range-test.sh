@@ -6,6 +6,7 @@
 #  1. natively, through pvs_rt_open_ranges with a counting read callback (must pass);
 #  2. through the range server (scripts/serve_web.py) and the runtime in WebAssembly in headless
 #     chromium: the server's log must list exactly the same ranges.
+# The 1 GB file is deleted at the end unless VISLIB_KEEP_1GB=1 (then a rerun reuses it).
 # Usage: web-range-test.sh PVS_SYNTHETIC WORKDIR. Exit 0 pass, 1 fail (a missing web bundle too),
 # 77 chromium cannot start (after part 1 passed). Time budget: writing the file is about
 # a minute on an idle core (more on a loaded machine); the checks take seconds.
@@ -14,6 +15,7 @@ synth=$1 work=$2
 root=$(cd "$(dirname "$0")/.." && pwd)
 mkdir -p "$work"
 big=$work/synthetic_1gb.pvs
+[[ ${VISLIB_KEEP_1GB:-0} == 1 ]] || trap 'rm -f "$big"' EXIT
 # 212 x 212 cells of 8000 ids with 3-byte gaps: about 24 KB per block, 1.08 GB in all.
 start=$(date +%s)
 if [[ ! -f $big ]]; then
@@ -41,8 +43,9 @@ fi
 stage=$(mktemp -d "${TMPDIR:-/tmp}/vislib-web-range.XXXXXX")
 server=""
 cleanup() {
-  [[ -n $server ]] && kill "$server" 2>/dev/null
+  if [[ -n $server ]]; then kill "$server" 2>/dev/null || true; fi
   rm -rf "$stage"
+  [[ ${VISLIB_KEEP_1GB:-0} == 1 ]] || rm -f "$big"
 }
 trap cleanup EXIT
 ln -s "$root/web" "$stage/web"
