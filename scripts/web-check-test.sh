@@ -2,7 +2,9 @@
 # Headless test of the web client (ctest web_check_city): the quick start's bake of data/city.glb
 # (at --res 32 for speed), replayed in chromium along a path through at least 5 cells. For every
 # frame, the cell the runtime found in the browser must equal `pvs inspect --at`'s (or both find
-# none), and the triangles drawn must equal that cell's PVS count.
+# none), and the triangles drawn must equal that cell's PVS count. Then the page's frames of the
+# centre crossing's PVS, looking along the four axes, are compared with `pvs inspect --render`'s
+# pixel by pixel (scripts/web_compare.py: PSNR and the share of edge pixels).
 # Usage: web-check-test.sh PVS_EXE WORKDIR. Exit 0 pass, 1 fail, 2 missing build, 77 chromium
 # cannot start. Time budget: the bake about 20 s on 2 cores, the replay about 10 s.
 set -euo pipefail
@@ -56,3 +58,13 @@ print("web-check-test: %s: %d frames through %d cells" % ("pass" if ok else "FAI
                                                            len(cells)))
 sys.exit(0 if ok else 1)
 PY
+"$pvs" inspect "$work/city.pvs" --scene "$root/data/city.glb" --at 0,1.6,0 --render "$work/cpu" \
+  --frame 320x240 -q >/dev/null
+set +e
+PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
+  --path "0,1.6,0@1,1.6,0;0,1.6,0@0,1.6,1;0,1.6,0@-1,1.6,0;0,1.6,0@0,1.6,-1" --fov 90 \
+  --size 320x240 --json "$work/compare.json" --png "$work/compare" --png-frames 0,1,2,3
+rc=$?
+set -e
+[[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh (frames to compare) exited $rc"; exit 1; }
+/usr/bin/python3 "$root/scripts/web_compare.py" "$work/cpu" "$work/compare"

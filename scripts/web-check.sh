@@ -5,7 +5,8 @@
 # triangles drawn, ms per frame and PVS bytes fetched (and what the server sent) to OUT.
 #
 # Usage: web-check.sh SCENE PVS --path "x,y,z[@lx,ly,lz];..." --json OUT
-#                     [--png DIR --png-frames 0,4,9] [--size WxH] [--fov DEG]
+#                     [--png DIR --png-frames 0,4,9] [--size WxH] [--fov DEG] [--bare]
+# --bare: the frames without the overlays (to compare with pvs inspect --render's frames).
 # Exit: 0 done, 1 the page failed, 2 bad arguments or missing build, 77 chromium cannot start.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -13,8 +14,13 @@ usage() { sed -n 's/^# Usage: //p;s/^#   *\(\[--png.*\)/\1/p' "$0" >&2; exit 2; 
 [[ $# -ge 2 ]] || usage
 scene=$1 pvs=$2
 shift 2
-path_text="" json="" png="" png_frames="" size=640x400 fov=60
+path_text="" json="" png="" png_frames="" size=640x400 fov=60 extra=
 while [[ $# -gt 0 ]]; do
+  if [[ $1 == --bare ]]; then
+    extra="&overlay=0"
+    shift
+    continue
+  fi
   [[ $# -ge 2 ]] || usage
   case $1 in
     --path) path_text=$2 ;;
@@ -33,7 +39,7 @@ source "$root/scripts/web_stage.sh"
 trap web_unstage EXIT
 web_stage "$scene" "$pvs"
 query=$(python3 -c 'import sys, urllib.parse as u; print(u.quote(sys.argv[1], safe=",;@.-"))' "$path_text")
-url="$PAGE&path=$query&size=$size&fov=$fov"
+url="$PAGE&path=$query&size=$size&fov=$fov$extra"
 mkdir -p "$(dirname "$json")"
 set +e
 node "$root/web/tools/web_check.mjs" --url "$url" --json "$json" \

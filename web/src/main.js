@@ -4,7 +4,8 @@
 //
 // URL parameters: scene=URL (GLB), pvs=URL, at=x,y,z and look=x,y,z (start), fov=degrees
 // (vertical, default 60), prefetch=MARGIN (on entering a cell, fetch the blocks of its neighbours
-// within MARGIN scene units; off by default, so that only visited cells are fetched), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
+// within MARGIN scene units; off by default, so that only visited cells are fetched), overlay=0
+// (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
 // frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size).
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
@@ -114,6 +115,8 @@ class Viewer {
     const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
     if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
     this.fov = Number(params.get("fov") || 60);
+    if (params.get("overlay") === "0")
+      for (const id of ["overlay", "map", "help"]) document.getElementById(id).style.display = "none";
     // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size.
     this.nearFar = params.get("nearfar") ? params.get("nearfar").split(",").map(Number) : null;
     this.envSize = Number(params.get("envsize") || 512);
