@@ -4,7 +4,9 @@
 # frame, the cell the runtime found in the browser must equal `pvs inspect --at`'s (or both find
 # none), and the triangles drawn must equal that cell's PVS count. Then the page's frames of the
 # centre crossing's PVS, looking along the four axes, are compared with `pvs inspect --render`'s
-# pixel by pixel (scripts/web_compare.py: PSNR and the share of edge pixels).
+# pixel by pixel (scripts/web_compare.py: PSNR and the share of edge pixels), and the popping
+# meter's pixels with the CPU renderer's missed pixels of the same views (within 0.1% of the
+# frame's pixels: rasterisation against ray casting on triangle edges, and coplanar faces).
 # Usage: web-check-test.sh PVS_EXE WORKDIR. Exit 0 pass, 1 fail, 2 missing build, 77 chromium
 # cannot start. Time budget: the bake about 20 s on 2 cores, the replay about 10 s.
 set -euo pipefail
@@ -59,12 +61,22 @@ print("web-check-test: %s: %d frames through %d cells" % ("pass" if ok else "FAI
 sys.exit(0 if ok else 1)
 PY
 "$pvs" inspect "$work/city.pvs" --scene "$root/data/city.glb" --at 0,1.6,0 --render "$work/cpu" \
-  --frame 320x240 -q >/dev/null
+  --frame 320x240 --json -q >"$work/cpu.json"
 set +e
 PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
   --path "0,1.6,0@1,1.6,0;0,1.6,0@0,1.6,1;0,1.6,0@-1,1.6,0;0,1.6,0@0,1.6,-1" --fov 90 \
-  --size 320x240 --json "$work/compare.json" --png "$work/compare" --png-frames 0,1,2,3
+  --size 320x240 --popping 1 --json "$work/compare.json" --png "$work/compare" --png-frames 0,1,2,3
 rc=$?
 set -e
 [[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh (frames to compare) exited $rc"; exit 1; }
 /usr/bin/python3 "$root/scripts/web_compare.py" "$work/cpu" "$work/compare"
+python3 - "$work/cpu.json" "$work/compare.json" <<'PY'
+import json, sys
+cpu = [v["missed_pixels"] for v in json.load(open(sys.argv[1]))["render"]["views"]]
+web = [f["popping_pixels"] for f in json.load(open(sys.argv[2]))["frames"]]
+tolerance = 0.001 * 320 * 240  # pixels
+ok = len(web) == len(cpu) and all(w is not None and abs(w - c) <= tolerance for w, c in zip(web, cpu))
+print("web-check-test: popping pixels %s, CPU missed pixels %s (tolerance %d): %s"
+      % (web, cpu, tolerance, "pass" if ok else "FAIL"))
+sys.exit(0 if ok else 1)
+PY

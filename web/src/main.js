@@ -64,6 +64,26 @@ void main() {
   outColour = vec4(vColour * shade, 1.0);
 }`;
 
+// The popping meter's id pass (WebGL2 has no primitive id): the full scene, de-indexed, so the
+// vertex id / 3 is the triangle id, written as 24-bit RGB; the background stays 0xFFFFFF.
+const ID_VERTEX = `
+in vec3 position;
+uniform mat4 projectionMatrix, viewMatrix;
+flat out int vId;
+void main() {
+  vId = gl_VertexID / 3;
+  gl_Position = projectionMatrix * viewMatrix * vec4(position, 1.0);
+}`;
+const ID_FRAGMENT = `
+precision highp float;
+precision highp int;
+flat in int vId;
+out vec4 outColour;
+void main() {
+  outColour = vec4(float(vId & 255), float((vId >> 8) & 255), float((vId >> 16) & 255), 255.0) / 255.0;
+}`;
+const NO_ID = 0xFFFFFF;
+
 async function fetchBytes(url) {
   const r = await fetch(url);
   if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
@@ -120,6 +140,10 @@ class Viewer {
     // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size.
     this.nearFar = params.get("nearfar") ? params.get("nearfar").split(",").map(Number) : null;
     this.envSize = Number(params.get("envsize") || 512);
+    // popping=K: the popping meter every K frames (0: off; key P measures once).
+    this.poppingEvery = Number(params.get("popping") || 0);
+    this.frameCount = 0;
+    this.popping = null;
     this.prefetch = params.has("prefetch") ? Number(params.get("prefetch") || 0) : -1;
     const size = params.get("size");
     if (size) {
@@ -169,6 +193,7 @@ class Viewer {
     if (params.get("look")) this.camera.lookAt(...vec3(params.get("look")));
     else this.camera.lookAt(at[0] + 1, at[1], at[2]);
     if (this.nearFar) this.initNearFar();
+    this.initPopping();
     this.setDrawList(null);
     this.drawMapBase();
     return this;
@@ -176,6 +201,11 @@ class Viewer {
 
   setDrawList(ids) {
     this.far = 0;
+    this.mask = null;
+    if (ids) {
+      this.mask = new Uint8Array(this.total);
+      for (const t of ids) this.mask[t] = 1;
+    }
     if (ids && this.nearFar) ids = this.partitionNearFar(ids);
     if (ids) {
       this.geometry.setIndex(indexOf(ids));
@@ -231,6 +261,61 @@ class Viewer {
     return near;
   }
 
+  initPopping() {
+    const w = this.renderer.domElement.width, h = this.renderer.domElement.height;
+    this.idTarget = new THREE.WebGLRenderTarget(w, h, {depthBuffer: true});
+    this.idMaterial = new THREE.RawShaderMaterial({
+      vertexShader: ID_VERTEX, fragmentShader: ID_FRAGMENT, side: THREE.DoubleSide,
+      glslVersion: THREE.GLSL3,
+    });
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", this.geometry.getAttribute("position"));
+    const mesh = new THREE.Mesh(g, this.idMaterial);
+    mesh.frustumCulled = false;
+    this.idWorld = new THREE.Scene();
+    this.idWorld.add(mesh);
+    this.idPixels = new Uint8Array(4 * w * h);
+    this.heat = document.createElement("canvas");
+    this.heat.width = w;
+    this.heat.height = h;
+    this.heat.style.cssText = "position:absolute;left:0;top:0;pointer-events:none;" +
+      `width:${canvas.style.width || "100%"};height:${canvas.style.height || "100%"}`;
+    if (params.get("overlay") === "0") this.heat.style.display = "none";
+    document.body.insertBefore(this.heat, overlay);  // under the text overlays
+    addEventListener("keydown", (e) => { if (e.key === "p") this.measureNext = true; });
+  }
+
+  // The popping meter: the full scene's first triangle per pixel (id pass); a pixel pops when
+  // that triangle is not in the drawn cell's set (what the CPU renderer counts as a missed
+  // pixel). Shown as a red heat overlay; returns the count.
+  measurePopping() {
+    const w = this.idTarget.width, h = this.idTarget.height;
+    const clear = new THREE.Color();
+    this.renderer.getClearColor(clear);
+    this.renderer.setRenderTarget(this.idTarget);
+    this.renderer.setClearColor(new THREE.Color(1, 1, 1), 1);
+    this.renderer.clear();
+    this.renderer.render(this.idWorld, this.camera);
+    this.renderer.readRenderTargetPixels(this.idTarget, 0, 0, w, h, this.idPixels);
+    this.renderer.setRenderTarget(null);
+    this.renderer.setClearColor(clear, 1);
+    const ctx = this.heat.getContext("2d");
+    const img = ctx.createImageData(w, h);
+    let count = 0;
+    for (let y = 0; y < h; ++y)
+      for (let x = 0; x < w; ++x) {
+        const i = 4 * (y * w + x);
+        const id = this.idPixels[i] | (this.idPixels[i + 1] << 8) | (this.idPixels[i + 2] << 16);
+        if (id === NO_ID || !this.mask || this.mask[id]) continue;
+        ++count;
+        const o = 4 * ((h - 1 - y) * w + x);  // the read-back rows run bottom-up
+        img.data[o] = 255;
+        img.data[o + 3] = 200;
+      }
+    ctx.putImageData(img, 0, 0);
+    return count;
+  }
+
   // One frame from the camera's current pose: the runtime's cell, the draw list, the render.
   async frame() {
     const t0 = performance.now();
@@ -245,13 +330,18 @@ class Viewer {
     this.requests = r.requests;
     this.material.uniforms.eye.value.copy(p);
     this.renderer.render(this.world, this.camera);
+    const measure = this.measureNext ||
+      (this.poppingEvery > 0 && this.frameCount % this.poppingEvery === 0);
+    this.measureNext = false;
+    this.frameCount += 1;
+    if (measure) this.popping = this.measurePopping();
     const gl = this.renderer.getContext();
     gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the GPU
     const ms = performance.now() - t0;
     this.showOverlay(ms);
     this.drawMap();
     return {cell: this.found, drawn_cell: this.cell, triangles_drawn: this.drawn,
-            triangles_far: this.far,
+            triangles_far: this.far, popping_pixels: measure ? this.popping : null,
             triangles_total: this.total, ms, bytes_fetched: this.bytes,
             range_requests: this.requests, eye: [p.x, p.y, p.z]};
   }
@@ -285,7 +375,8 @@ class Viewer {
       `${cellText}\ntriangles drawn ${this.drawn}${this.nearFar ? ` near + ${this.far} far (environment map)` : ""} / ${this.total}` +
       ` (${(100 * (this.drawn + this.far) / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
       `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
-      `\nscene ${this.sceneBytes} bytes`;
+      `\nscene ${this.sceneBytes} bytes` +
+      (this.popping === null ? "" : `\npopping pixels ${this.popping} (last measured; P measures)`);
   }
 
   // Top view of the cells, coloured by PVS size (dark blue: smallest, yellow: largest).
