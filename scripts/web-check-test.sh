@@ -7,6 +7,8 @@
 # pixel by pixel (scripts/web_compare.py: PSNR and the share of edge pixels), and the popping
 # meter's pixels with the CPU renderer's missed pixels of the same views (within 0.1% of the
 # frame's pixels: rasterisation against ray casting on triangle edges, and coplanar faces).
+# Last, the page's near-far frame against `pvs view`'s with the same choices pinned (centre,
+# radii, environment map size, eye lookup, 90 degrees, 320 x 240): PSNR at least 35 dB.
 # Usage: web-check-test.sh PVS_EXE WORKDIR. Exit 0 pass, 1 fail, 2 missing build, 77 chromium
 # cannot start. Time budget: the bake about 20 s on 2 cores, the replay about 10 s.
 set -euo pipefail
@@ -78,5 +80,27 @@ tolerance = 0.001 * 320 * 240  # pixels
 ok = len(web) == len(cpu) and all(w is not None and abs(w - c) <= tolerance for w, c in zip(web, cpu))
 print("web-check-test: popping pixels %s, CPU missed pixels %s (tolerance %d): %s"
       % (web, cpu, tolerance, "pass" if ok else "FAIL"))
+sys.exit(0 if ok else 1)
+PY
+"$pvs" view "$work/city.pvs" --scene "$root/data/city.glb" --at 0,1.6,0 --look 30,1.6,0 \
+  --near-far 15,40 --centre 0,1.6,0 --env-size 512 --lookup eye --frame 320x240 -q \
+  -o "$work/near_far/cpu.png"
+set +e
+PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
+  --path "0,1.6,0@30,1.6,0" --fov 90 --size 320x240 --near-far 15,40 --centre 0,1.6,0 \
+  --env-size 512 --json "$work/near_far.json" --png "$work/near_far" --png-frames 0
+rc=$?
+set -e
+[[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh (near-far) exited $rc"; exit 1; }
+/usr/bin/python3 - "$work/near_far/cpu.png" "$work/near_far/frame_0000.png" <<'PY'
+import sys
+import matplotlib.image as mi
+import numpy as np
+a, b = (np.round(mi.imread(f)[:, :, :3] * 255) for f in sys.argv[1:3])
+mse = float(((a - b) ** 2).mean())
+psnr = 10 * np.log10(255.0 ** 2 / mse) if mse > 0 else float("inf")
+ok = a.shape == b.shape and psnr >= 35.0
+print("web-check-test: near-far frame against pvs view's: PSNR %.2f dB (>= 35): %s"
+      % (psnr, "pass" if ok else "FAIL"))
 sys.exit(0 if ok else 1)
 PY

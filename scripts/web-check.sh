@@ -6,7 +6,7 @@
 #
 # Usage: web-check.sh SCENE PVS --path "x,y,z[@lx,ly,lz];..." --json OUT
 #                     [--png DIR --png-frames 0,4,9] [--size WxH] [--fov DEG] [--bare]
-#                     [--popping K]
+#                     [--popping K] [--near-far r1,r2 [--centre x,y,z] [--env-size N]]
 # --popping K: the popping meter every K frames (popping_pixels per measured frame).
 # --bare: the frames without the overlays (to compare with pvs inspect --render's frames).
 # Exit: 0 done, 1 the page failed, 2 bad arguments or missing build, 77 chromium cannot start.
@@ -32,6 +32,9 @@ while [[ $# -gt 0 ]]; do
     --size) size=$2 ;;
     --fov) fov=$2 ;;
     --popping) extra+="&popping=$2" ;;
+    --near-far) extra+="&nearfar=$2" ;;
+    --centre) extra+="&centre=$2" ;;
+    --env-size) extra+="&envsize=$2" ;;
     *) echo "web-check: unknown option $1" >&2; usage ;;
   esac
   shift 2

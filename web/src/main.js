@@ -137,7 +137,8 @@ class Viewer {
     this.fov = Number(params.get("fov") || 60);
     if (params.get("overlay") === "0")
       for (const id of ["overlay", "map", "help"]) document.getElementById(id).style.display = "none";
-    // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size.
+    // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size;
+    // centre=x,y,z: O for every cell (default: the centre of the cell's view region).
     this.nearFar = params.get("nearfar") ? params.get("nearfar").split(",").map(Number) : null;
     this.envSize = Number(params.get("envsize") || 512);
     // popping=K: the popping meter every K frames (0: off; key P measures once).
@@ -240,8 +241,8 @@ class Viewer {
   partitionNearFar(ids) {
     const [, r2] = this.nearFar;
     const b = this.pvs.boxes, c = this.cell, p = this.scene.positions;
-    const o = [(b[6 * c] + b[6 * c + 3]) / 2, (b[6 * c + 1] + b[6 * c + 4]) / 2,
-               (b[6 * c + 2] + b[6 * c + 5]) / 2];
+    const o = params.get("centre") ? vec3(params.get("centre"))
+      : [(b[6 * c] + b[6 * c + 3]) / 2, (b[6 * c + 1] + b[6 * c + 4]) / 2, (b[6 * c + 2] + b[6 * c + 5]) / 2];
     const near = [], far = [];
     for (const t of ids) {
       let allFar = true;
