@@ -1,7 +1,11 @@
 // pvs export SCENE -o flat.obj [--states K] [--time TAU]: the scene as a flat OBJ whose face i is
-// triangle id i. One `o <object name>` line each time the object changes along the id order,
-// all vertices as `v` lines (%.17g, exact round trip) in vertex order, one `f` line per triangle.
-// Positions are those at animation time TAU (Scene::position_at; default 0 = state 0).
+// triangle id i. With -o FILE.glb: the scene as binary glTF for the web client (web/), one node
+// and mesh per object in object order, primitives in id order (scene_to_glb), so that reading the
+// meshes in order gives the triangles in id order; refused (exit 2) when the scene's triangle
+// objects are not non-decreasing in id order, where that reading would not give vislib's ids. One
+// `o <object name>` line each time the object changes along the id order, all vertices as `v` lines
+// (%.17g, exact round trip) in vertex order, one `f` line per triangle. Positions are those at
+// animation time TAU (Scene::position_at; default 0 = state 0).
 // --id-map FILE.json: the runs of consecutive triangle ids of one object with their vertex blocks
 // (vislib/scene/id_map.h), so an engine maps PVS ids to its draw calls.
 // Spheres, if any, go to OUT.spheres in the sphere text format (docs/sphere-format.md): all key
@@ -12,8 +16,10 @@
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/id_map.h"
+#include "vislib/scene/write_gltf.h"
 
 namespace pvs_cli {
 namespace {
@@ -32,9 +38,30 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
 }
 
 void run_export(const ExportOptions& o) {
+  const bool glb = vislib::file_extension(o.out) == ".glb";
+  if (glb && o.time)
+    throw CLI::ValidationError("--time", "a .glb export keeps every key state (morph targets)");
+  if (glb && !o.id_map.empty())
+    throw CLI::ValidationError("--id-map", "goes with an .obj export (a .glb keeps the id order)");
   check_output_file(o.out, "--output");  // before any work
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
+  if (glb) {
+    for (size_t t = 1; t < scene.triangle_count(); ++t)
+      if (scene.triangle_object[t] < scene.triangle_object[t - 1])
+        throw vislib::InputError(o.scene, "triangle " + std::to_string(t) + " of object " +
+                                              std::to_string(scene.triangle_object[t]) +
+                                              " follows one of object " +
+                                              std::to_string(scene.triangle_object[t - 1]) +
+                                              ": the objects are not in id order, so a .glb export "
+                                              "would not keep the triangle ids "
+                                              "(export .obj instead)");
+    vislib::write_file_atomic(o.out, vislib::scene_to_glb(scene));
+    if (show_progress())
+      std::fprintf(stderr, "pvs: wrote %s (%zu objects, %zu triangles in id order)\n",
+                   o.out.c_str(), scene.objects.size(), scene.triangle_count());
+    return;
+  }
   double tau = o.time.value_or(0.0);
   std::string obj = "# pvs export of " + o.scene + ": face i is triangle id i\n";
   for (uint32_t v = 0; v < scene.vertex_count(); ++v) {
@@ -86,9 +113,11 @@ void run_export(const ExportOptions& o) {
 const Registration reg("export", [](CLI::App& app) {
   auto o = std::make_shared<ExportOptions>();
   auto* cmd = app.add_subcommand(
-      "export", "Write the scene as a flat OBJ (face i = triangle id i); spheres to OUT.spheres");
+      "export",
+      "Write the scene as a flat OBJ (face i = triangle id i; spheres to OUT.spheres), or as .glb "
+      "for the web client (meshes in object order, triangles in id order)");
   cmd->add_option("scene", o->scene, "Scene file")->required();
-  cmd->add_option("-o,--output", o->out, "Output .obj")->required();
+  cmd->add_option("-o,--output", o->out, "Output .obj, or .glb")->required();
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
       ->check(positive());
   cmd->add_option("--time", o->time, "Animation time in [0,1] (default: state 0)")

@@ -36,6 +36,8 @@ using nlohmann::json;
 struct InspectArgs {
   std::string file, at, scene, gltf, render_dir;
   std::string frame = "640x480";
+  std::string look;
+  double fov = 90;
   int64_t cell = -1;
   bool json_out = false;
   int max_ids = 40;
@@ -175,7 +177,17 @@ void run_inspect(const InspectArgs& a) {
                                          "'s view region is enclosed by the scene: give --at");
           eye = *free_space.free_point;
         }
-        j["render"] = render_cell(scene, ids, g, eye, a.render_dir, fw, fh);
+        vislib::CellViewOptions views;
+        views.vfov_degrees = a.fov;
+        if (!a.look.empty()) {
+          const vislib::Vec3 f = parse_vec3(a.look, "--look") - eye;
+          if (!(std::hypot(f.x, f.z) > 1e-9 * (1 + std::fabs(f.y))))
+            throw CLI::ValidationError("--look",
+                                       "must differ from the eye horizontally (the "
+                                       "camera's up is +y)");
+          views.forwards = {f};
+        }
+        j["render"] = render_cell(scene, ids, g, eye, a.render_dir, fw, fh, views);
       }
     }
     if (a.json_out) {
@@ -214,6 +226,12 @@ void add_inspect(CLI::App& app) {
       "map into this folder, "
       "with epsilon/PSNR/SSIM");
   cmd->add_option("--frame", a->frame, "Frame size WxH for --render")->capture_default_str();
+  cmd->add_option("--look", a->look,
+                  "With --render: one view, from the eye towards the point x,y,z, instead of the "
+                  "4 horizontal directions");
+  cmd->add_option("--fov", a->fov, "With --render: vertical field of view in degrees")
+      ->check(CLI::Range(1e-6, 179.999))
+      ->capture_default_str();
   cmd->add_option("--max-ids", a->max_ids, "Text output: print at most this many ids of a cell")
       ->capture_default_str();
   cmd->callback([a] { run_inspect(*a); });

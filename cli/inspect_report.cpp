@@ -132,10 +132,10 @@ void print_summary(const std::string& path, const json& j) {
 // cell's visible set and the error heat map in 4 horizontal directions; returns the metrics.
 json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids,
                  vislib::Granularity g, vislib::Vec3 eye, const std::string& dir, int width,
-                 int height) {
+                 int height, const vislib::CellViewOptions& options) {
   json views = json::array();
   for (const vislib::CellView& v : vislib::render_cell_views(
-           scene, vislib::visible_triangles(scene, ids, g), eye, dir, width, height)) {
+           scene, vislib::visible_triangles(scene, ids, g), eye, dir, width, height, options)) {
     const vislib::FrameQuality& q = v.quality;
     views.push_back({{"eye", {v.eye.x, v.eye.y, v.eye.z}},
                      {"forward", {v.forward.x, v.forward.y, v.forward.z}},
@@ -147,7 +147,10 @@ json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids,
                      {"pvs", v.pvs},
                      {"heat_map", v.heat_map}});
   }
-  return {{"views", views}, {"width", width}, {"height", height}};
+  return {{"views", views},
+          {"width", width},
+          {"height", height},
+          {"vfov_degrees", options.vfov_degrees}};
 }
 
 // The text output of one cell (the JSON `j` built by the command).

@@ -9,6 +9,7 @@
 
 #include "pvs_format/pvs_format.h"
 #include "vislib/base/vec.h"
+#include "vislib/eval/cell_views.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/scene.h"
 
@@ -20,11 +21,12 @@ nlohmann::json box_json(const pvs::Box& b);
 nlohmann::json summary(pvs::Reader& r);
 void print_summary(const std::string& path, const nlohmann::json& j);
 
-// Renders the full scene and the cell's visible set (`ids` of granularity g) from `eye` in four
-// horizontal directions into `dir`; returns the views' metrics and files.
+// Renders the full scene and the cell's visible set (`ids` of granularity g) from `eye` in the
+// views of `views` (default: four horizontal directions at 90 degrees) into `dir`; returns the
+// views' metrics and files.
 nlohmann::json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids,
                            vislib::Granularity g, vislib::Vec3 eye, const std::string& dir,
-                           int width, int height);
+                           int width, int height, const vislib::CellViewOptions& views = {});
 
 // The text output of one cell (the JSON `j` built by the command).
 void print_cell(const nlohmann::json& j, const std::vector<uint32_t>& ids, uint32_t cell_count,

@@ -688,6 +688,17 @@ struct FileSource : Reader::Source {
   }
 };
 
+struct RangeSource : Reader::Source {
+  uint64_t bytes = 0;
+  Reader::RangeRead fn;
+  uint64_t size() const override { return bytes; }
+  std::string read(uint64_t offset, size_t n) override {
+    std::string out(n, '\0');
+    if (n > 0) fn(offset, n, out.data());
+    return out;
+  }
+};
+
 }  // namespace
 
 Reader::Reader(Reader&&) noexcept = default;
@@ -720,6 +731,17 @@ Reader Reader::from_file(const std::string& path, const ReadOptions& options) {
   std::streamoff end = src->in.tellg();
   if (end < 0) throw FormatError(0, "cannot determine the size of " + path);
   src->bytes = uint64_t(end);
+  Reader r;
+  r.source_ = std::move(src);
+  r.open(options);
+  return r;
+}
+
+Reader Reader::from_ranges(uint64_t size, RangeRead read, const ReadOptions& options) {
+  if (!read) throw std::invalid_argument("pvs::Reader::from_ranges: no read function");
+  auto src = std::make_unique<RangeSource>();
+  src->bytes = size;
+  src->fn = std::move(read);
   Reader r;
   r.source_ = std::move(src);
   r.open(options);

@@ -190,6 +190,14 @@ class Reader {
   static Reader from_view(std::string_view bytes, const ReadOptions& options = {});
   // Throws FormatError(0, "cannot open ...") if the file cannot be opened.
   static Reader from_file(const std::string& path, const ReadOptions& options = {});
+  // Reads a file of `size` bytes that the caller serves by byte range (a file fetched over HTTP
+  // with range requests, a packed archive): `read(offset, n, out)` stores exactly the n bytes at
+  // `offset` in out[0..n) (offset + n <= size, n > 0), or throws (the exception reaches the
+  // caller of the Reader function that asked). Opening asks for the header, the layout section
+  // and the index; read_cell asks for the cell's block and those of its Delta chain, and nothing
+  // is cached: each call asks again.
+  using RangeRead = std::function<void(uint64_t offset, size_t n, char* out)>;
+  static Reader from_ranges(uint64_t size, RangeRead read, const ReadOptions& options = {});
 
   Reader(Reader&&) noexcept;
   Reader& operator=(Reader&&) noexcept;

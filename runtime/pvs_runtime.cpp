@@ -167,21 +167,46 @@ Pvs::Pvs(Pvs&&) noexcept = default;
 Pvs& Pvs::operator=(Pvs&&) noexcept = default;
 Pvs::~Pvs() = default;
 
+namespace {
+
+// The checks and tables of open() and open_ranges() once impl->reader is open.
+void finish_open(Pvs::Impl& impl, const OpenOptions& options);
+
+}  // namespace
+
 Pvs Pvs::open(const std::string& path, const OpenOptions& options) {
   auto impl = std::make_unique<Impl>();
   impl->mapping.map(path);
   pvs::ReadOptions ro;
   ro.max_universe = options.max_universe;
+  impl->reader.emplace(pvs::Reader::from_view(impl->mapping.view(), ro));
+  finish_open(*impl, options);
+  return Pvs(std::move(impl));
+}
+
+Pvs Pvs::open_ranges(uint64_t size, pvs::Reader::RangeRead read, const OpenOptions& options) {
+  auto impl = std::make_unique<Impl>();
+  pvs::ReadOptions ro;
+  ro.max_universe = options.max_universe;
+  impl->reader.emplace(pvs::Reader::from_ranges(size, std::move(read), ro));
+  finish_open(*impl, options);
+  return Pvs(std::move(impl));
+}
+
+namespace {
+
+void finish_open(Pvs::Impl& impl_ref, const OpenOptions& options) {
+  Pvs::Impl* impl = &impl_ref;
   // The fingerprint is compared here rather than by the reader so that a mismatch has its own
   // type (and C error code); the header CRC has been checked by then.
-  impl->reader.emplace(pvs::Reader::from_view(impl->mapping.view(), ro));
   const pvs::FileInfo& info = impl->reader->info();
   if (options.expected_fingerprint && *options.expected_fingerprint != info.scene_fingerprint)
     throw FingerprintMismatch(*options.expected_fingerprint, info.scene_fingerprint);
   if (options.verify_all_blocks) impl->reader->verify();
   if (info.layout.kind == pvs::LayoutKind::Boxes) impl->buckets.build(info.layout.boxes);
-  return Pvs(std::move(impl));
 }
+
+}  // namespace
 
 const pvs::FileInfo& Pvs::info() const {
   return impl_->reader->info();
@@ -252,6 +277,12 @@ bool Pvs::is_absent(uint32_t cell) {
 std::vector<uint32_t> Pvs::visible_ids(uint32_t cell) {
   assert(cell < cell_count());
   return impl_->reader->read_cell(cell);
+}
+
+std::pair<uint64_t, uint32_t> Pvs::block_range(uint32_t cell) const {
+  assert(cell < cell_count());
+  const pvs::IndexEntry& e = impl_->reader->entry(cell);
+  return {e.offset, e.size};
 }
 
 void Pvs::prefetch(uint32_t cell) {

@@ -20,6 +20,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
@@ -70,6 +71,13 @@ class Pvs {
   // Maps `path` read-only and checks its header, layout section and index (and every block if
   // options.verify_all_blocks). Throws OpenError, pvs::FormatError or FingerprintMismatch.
   static Pvs open(const std::string& path, const OpenOptions& options = {});
+  // Reads a file of `size` bytes through `read` (byte ranges, pvs::Reader::from_ranges) instead
+  // of a mapping: for a file served over HTTP range requests (the web client) or kept in an
+  // archive. Opening asks for the header, the layout section and the index; visible_ids() for the
+  // cell's block and those of its Delta chain; prefetch() does nothing. An exception `read`
+  // throws reaches the caller (the C API reports it as PVS_RT_IO).
+  static Pvs open_ranges(uint64_t size, pvs::Reader::RangeRead read,
+                         const OpenOptions& options = {});
 
   Pvs(Pvs&&) noexcept;
   Pvs& operator=(Pvs&&) noexcept;
@@ -102,6 +110,11 @@ class Pvs {
   // at most info().max_delta_depth more) from the mapping. Throws pvs::FormatError on a corrupt
   // block or an absent cell.
   std::vector<uint32_t> visible_ids(uint32_t cell);
+
+  // The byte range of the cell's block in the file (from the index; offset, bytes): what a
+  // streaming client fetches ahead for a cell (its Delta chain's blocks are known only once the
+  // block is read).
+  std::pair<uint64_t, uint32_t> block_range(uint32_t cell) const;
 
   // Asks the OS to page in the block of `cell` (madvise MADV_WILLNEED on its byte range, from the
   // index; returns immediately, reads nothing). The blocks of its Delta chain are not known

@@ -2,6 +2,7 @@
 // point catches every exception and maps it to a status code plus a per-thread message.
 #include "runtime/pvs_runtime_c.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <new>
@@ -68,6 +69,26 @@ pvs_rt_status pvs_rt_open(const char* path, int check_fingerprint, uint64_t expe
     pvs_runtime::OpenOptions opt;
     if (check_fingerprint) opt.expected_fingerprint = expected_fingerprint;
     *out = new pvs_rt{pvs_runtime::Pvs::open(path, opt)};
+    return PVS_RT_OK;
+  });
+}
+
+pvs_rt_status pvs_rt_open_ranges(uint64_t file_size, pvs_rt_read_fn read, void* user,
+                                 int check_fingerprint, uint64_t expected_fingerprint,
+                                 pvs_rt** out) {
+  if (out) *out = nullptr;
+  if (!read || !out)
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_open_ranges: read and out must not be null");
+  return guarded([&] {
+    pvs_runtime::OpenOptions opt;
+    if (check_fingerprint) opt.expected_fingerprint = expected_fingerprint;
+    auto fn = [read, user](uint64_t offset, size_t n, char* dst) {
+      if (read(user, offset, uint64_t(n), dst) != 0)
+        throw pvs_runtime::OpenError("cannot read " + std::to_string(n) + " bytes at byte " +
+                                         std::to_string(offset) + " (the read callback failed)",
+                                     EIO);
+    };
+    *out = new pvs_rt{pvs_runtime::Pvs::open_ranges(file_size, fn, opt)};
     return PVS_RT_OK;
   });
 }
@@ -165,6 +186,16 @@ pvs_rt_status pvs_rt_visible_ids(pvs_rt* h, uint32_t cell, uint32_t* out, size_t
     if (!ids.empty()) std::memcpy(out, ids.data(), ids.size() * sizeof(uint32_t));
     return PVS_RT_OK;
   });
+}
+
+pvs_rt_status pvs_rt_block_range(const pvs_rt* h, uint32_t cell, uint64_t* offset, uint32_t* size) {
+  if (!h || !offset || !size)
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_block_range: null argument");
+  if (pvs_rt_status s = check_cell(h, cell)) return s;
+  const auto r = h->pvs.block_range(cell);
+  *offset = r.first;
+  *size = r.second;
+  return PVS_RT_OK;
 }
 
 pvs_rt_status pvs_rt_prefetch(pvs_rt* h, uint32_t cell) {

@@ -27,7 +27,7 @@
 extern "C" {
 #endif
 
-typedef struct pvs_rt pvs_rt; /* an open, memory-mapped PVS file */
+typedef struct pvs_rt pvs_rt; /* an open PVS file (memory-mapped, or read by byte range) */
 
 typedef enum pvs_rt_status {
   PVS_RT_OK = 0,
@@ -59,6 +59,22 @@ typedef struct pvs_rt_info {
  * is set to NULL. */
 PVS_RT_API pvs_rt_status pvs_rt_open(const char* path, int check_fingerprint,
                                      uint64_t expected_fingerprint, pvs_rt** out);
+/* Reads `size` bytes at byte `offset` of the file into `out` (offset + size <= the file size,
+ * size > 0); returns 0 on success, anything else on failure. `user` is pvs_rt_open_ranges's. */
+typedef int (*pvs_rt_read_fn)(void* user, uint64_t offset, uint64_t size, void* out);
+
+/* Opens a PVS file of `file_size` bytes that `read` serves by byte range instead of a path (a file
+ * fetched over HTTP range requests, as the web client does): the open asks for the header, the
+ * layout section and the index; pvs_rt_visible_ids for the cell's block and the blocks of its
+ * Delta chain (at most pvs_rt_info's max delta depth more), every time (no cache: the caller may
+ * keep one); nothing else ever. pvs_rt_prefetch does nothing on such a handle
+ * (pvs_rt_block_range names what to fetch ahead). `read` and `user` must stay valid until
+ * pvs_rt_close. A failing read makes the call that needed it return PVS_RT_IO. Otherwise as
+ * pvs_rt_open. */
+PVS_RT_API pvs_rt_status pvs_rt_open_ranges(uint64_t file_size, pvs_rt_read_fn read, void* user,
+                                            int check_fingerprint, uint64_t expected_fingerprint,
+                                            pvs_rt** out);
+
 /* Releases the handle (NULL is allowed). */
 PVS_RT_API void pvs_rt_close(pvs_rt* handle);
 
@@ -91,6 +107,11 @@ PVS_RT_API pvs_rt_status pvs_rt_visible_count(const pvs_rt* handle, uint32_t cel
  * written). PVS_RT_FORMAT if the block is corrupt, PVS_RT_ABSENT for an absent cell. */
 PVS_RT_API pvs_rt_status pvs_rt_visible_ids(pvs_rt* handle, uint32_t cell, uint32_t* out,
                                             size_t capacity, size_t* count);
+
+/* The byte range of the cell's block (*offset from the start of the file, *size bytes), from the
+ * index: what a client streaming the file fetches ahead for a cell it may enter. */
+PVS_RT_API pvs_rt_status pvs_rt_block_range(const pvs_rt* handle, uint32_t cell, uint64_t* offset,
+                                            uint32_t* size);
 
 /* Asks the OS to page in the cell's block (returns immediately). */
 PVS_RT_API pvs_rt_status pvs_rt_prefetch(pvs_rt* handle, uint32_t cell);

@@ -7,6 +7,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
+# The web client (web/): emscripten, chromium, node + npm when missing, then its bundle.
+bash scripts/install-web-deps.sh
+bash scripts/build-web.sh
 mkdir -p out
 PVS=build/cli/pvs
 echo "== pvs info data/city.glb"
@@ -20,3 +23,4 @@ echo "== pvs inspect out/city.pvs --at 0,1.6,0 (the cell at the centre crossing)
 $PVS inspect out/city.pvs --scene data/city.glb --at 0,1.6,0 --max-ids 20 --render out/render \
   --export-gltf out/cell.glb
 echo "Done: out/city.pvs (the PVS), out/render/ (frames and heat maps), out/cell.glb (the cell's visible set)."
+echo "Walk through it in a browser: bash scripts/view.sh (prints the URL)."

@@ -5,5 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 BUILD_DIR=${BUILD_DIR:-build} bash scripts/build.sh "$@"
+# The web client's bundle, for its ctest checks (emscripten, chromium, node + npm when missing).
+bash scripts/install-web-deps.sh
+bash scripts/build-web.sh
 cd "${BUILD_DIR:-build}"
 ctest --output-on-failure -j "$(nproc)" --timeout 1500 2>&1 | tee ctest.log

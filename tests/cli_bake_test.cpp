@@ -457,3 +457,34 @@ TEST(CliBake, TheBvhWalkGivesTheSameFileAndTheSameSets) {
   EXPECT_EQ(sets[0], sets[1]);
   EXPECT_GT(sets[0].size(), 100u);
 }
+
+TEST(CliBake, InspectRenderLooksAtAPointWithAFieldOfView) {
+  std::string dir = temp_dir("cli_inspect_look");
+  std::string pvs = dir + "/city.pvs", out;
+  ASSERT_EQ(run_pvs("bake " + city() +
+                        " --walkable --cell-size 20 --box -20,-1,-20,20,2,20 --res 16 -q -o " + pvs,
+                    &out),
+            0)
+      << out;
+  const std::string base =
+      "inspect " + pvs + " --scene " + city() + " --at 0,1.6,0 --frame 40x30 --json -q --render ";
+  ASSERT_EQ(run_pvs(base + dir + "/four", &out), 0) << out;
+  // --look at a point along +x at the default 90 degrees: the first of the four views, exactly.
+  ASSERT_EQ(run_pvs(base + dir + "/look --look 5,1.6,0", &out), 0) << out;
+  json j = json::parse(out.substr(out.find('{')));
+  ASSERT_EQ(j["render"]["views"].size(), 1u);
+  EXPECT_EQ(j["render"]["vfov_degrees"], 90.0);
+  EXPECT_EQ(vislib::read_file(dir + "/look/view0_full.png"),
+            vislib::read_file(dir + "/four/view0_full.png"));
+  EXPECT_EQ(vislib::read_file(dir + "/look/view0_pvs.png"),
+            vislib::read_file(dir + "/four/view0_pvs.png"));
+  // A narrower field of view is another frame.
+  ASSERT_EQ(run_pvs(base + dir + "/narrow --look 5,1.6,0 --fov 40", &out), 0) << out;
+  EXPECT_EQ(json::parse(out.substr(out.find('{')))["render"]["vfov_degrees"], 40.0);
+  EXPECT_NE(vislib::read_file(dir + "/narrow/view0_full.png"),
+            vislib::read_file(dir + "/four/view0_full.png"));
+  // Looking straight up or at the eye has no horizontal direction; a field of view of 180 none.
+  EXPECT_EQ(run_pvs(base + dir + "/up --look 0,9,0", &out), 2) << out;
+  EXPECT_NE(out.find("--look"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs(base + dir + "/wide --fov 180", &out), 2) << out;
+}

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "tests/import_test_files.h"
@@ -134,4 +135,27 @@ TEST(CliExport, TimeSamplesTheAnimation) {
   ASSERT_EQ(a.vertex_count(), b.vertex_count());
   for (uint32_t v = 0; v < a.vertex_count(); ++v)
     ASSERT_EQ(a.position_at(v, 0.5), b.positions[0][v]);
+}
+
+TEST(CliExport, GlbKeepsTheIdOrderAndRefusesObjectsOutOfIdOrder) {
+  std::string dir = temp_dir("cli_export_glb");
+  const std::string verts = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  // Objects a, a, b, c, c in id order: the GLB's meshes in order give the ids back.
+  std::string in = write_text(dir + "/in.obj", verts +
+                                                   "o a\nf 1 2 3\nf 1 2 4\no b\nf 2 3 4\n"
+                                                   "o c\nf 1 3 4\nf 3 2 1\n");
+  std::string out;
+  ASSERT_EQ(run_pvs("export '" + in + "' -o '" + dir + "/s.glb'", &out), 0) << out;
+  vislib::Scene a = vislib::load_scene(in), b = vislib::load_scene(dir + "/s.glb");
+  EXPECT_EQ(b.triangle_object, a.triangle_object);
+  ASSERT_EQ(b.triangle_count(), a.triangle_count());
+  for (uint32_t t = 0; t < a.triangle_count(); ++t)
+    EXPECT_EQ(b.corners(t, 0), a.corners(t, 0)) << "triangle " << t;
+  // Object a again after b: reading the meshes in order would not give the ids.
+  std::string bad =
+      write_text(dir + "/bad.obj", verts + "o a\nf 1 2 3\no b\nf 2 3 4\no a\nf 1 3 4\n");
+  EXPECT_EQ(run_pvs("export '" + bad + "' -o '" + dir + "/bad.glb'", &out), 2) << out;
+  EXPECT_NE(out.find("not in id order"), std::string::npos) << out;
+  EXPECT_NE(out.find(bad), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/bad.glb"));
 }

@@ -6,11 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <set>
 #include <string>
 #include <vector>
 
+#include "pvs_format/pvs_format.h"
 #include "runtime/near_far_c.h"
 #include "runtime/pvs_runtime_c.h"
 
@@ -340,4 +343,163 @@ TEST(RuntimeCApi, SchedulerAndFingerprintRejectBadArguments) {
   uint64_t fd = 1;
   EXPECT_EQ(pvs_rt_scene_fingerprint(&md, 1, 1, 1, &fd), PVS_RT_OK);
   EXPECT_EQ(fd, fp);
+}
+
+namespace {
+
+// A file in memory served by byte range, recording every range asked for.
+struct RangeLog {
+  std::string bytes;
+  std::vector<std::pair<uint64_t, uint64_t>> ranges;  // [begin, end)
+  bool fail = false;
+};
+
+int read_range(void* user, uint64_t offset, uint64_t size, void* out) {
+  auto* log = static_cast<RangeLog*>(user);
+  if (log->fail || offset + size > log->bytes.size()) return 1;
+  log->ranges.emplace_back(offset, offset + size);
+  std::memcpy(out, log->bytes.data() + offset, size_t(size));
+  return 0;
+}
+
+// A 6 x 1 x 5 grid of nested random sets (neighbouring cells alike, so the writer picks Delta
+// blocks), written to a temporary file.
+struct RangeCase {
+  std::string path;
+  pvs::FileInfo info;
+  std::string bytes;
+};
+
+RangeCase make_range_case() {
+  RangeCase rc;
+  rc.info.scene_fingerprint = 0x5eedf00dull;
+  rc.info.universe = 5000;
+  rc.info.layout.grid_box = {{-30, 0, -25}, {30, 3, 25}};
+  rc.info.layout.nx = 6;
+  rc.info.layout.nz = 5;
+  rc.info.layout.eye_hi = 2;
+  std::mt19937 rng(7);
+  std::vector<pvs::CellSet> cells;
+  std::vector<uint32_t> base;
+  for (uint32_t i = 0; i < rc.info.universe; ++i)
+    if (rng() % 3 == 0) base.push_back(i);
+  for (uint32_t c = 0; c < 30; ++c) {
+    std::vector<uint32_t> ids;
+    for (uint32_t id : base)
+      if (rng() % 50 != 0) ids.push_back(id);
+    cells.emplace_back(ids);
+  }
+  rc.bytes = pvs::write_pvs(rc.info, cells);
+  rc.path = (std::filesystem::temp_directory_path() /
+             ("vislib_range_case_" + std::to_string(rng()) + ".pvs"))
+                .string();
+  std::ofstream(rc.path, std::ios::binary).write(rc.bytes.data(), std::streamsize(rc.bytes.size()));
+  return rc;
+}
+
+std::vector<uint32_t> ids_of(pvs_rt* h, uint32_t cell) {
+  uint32_t n = 0;
+  EXPECT_EQ(pvs_rt_visible_count(h, cell, &n), PVS_RT_OK);
+  std::vector<uint32_t> ids(n);
+  size_t count = 0;
+  EXPECT_EQ(pvs_rt_visible_ids(h, cell, ids.data(), ids.size(), &count), PVS_RT_OK)
+      << pvs_rt_last_error();
+  ids.resize(count);
+  return ids;
+}
+
+}  // namespace
+
+TEST(RuntimeCApi, OpenRangesAnswersLikeOpenByPath) {
+  const RangeCase rc = make_range_case();
+  RangeLog log{rc.bytes, {}, false};
+  pvs_rt *by_path = nullptr, *by_ranges = nullptr;
+  ASSERT_EQ(pvs_rt_open(rc.path.c_str(), 1, rc.info.scene_fingerprint, &by_path), PVS_RT_OK);
+  ASSERT_EQ(pvs_rt_open_ranges(rc.bytes.size(), read_range, &log, 1, rc.info.scene_fingerprint,
+                               &by_ranges),
+            PVS_RT_OK)
+      << pvs_rt_last_error();
+  pvs_rt_info a{}, b{};
+  ASSERT_EQ(pvs_rt_get_info(by_path, &a), PVS_RT_OK);
+  ASSERT_EQ(pvs_rt_get_info(by_ranges, &b), PVS_RT_OK);
+  EXPECT_EQ(std::memcmp(&a, &b, sizeof a), 0);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> x(-31, 31), z(-26, 26);
+  for (int i = 0; i < 200; ++i) {
+    const double p[3] = {x(rng), 1.0, z(rng)};
+    uint32_t ca = 99, cb = 98;
+    const pvs_rt_status sa = pvs_rt_find_cell(by_path, p, &ca);
+    ASSERT_EQ(sa, pvs_rt_find_cell(by_ranges, p, &cb));
+    if (sa == PVS_RT_OK) {
+      EXPECT_EQ(ca, cb);
+    }
+  }
+  for (uint32_t c = 0; c < a.cell_count; ++c) EXPECT_EQ(ids_of(by_path, c), ids_of(by_ranges, c));
+  pvs_rt_close(by_path);
+  pvs_rt_close(by_ranges);
+  std::filesystem::remove(rc.path);
+}
+
+TEST(RuntimeCApi, OpenRangesAsksForHeaderIndexAndTheQueriedCellsBlocksOnly) {
+  const RangeCase rc = make_range_case();
+  pvs::Reader reader = pvs::Reader::from_memory(rc.bytes);
+  RangeLog log{rc.bytes, {}, false};
+  pvs_rt* h = nullptr;
+  ASSERT_EQ(pvs_rt_open_ranges(rc.bytes.size(), read_range, &log, 0, 0, &h), PVS_RT_OK);
+  // Opening: the header, the layout section and the index, in that order, nothing else.
+  const std::vector<std::pair<uint64_t, uint64_t>> open_ranges = {
+      {0, pvs::kHeaderSize},
+      {pvs::kHeaderSize, reader.index_offset()},
+      {reader.index_offset(), reader.blocks_offset()}};
+  EXPECT_EQ(log.ranges, open_ranges);
+  log.ranges.clear();
+  // Queries: each cell's block, then the blocks of its Delta chain (from the reader's own view of
+  // the blocks), and nothing of any other cell.
+  int deltas = 0;
+  for (uint32_t cell : {17u, 4u, 29u, 12u}) {
+    std::vector<std::pair<uint64_t, uint64_t>> expected;
+    for (uint32_t c = cell;;) {
+      const pvs::IndexEntry& e = reader.entry(c);
+      expected.emplace_back(e.offset, e.offset + e.size);
+      const pvs::BlockInfo bi = reader.block_info(c);
+      if (bi.encoding != pvs::Encoding::Delta) break;
+      ++deltas;
+      c = bi.reference;
+    }
+    log.ranges.clear();
+    uint64_t off = 0;
+    uint32_t size = 0;
+    ASSERT_EQ(pvs_rt_block_range(h, cell, &off, &size), PVS_RT_OK);
+    EXPECT_EQ(off, expected[0].first);
+    EXPECT_EQ(off + size, expected[0].second);
+    EXPECT_EQ(ids_of(h, cell), reader.read_cell(cell));
+    EXPECT_EQ(log.ranges, expected) << "cell " << cell;
+  }
+  EXPECT_GT(deltas, 0) << "the case should exercise Delta chains";
+  // The index answers without reading: counts, lookups and neighbours ask for nothing.
+  log.ranges.clear();
+  uint32_t n = 0, cell = 0;
+  const double p[3] = {0, 1, 0};
+  size_t count = 0;
+  uint32_t nb[27];
+  EXPECT_EQ(pvs_rt_visible_count(h, 5, &n), PVS_RT_OK);
+  EXPECT_EQ(pvs_rt_find_cell(h, p, &cell), PVS_RT_OK);
+  EXPECT_EQ(pvs_rt_neighbours(h, cell, 0, nb, 27, &count), PVS_RT_OK);
+  EXPECT_EQ(pvs_rt_prefetch(h, cell), PVS_RT_OK);
+  EXPECT_TRUE(log.ranges.empty());
+  // A failing read is an i/o error naming the range.
+  log.fail = true;
+  size_t got = 0;
+  std::vector<uint32_t> out(rc.info.universe);
+  EXPECT_EQ(pvs_rt_visible_ids(h, 3, out.data(), out.size(), &got), PVS_RT_IO);
+  EXPECT_NE(std::string(pvs_rt_last_error()).find("read callback failed"), std::string::npos);
+  pvs_rt_close(h);
+  pvs_rt* h2 = reinterpret_cast<pvs_rt*>(&log);
+  EXPECT_EQ(pvs_rt_open_ranges(rc.bytes.size(), read_range, &log, 0, 0, &h2), PVS_RT_IO);
+  EXPECT_EQ(h2, nullptr);
+  EXPECT_EQ(pvs_rt_open_ranges(rc.bytes.size(), nullptr, &log, 0, 0, &h2), PVS_RT_INVALID_ARGUMENT);
+  // A file size that disagrees with the header is a format error, like a truncated file.
+  log.fail = false;
+  EXPECT_EQ(pvs_rt_open_ranges(rc.bytes.size() - 1, read_range, &log, 0, 0, &h2), PVS_RT_FORMAT);
+  std::filesystem::remove(rc.path);
 }

@@ -10,16 +10,19 @@
 namespace vislib {
 
 std::vector<CellView> render_cell_views(const Scene& scene, const std::vector<uint32_t>& triangles,
-                                        Vec3 eye, const std::string& dir, int width, int height) {
+                                        Vec3 eye, const std::string& dir, int width, int height,
+                                        const CellViewOptions& options) {
   std::filesystem::create_directories(dir);
   const std::vector<uint8_t> mask = triangle_mask(scene.triangle_count(), triangles);
   EmbreeScene rt(scene, 0.0, eye);
   std::vector<CellView> views;
-  const Vec3 dirs[4] = {{1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, 0, -1}};
-  for (int k = 0; k < 4; ++k) {
+  std::vector<Vec3> dirs = options.forwards;
+  if (dirs.empty()) dirs = {{1, 0, 0}, {0, 0, 1}, {-1, 0, 0}, {0, 0, -1}};
+  for (size_t k = 0; k < dirs.size(); ++k) {
     Camera cam;
     cam.eye = eye;
     cam.forward = dirs[k];
+    cam.vfov_degrees = options.vfov_degrees;
     cam.width = width;
     cam.height = height;
     const Frame truth = render_frame(scene, rt, cam);

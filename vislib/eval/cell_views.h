@@ -18,10 +18,19 @@ struct CellView {
   std::string full, pvs, heat_map;  // the PNG files written
 };
 
-// Renders from `eye`, looking along +x, +z, -x, -z (in that order), the full scene and the scene
-// reduced to `triangles` (ids < triangle_count()), width x height pixels, and writes
-// dir/view<k>_full.png, _pvs.png and _heat.png (dir is created). Deterministic.
+// Which views render_cell_views renders: `forwards` the view directions (each with a nonzero
+// horizontal part, the camera's up being +y; empty: +x, +z, -x, -z in that order), at a vertical
+// field of view of `vfov_degrees` in (0, 180).
+struct CellViewOptions {
+  std::vector<Vec3> forwards;
+  double vfov_degrees = 90;
+};
+
+// Renders from `eye`, along each direction of options, the full scene and the scene reduced to
+// `triangles` (ids < triangle_count()), width x height pixels, and writes dir/view<k>_full.png,
+// _pvs.png and _heat.png (dir is created). Deterministic.
 std::vector<CellView> render_cell_views(const Scene& scene, const std::vector<uint32_t>& triangles,
-                                        Vec3 eye, const std::string& dir, int width, int height);
+                                        Vec3 eye, const std::string& dir, int width, int height,
+                                        const CellViewOptions& options = {});
 
 }  // namespace vislib

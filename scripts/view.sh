@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Opens the web client on a bake: serves the scene and its PVS over HTTP (with range requests)
+# and prints the local URL to open in a browser. Ctrl-C stops it.
+# Usage: view.sh [SCENE [PVS]]  (default: data/city.glb and out/city.pvs, the quick start's bake)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+scene=${1:-$root/data/city.glb}
+pvs=${2:-$root/out/city.pvs}
+source "$root/scripts/web_stage.sh"
+trap web_unstage EXIT
+WEB_PORT=${WEB_PORT:-8035} web_stage "$scene" "$pvs"
+echo "Open $PAGE&at=0,1.6,0&prefetch=0"
+echo "(WASD to walk, drag to look; the server logs each request to $SERVER_LOG; Ctrl-C stops)"
+wait "$SERVER_PID"

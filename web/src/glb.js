@@ -1,0 +1,103 @@
+// glb.js: reads the GLB that `pvs export SCENE -o scene.glb` writes into triangles in vislib's id
+// order: node i of the scene is object i, its mesh's primitives hold that object's triangles in
+// id order (vislib/scene/write_gltf.h), and the export refuses scenes whose objects are not in id
+// order. So concatenating the nodes' primitives gives triangle id t at position t.
+// Plain ES module, no dependency: the browser page and node (the id-order test) both use it.
+
+const FLOAT = 5126, UINT32 = 5125, UINT16 = 5123, UINT8 = 5121;
+
+function accessorArray(gltf, bin, index, want) {
+  const a = gltf.accessors[index];
+  const view = gltf.bufferViews[a.bufferView];
+  const comps = {SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4}[a.type];
+  if (comps !== want) throw new Error(`accessor ${index}: ${a.type}, expected ${want} components`);
+  const size = {[FLOAT]: 4, [UINT32]: 4, [UINT16]: 2, [UINT8]: 1}[a.componentType];
+  if (!size) throw new Error(`accessor ${index}: component type ${a.componentType}`);
+  if (view.byteStride && view.byteStride !== size * comps)
+    throw new Error(`accessor ${index}: interleaved data is not supported`);
+  const offset = bin.byteOffset + (view.byteOffset || 0) + (a.byteOffset || 0);
+  const n = a.count * comps;
+  const copy = bin.buffer.slice(offset, offset + n * size);  // aligned copy
+  if (a.componentType === FLOAT) return new Float32Array(copy);
+  if (a.componentType === UINT32) return new Uint32Array(copy);
+  if (a.componentType === UINT16) return new Uint32Array(new Uint16Array(copy));
+  return new Uint32Array(new Uint8Array(copy));
+}
+
+// Returns {positions: Float32Array(9 * T) (triangle t's corners at 9t..9t+8, de-indexed),
+// triangleObject: Uint32Array(T), objectCount, objectNames}. Throws on anything else than the
+// export's layout (node transforms, non-triangle primitives, several scenes).
+export function parseGlb(arrayBuffer) {
+  const dv = new DataView(arrayBuffer);
+  if (dv.getUint32(0, true) !== 0x46546c67) throw new Error("not a GLB file (bad magic)");
+  let off = 12, gltf = null, bin = null;
+  while (off + 8 <= arrayBuffer.byteLength) {
+    const len = dv.getUint32(off, true), type = dv.getUint32(off + 4, true);
+    const chunk = new Uint8Array(arrayBuffer, off + 8, len);
+    if (type === 0x4e4f534a) gltf = JSON.parse(new TextDecoder().decode(chunk));
+    else if (type === 0x004e4942) bin = chunk;
+    off += 8 + len;
+  }
+  if (!gltf) throw new Error("GLB without a JSON chunk");
+  const scene = gltf.scenes[gltf.scene || 0];
+  const nodes = scene.nodes || [];
+  const parts = [], objects = [], names = [];
+  let total = 0;
+  nodes.forEach((nodeIndex, object) => {
+    const node = gltf.nodes[nodeIndex];
+    names.push(node.name || `object ${object}`);
+    if (node.matrix || node.translation || node.rotation || node.scale || node.children)
+      throw new Error(`node ${nodeIndex}: transforms or children (export the scene with pvs export -o FILE.glb)`);
+    if (node.mesh === undefined) return;
+    for (const prim of gltf.meshes[node.mesh].primitives) {
+      if ((prim.mode ?? 4) !== 4) throw new Error(`mesh ${node.mesh}: not TRIANGLES`);
+      const pos = accessorArray(gltf, bin, prim.attributes.POSITION, 3);
+      const idx = accessorArray(gltf, bin, prim.indices, 1);
+      parts.push({pos, idx});
+      objects.push([object, idx.length / 3]);
+      total += idx.length / 3;
+    }
+  });
+  const positions = new Float32Array(9 * total);
+  const triangleObject = new Uint32Array(total);
+  let t = 0;
+  parts.forEach(({pos, idx}, k) => {
+    const [object, n] = objects[k];
+    for (let i = 0; i < 3 * n; ++i) {
+      const v = idx[i];
+      positions[3 * (3 * t) + 3 * (i % 3)] = pos[3 * v];
+      positions[3 * (3 * t) + 3 * (i % 3) + 1] = pos[3 * v + 1];
+      positions[3 * (3 * t) + 3 * (i % 3) + 2] = pos[3 * v + 2];
+      if (i % 3 === 2) triangleObject[t++] = object;
+    }
+  });
+  return {positions, triangleObject, objectCount: nodes.length, objectNames: names};
+}
+
+// splitmix64 as vislib/eval/render.cpp has it (BigInt: 64-bit wrapping arithmetic).
+function splitmix(x) {
+  const M = (1n << 64n) - 1n;
+  let z = (x + 0x9E3779B97F4A7C15n) & M;
+  z = ((z ^ (z >> 30n)) * 0xBF58476D1CE4E5B9n) & M;
+  z = ((z ^ (z >> 27n)) * 0x94D049BB133111EBn) & M;
+  return z ^ (z >> 31n);
+}
+
+function toByte(v) {
+  const s = Math.round(v * 255);
+  return s < 0 ? 0 : s > 255 ? 255 : s;
+}
+
+// The colour of object `object` in the CPU reference renderer (vislib::object_colour): a hue,
+// saturation and value drawn from splitmix64 of the id, as 8-bit RGB.
+export function objectColour(object) {
+  const h = splitmix(BigInt(object));
+  const hue = Number(h & 0xFFFFn) / 65536 * 6;
+  const sat = 0.45 + 0.35 * Number((h >> 16n) & 0xFFn) / 255;
+  const val = 0.65 + 0.35 * Number((h >> 24n) & 0xFFn) / 255;
+  const sector = Math.floor(hue), frac = hue - sector;
+  const p = val * (1 - sat), q = val * (1 - sat * frac), t = val * (1 - sat * (1 - frac));
+  const rgb = [[val, t, p], [q, val, p], [p, val, t], [p, q, val], [t, p, val]][sector] ||
+              [val, p, q];
+  return rgb.map(toByte);
+}

@@ -1,0 +1,494 @@
+// main.js: the web client. Opens a scene (GLB from `pvs export SCENE -o scene.glb`: triangles in
+// vislib's id order) and a PVS (read by range requests through the runtime in WebAssembly), and
+// per frame asks the runtime for the eye's cell and draws only that cell's visible triangles.
+//
+// URL parameters: scene=URL (GLB), pvs=URL, at=x,y,z and look=x,y,z (start), fov=degrees
+// (vertical, default 60), prefetch=MARGIN (on entering a cell, fetch the blocks of its neighbours
+// within MARGIN scene units; off by default, so that only visited cells are fetched), overlay=0
+// (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
+// frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size).
+//
+// Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
+// scene), and the overlay says so in red.
+//
+// Shading is the CPU reference renderer's (vislib/eval/render.h): albedo = the object's colour
+// from a hash of its id (vislib::object_colour, glb.js), shade = 0.1 + 0.9 |n.v| with n the
+// geometric normal of the triangle and v the direction from the eye to the point (two-sided
+// headlight), background RGB (150, 170, 195); no colour management, no tone mapping. The CPU
+// renderer samples pixel centres by ray casting and rounds albedo and result to 8 bits; WebGL
+// rasterises the same triangles with the same camera, so frames agree up to rasterisation on
+// triangle edges and one 8-bit step.
+import * as THREE from "three";
+import {parseGlb, objectColour} from "./glb.js";
+import {parsePath, vec3} from "./path.js";
+import {PvsClient} from "./pvs_client.js";
+
+const params = new URLSearchParams(location.search);
+const overlay = document.getElementById("overlay");
+const mapCanvas = document.getElementById("map");
+const canvas = document.getElementById("view");
+
+// Near-far (near-far paper §4.1, Eq. 1 with a = r2 - r, runtime/near_far.h morph_vertex): with
+// nearFar on, a vertex at axis distance r from the centre O is kept (r <= r1), sent to
+// U + |OP| d_O (r >= r2: where O's environment map shows it) or, in between, to U + t d with
+// d = normalize(w d_U + (1 - w) d_O), t = w |UP| + (1 - w) |OP|, w = (r2 - r) / (r2 - r1).
+const VERTEX = `
+in vec3 position; in vec3 normal; in vec3 colour;
+uniform mat4 projectionMatrix, viewMatrix;
+uniform vec3 eye, centre;
+uniform float r1, r2;
+uniform bool nearFar;
+out vec3 vWorld; out vec3 vNormal; out vec3 vColour;
+vec3 morph(vec3 p) {
+  float r = length(p.xz - centre.xz);
+  if (!nearFar || r <= r1) return p;
+  vec3 up = p - eye, op = p - centre;
+  if (r >= r2) return eye + length(op) * normalize(op);
+  float w = (r2 - r) / (r2 - r1);
+  vec3 d = normalize(w * normalize(up) + (1.0 - w) * normalize(op));
+  return eye + (w * length(up) + (1.0 - w) * length(op)) * d;
+}
+void main() {
+  vWorld = morph(position); vNormal = normal; vColour = colour;
+  gl_Position = projectionMatrix * viewMatrix * vec4(vWorld, 1.0);
+}`;
+const FRAGMENT = `precision highp float;
+uniform vec3 eye;
+in vec3 vWorld; in vec3 vNormal; in vec3 vColour;
+out vec4 outColour;
+void main() {
+  vec3 v = vWorld - eye;
+  float nl = length(vNormal), vl = length(v);
+  float lambert = nl > 0.0 && vl > 0.0 ? abs(dot(vNormal, v)) / (nl * vl) : 0.0;
+  float shade = 0.1 + 0.9 * min(lambert, 1.0);
+  outColour = vec4(vColour * shade, 1.0);
+}`;
+
+// The popping meter's id pass (WebGL2 has no primitive id): the full scene, de-indexed, so the
+// vertex id / 3 is the triangle id, written as 24-bit RGB; the background stays 0xFFFFFF.
+const ID_VERTEX = `
+in vec3 position;
+uniform mat4 projectionMatrix, viewMatrix;
+flat out int vId;
+void main() {
+  vId = gl_VertexID / 3;
+  gl_Position = projectionMatrix * viewMatrix * vec4(position, 1.0);
+}`;
+const ID_FRAGMENT = `
+precision highp float;
+precision highp int;
+flat in int vId;
+out vec4 outColour;
+void main() {
+  outColour = vec4(float(vId & 255), float((vId >> 8) & 255), float((vId >> 16) & 255), 255.0) / 255.0;
+}`;
+const NO_ID = 0xFFFFFF;
+
+async function fetchBytes(url) {
+  const r = await fetch(url);
+  if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
+  return r.arrayBuffer();
+}
+
+function buildGeometry(scene) {
+  const T = scene.triangleObject.length;
+  const normals = new Float32Array(9 * T);
+  const colours = new Float32Array(9 * T);
+  const palette = new Map();
+  const p = scene.positions;
+  for (let t = 0; t < T; ++t) {
+    const o = 9 * t;
+    const ax = p[o + 3] - p[o], ay = p[o + 4] - p[o + 1], az = p[o + 5] - p[o + 2];
+    const bx = p[o + 6] - p[o], by = p[o + 7] - p[o + 1], bz = p[o + 8] - p[o + 2];
+    const n = [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx];
+    const ob = scene.triangleObject[t];
+    if (!palette.has(ob)) palette.set(ob, objectColour(ob).map((c) => c / 255));
+    const c = palette.get(ob);
+    for (let k = 0; k < 3; ++k) {
+      normals.set(n, o + 3 * k);
+      colours.set(c, o + 3 * k);
+    }
+  }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute("position", new THREE.BufferAttribute(scene.positions, 3));
+  g.setAttribute("normal", new THREE.BufferAttribute(normals, 3));
+  g.setAttribute("colour", new THREE.BufferAttribute(colours, 3));
+  g.computeBoundingSphere();
+  return g;
+}
+
+// The index buffer drawing triangles `ids` of the de-indexed geometry (triangle t = vertices
+// 3t, 3t+1, 3t+2).
+function indexOf(ids) {
+  const idx = new Uint32Array(3 * ids.length);
+  for (let i = 0; i < ids.length; ++i) {
+    idx[3 * i] = 3 * ids[i];
+    idx[3 * i + 1] = 3 * ids[i] + 1;
+    idx[3 * i + 2] = 3 * ids[i] + 2;
+  }
+  return new THREE.BufferAttribute(idx, 1);
+}
+
+class Viewer {
+  async init() {
+    THREE.ColorManagement.enabled = false;
+    const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
+    if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
+    this.fov = Number(params.get("fov") || 60);
+    if (params.get("overlay") === "0")
+      for (const id of ["overlay", "map", "help"]) document.getElementById(id).style.display = "none";
+    // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size;
+    // centre=x,y,z: O for every cell (default: the centre of the cell's view region).
+    this.nearFar = params.get("nearfar") ? params.get("nearfar").split(",").map(Number) : null;
+    this.envSize = Number(params.get("envsize") || 512);
+    // popping=K: the popping meter every K frames (0: off; key P measures once).
+    this.poppingEvery = Number(params.get("popping") || 0);
+    this.frameCount = 0;
+    this.popping = null;
+    this.prefetch = params.has("prefetch") ? Number(params.get("prefetch") || 0) : -1;
+    const size = params.get("size");
+    if (size) {
+      const [w, h] = size.split("x").map(Number);
+      canvas.style.width = `${w}px`;
+      canvas.style.height = `${h}px`;
+      canvas.width = w;
+      canvas.height = h;
+    }
+    this.client = new PvsClient();
+    const [glb, opened] = await Promise.all([fetchBytes(sceneUrl), this.client.open(pvsUrl)]);
+    this.sceneBytes = glb.byteLength;
+    this.scene = parseGlb(glb);
+    this.pvs = opened;
+    this.total = this.scene.triangleObject.length;
+    if (opened.info.granularity !== 0)
+      throw new Error("this PVS holds object ids; the viewer draws triangle ids");
+    if (opened.info.universe !== this.total)
+      throw new Error(`the PVS has ${opened.info.universe} triangle ids, the scene ${this.total} triangles: not this scene's PVS`);
+    this.bytes = opened.bytes;
+    this.requests = opened.requests;
+
+    this.renderer = new THREE.WebGLRenderer({canvas, antialias: false, preserveDrawingBuffer: true});
+    this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+    this.renderer.setPixelRatio(1);
+    this.renderer.setSize(canvas.clientWidth || canvas.width, canvas.clientHeight || canvas.height, false);
+    this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
+    this.geometry = buildGeometry(this.scene);
+    this.material = new THREE.RawShaderMaterial({
+      vertexShader: VERTEX, fragmentShader: FRAGMENT, side: THREE.DoubleSide,
+      glslVersion: THREE.GLSL3,
+      uniforms: {eye: {value: new THREE.Vector3()}, centre: {value: new THREE.Vector3()},
+                 r1: {value: 0}, r2: {value: 1}, nearFar: {value: false}},
+    });
+    this.mesh = new THREE.Mesh(this.geometry, this.material);
+    this.mesh.frustumCulled = false;
+    this.world = new THREE.Scene();
+    this.world.add(this.mesh);
+    const r = this.geometry.boundingSphere.radius;
+    const aspect = this.renderer.domElement.width / this.renderer.domElement.height;
+    this.camera = new THREE.PerspectiveCamera(this.fov, aspect, 0.05, 4 * r + 10);
+    this.cell = -1;  // the cell whose set is drawn (-1: none yet, the whole scene)
+    this.found = -1;  // the cell found this frame
+    this.path = params.get("path") ? parsePath(params.get("path")) : null;
+    const at = params.get("at") ? vec3(params.get("at")) : this.path ? this.path[0].eye : [0, 1.6, 0];
+    this.camera.position.set(...at);
+    if (params.get("look")) this.camera.lookAt(...vec3(params.get("look")));
+    else this.camera.lookAt(at[0] + 1, at[1], at[2]);
+    if (this.nearFar) this.initNearFar();
+    this.initPopping();
+    this.setDrawList(null);
+    this.drawMapBase();
+    return this;
+  }
+
+  setDrawList(ids) {
+    this.far = 0;
+    this.mask = null;
+    if (ids) {
+      this.mask = new Uint8Array(this.total);
+      for (const t of ids) this.mask[t] = 1;
+    }
+    if (ids && this.nearFar) ids = this.partitionNearFar(ids);
+    if (ids) {
+      this.geometry.setIndex(indexOf(ids));
+      this.drawn = ids.length;
+    } else {
+      this.geometry.setIndex(null);
+      this.drawn = this.total;
+    }
+  }
+
+  // Near-far: the environment cube map (colour) is rendered from the centre O of the cell's view
+  // region on entering the cell, from the cell's far triangles (every vertex at axis distance
+  // >= r2); the main pass draws the others (near and intermediate, morphed) over it.
+  initNearFar() {
+    const [r1, r2] = this.nearFar;
+    if (!(r1 >= 0 && r2 > r1)) throw new Error(`nearfar=${this.nearFar}: need 0 <= r1 < r2`);
+    this.envTarget = new THREE.WebGLCubeRenderTarget(this.envSize);
+    this.cubeCamera = new THREE.CubeCamera(0.05, this.camera.far, this.envTarget);
+    this.envGeometry = new THREE.BufferGeometry();
+    for (const name of ["position", "normal", "colour"])
+      this.envGeometry.setAttribute(name, this.geometry.getAttribute(name));
+    this.envMaterial = this.material.clone();
+    this.envMaterial.uniforms.nearFar.value = false;
+    this.envMesh = new THREE.Mesh(this.envGeometry, this.envMaterial);
+    this.envMesh.frustumCulled = false;
+    this.envWorld = new THREE.Scene();
+    this.envWorld.add(this.envMesh);
+    this.material.uniforms.r1.value = r1;
+    this.material.uniforms.r2.value = r2;
+  }
+
+  partitionNearFar(ids) {
+    const [, r2] = this.nearFar;
+    const b = this.pvs.boxes, c = this.cell, p = this.scene.positions;
+    const o = params.get("centre") ? vec3(params.get("centre"))
+      : [(b[6 * c] + b[6 * c + 3]) / 2, (b[6 * c + 1] + b[6 * c + 4]) / 2, (b[6 * c + 2] + b[6 * c + 5]) / 2];
+    const near = [], far = [];
+    for (const t of ids) {
+      let allFar = true;
+      for (let k = 0; k < 3 && allFar; ++k)
+        allFar = Math.hypot(p[9 * t + 3 * k] - o[0], p[9 * t + 3 * k + 2] - o[2]) >= r2;
+      (allFar ? far : near).push(t);
+    }
+    this.material.uniforms.centre.value.set(...o);
+    this.material.uniforms.nearFar.value = true;
+    this.envGeometry.setIndex(indexOf(far));
+    this.envMaterial.uniforms.eye.value.set(...o);
+    this.cubeCamera.position.set(...o);
+    this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
+    this.cubeCamera.update(this.renderer, this.envWorld);
+    this.world.background = this.envTarget.texture;
+    this.far = far.length;
+    return near;
+  }
+
+  initPopping() {
+    const w = this.renderer.domElement.width, h = this.renderer.domElement.height;
+    this.idTarget = new THREE.WebGLRenderTarget(w, h, {depthBuffer: true});
+    this.idMaterial = new THREE.RawShaderMaterial({
+      vertexShader: ID_VERTEX, fragmentShader: ID_FRAGMENT, side: THREE.DoubleSide,
+      glslVersion: THREE.GLSL3,
+    });
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", this.geometry.getAttribute("position"));
+    const mesh = new THREE.Mesh(g, this.idMaterial);
+    mesh.frustumCulled = false;
+    this.idWorld = new THREE.Scene();
+    this.idWorld.add(mesh);
+    this.idPixels = new Uint8Array(4 * w * h);
+    this.heat = document.createElement("canvas");
+    this.heat.width = w;
+    this.heat.height = h;
+    this.heat.style.cssText = "position:absolute;left:0;top:0;pointer-events:none;" +
+      `width:${canvas.style.width || "100%"};height:${canvas.style.height || "100%"}`;
+    if (params.get("overlay") === "0") this.heat.style.display = "none";
+    document.body.insertBefore(this.heat, overlay);  // under the text overlays
+    addEventListener("keydown", (e) => { if (e.key === "p") this.measureNext = true; });
+  }
+
+  // The popping meter: the full scene's first triangle per pixel (id pass); a pixel pops when
+  // that triangle is not in the drawn cell's set (what the CPU renderer counts as a missed
+  // pixel). Shown as a red heat overlay; returns the count.
+  measurePopping() {
+    const w = this.idTarget.width, h = this.idTarget.height;
+    const clear = new THREE.Color();
+    this.renderer.getClearColor(clear);
+    this.renderer.setRenderTarget(this.idTarget);
+    this.renderer.setClearColor(new THREE.Color(1, 1, 1), 1);
+    this.renderer.clear();
+    this.renderer.render(this.idWorld, this.camera);
+    this.renderer.readRenderTargetPixels(this.idTarget, 0, 0, w, h, this.idPixels);
+    this.renderer.setRenderTarget(null);
+    this.renderer.setClearColor(clear, 1);
+    const ctx = this.heat.getContext("2d");
+    const img = ctx.createImageData(w, h);
+    let count = 0;
+    for (let y = 0; y < h; ++y)
+      for (let x = 0; x < w; ++x) {
+        const i = 4 * (y * w + x);
+        const id = this.idPixels[i] | (this.idPixels[i + 1] << 8) | (this.idPixels[i + 2] << 16);
+        if (id === NO_ID || !this.mask || this.mask[id]) continue;
+        ++count;
+        const o = 4 * ((h - 1 - y) * w + x);  // the read-back rows run bottom-up
+        img.data[o] = 255;
+        img.data[o + 3] = 200;
+      }
+    ctx.putImageData(img, 0, 0);
+    return count;
+  }
+
+  // One frame from the camera's current pose: the runtime's cell, the draw list, the render.
+  async frame() {
+    const t0 = performance.now();
+    const p = this.camera.position;
+    const r = await this.client.lookup([p.x, p.y, p.z], this.cell, this.prefetch);
+    this.found = r.cell;
+    if (r.cell >= 0 && r.cell !== this.cell) {
+      this.cell = r.cell;
+      this.setDrawList(r.ids);
+    }
+    this.bytes = r.bytes;
+    this.requests = r.requests;
+    this.material.uniforms.eye.value.copy(p);
+    this.renderer.render(this.world, this.camera);
+    const measure = this.measureNext ||
+      (this.poppingEvery > 0 && this.frameCount % this.poppingEvery === 0);
+    this.measureNext = false;
+    this.frameCount += 1;
+    if (measure) this.popping = this.measurePopping();
+    const gl = this.renderer.getContext();
+    gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the GPU
+    const ms = performance.now() - t0;
+    this.showOverlay(ms);
+    this.drawMap();
+    return {cell: this.found, drawn_cell: this.cell, triangles_drawn: this.drawn,
+            triangles_far: this.far, popping_pixels: measure ? this.popping : null,
+            triangles_total: this.total, ms, bytes_fetched: this.bytes,
+            range_requests: this.requests, eye: [p.x, p.y, p.z]};
+  }
+
+  // Replay: frame i of the path.
+  async step(i) {
+    const f = this.path[i];
+    this.camera.position.set(...f.eye);
+    let look = f.look;
+    if (!look) {
+      const next = this.path[i + 1] || null, prev = this.path[i - 1] || null;
+      if (next) look = next.eye;
+      else if (prev) look = f.eye.map((v, k) => 2 * v - prev.eye[k]);
+      else look = [f.eye[0] + 1, f.eye[1], f.eye[2]];
+      look = [look[0], f.eye[1], look[2]];
+      if (look[0] === f.eye[0] && look[2] === f.eye[2]) look[0] += 1;
+    }
+    this.camera.up.set(0, 1, 0);
+    this.camera.lookAt(...look);
+    const rec = await this.frame();
+    rec.frame = i;
+    return rec;
+  }
+
+  showOverlay(ms) {
+    const outside = this.found < 0;
+    const cellText = outside
+      ? `<span class="outside">outside every cell: ${this.cell >= 0 ? `keeping cell ${this.cell}'s set` : "drawing the whole scene"}</span>`
+      : `cell ${this.found} of ${this.pvs.info.cell_count}`;
+    overlay.innerHTML =
+      `${cellText}\ntriangles drawn ${this.drawn}${this.nearFar ? ` near + ${this.far} far (environment map)` : ""} / ${this.total}` +
+      ` (${(100 * (this.drawn + this.far) / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
+      `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
+      `\nscene ${this.sceneBytes} bytes` +
+      (this.popping === null ? "" : `\npopping pixels ${this.popping} (last measured; P measures)`);
+  }
+
+  // Top view of the cells, coloured by PVS size (dark blue: smallest, yellow: largest).
+  drawMapBase() {
+    const b = this.pvs.boxes, n = this.pvs.info.cell_count;
+    let x0 = Infinity, z0 = Infinity, x1 = -Infinity, z1 = -Infinity, cmax = 1, cmin = Infinity;
+    for (let c = 0; c < n; ++c) {
+      x0 = Math.min(x0, b[6 * c]); z0 = Math.min(z0, b[6 * c + 2]);
+      x1 = Math.max(x1, b[6 * c + 3]); z1 = Math.max(z1, b[6 * c + 5]);
+      cmax = Math.max(cmax, this.pvs.counts[c]); cmin = Math.min(cmin, this.pvs.counts[c]);
+    }
+    const W = mapCanvas.width, s = (W - 10) / Math.max(x1 - x0, z1 - z0, 1e-9);
+    this.map = {x0, z0, s, cmin, cmax};
+    const ctx = mapCanvas.getContext("2d");
+    const base = document.createElement("canvas");
+    base.width = base.height = W;
+    const bc = base.getContext("2d");
+    for (let c = 0; c < n; ++c) {
+      const f = (this.pvs.counts[c] - cmin) / Math.max(1, cmax - cmin);
+      bc.fillStyle = `rgb(${Math.round(40 + 215 * f)},${Math.round(40 + 180 * f)},${Math.round(140 - 110 * f)})`;
+      const [x, y, w, h] = this.mapRect(c);
+      bc.fillRect(x, y, w, h);
+    }
+    this.mapBase = base;
+    ctx.drawImage(base, 0, 0);
+  }
+
+  mapRect(c) {
+    const b = this.pvs.boxes, m = this.map;
+    return [5 + (b[6 * c] - m.x0) * m.s, 5 + (b[6 * c + 2] - m.z0) * m.s,
+            Math.max(1, (b[6 * c + 3] - b[6 * c]) * m.s), Math.max(1, (b[6 * c + 5] - b[6 * c + 2]) * m.s)];
+  }
+
+  drawMap() {
+    const ctx = mapCanvas.getContext("2d"), m = this.map;
+    ctx.clearRect(0, 0, mapCanvas.width, mapCanvas.height);
+    ctx.drawImage(this.mapBase, 0, 0);
+    if (this.cell >= 0) {
+      ctx.strokeStyle = "#fff";
+      ctx.lineWidth = 2;
+      ctx.strokeRect(...this.mapRect(this.cell));
+    }
+    const p = this.camera.position;
+    ctx.fillStyle = this.found >= 0 ? "#fff" : "#f44";
+    ctx.beginPath();
+    ctx.arc(5 + (p.x - m.x0) * m.s, 5 + (p.z - m.z0) * m.s, 3, 0, 2 * Math.PI);
+    ctx.fill();
+  }
+
+  // WASD + mouse drag; Q/E down/up; shift for speed.
+  startWalking() {
+    const keys = new Set();
+    addEventListener("keydown", (e) => keys.add(e.key.toLowerCase()));
+    addEventListener("keyup", (e) => keys.delete(e.key.toLowerCase()));
+    let dragging = false, yaw = 0, pitch = 0;
+    const d = new THREE.Vector3();
+    this.camera.getWorldDirection(d);
+    yaw = Math.atan2(d.x, -d.z);
+    pitch = Math.asin(Math.max(-1, Math.min(1, d.y)));
+    canvas.addEventListener("mousedown", () => (dragging = true));
+    addEventListener("mouseup", () => (dragging = false));
+    addEventListener("mousemove", (e) => {
+      if (!dragging) return;
+      yaw += e.movementX * 0.004;
+      pitch = Math.max(-1.5, Math.min(1.5, pitch - e.movementY * 0.004));
+    });
+    addEventListener("resize", () => {
+      this.renderer.setSize(canvas.clientWidth, canvas.clientHeight, false);
+      this.camera.aspect = canvas.clientWidth / canvas.clientHeight;
+      this.camera.updateProjectionMatrix();
+    });
+    let last = performance.now();
+    const loop = async () => {
+      const now = performance.now(), dt = Math.min(0.1, (now - last) / 1000);
+      last = now;
+      const speed = (keys.has("shift") ? 20 : 6) * dt;
+      const fwd = new THREE.Vector3(Math.sin(yaw), 0, -Math.cos(yaw));
+      const right = new THREE.Vector3(Math.cos(yaw), 0, Math.sin(yaw));
+      const p = this.camera.position;
+      if (keys.has("w")) p.addScaledVector(fwd, speed);
+      if (keys.has("s")) p.addScaledVector(fwd, -speed);
+      if (keys.has("d")) p.addScaledVector(right, speed);
+      if (keys.has("a")) p.addScaledVector(right, -speed);
+      if (keys.has("e")) p.y += speed;
+      if (keys.has("q")) p.y -= speed;
+      const look = new THREE.Vector3(Math.sin(yaw) * Math.cos(pitch), Math.sin(pitch),
+                                     -Math.cos(yaw) * Math.cos(pitch));
+      this.camera.lookAt(p.clone().add(look));
+      await this.frame();
+      requestAnimationFrame(loop);
+    };
+    requestAnimationFrame(loop);
+  }
+}
+
+const viewer = new Viewer();
+window.viewer = viewer;
+window.viewerReady = viewer.init().then(
+  async () => {
+    if (viewer.path) {
+      await viewer.step(0);
+      if (params.get("autoplay") !== null) {
+        for (let i = 0; i < viewer.path.length; ++i) await viewer.step(i);
+      }
+    } else {
+      viewer.startWalking();
+    }
+    return {triangles: viewer.total, cells: viewer.pvs.info.cell_count,
+            file_size: viewer.pvs.info.file_size, scene_bytes: viewer.sceneBytes};
+  },
+  (e) => {
+    overlay.innerHTML = `<span class="outside">error: ${e.message}</span>`;
+    throw e;
+  });
