@@ -31,7 +31,7 @@ json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
   json j = frame_error_json(truth, test);
   const vislib::ObjectCompletion c = vislib::object_completion(scene, truth, test);
   j["ovc"] = c.ovc;
-  j["ofc"] = c.ofc;
+  j["object_pixel_agreement"] = c.object_pixel_agreement;
   j["ofc_eq2"] = c.ofc_eq2;
   j["objects_in_truth"] = c.objects;
   return j;
@@ -102,16 +102,17 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
   std::fprintf(
       stderr,
       "cell %u: visible %zu triangles: near %zu, intermediate %zu, far %zu (env map %zu)\n"
-      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f (CloVR Eq. 2: %.3f) triangle "
-      "mismatch %.4f\n"
-      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f (CloVR Eq. 2: %.3f) triangle "
-      "mismatch %.4f\n",
+      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f object pixel agreement %.3f OFC (CloVR "
+      "Eq. 2) %.3f triangle mismatch %.4f\n"
+      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f object pixel agreement %.3f OFC (CloVR "
+      "Eq. 2) %.3f triangle mismatch %.4f\n",
       j["cell"].get<uint32_t>(), j["triangles"]["visible"].get<size_t>(), rc.near, rc.intermediate,
       rc.far, rc.env_map, j["epsilon"].get<double>(), fmt_psnr(j["psnr"]).c_str(),
-      j["ssim"].get<double>(), j["ovc"].get<double>(), j["ofc"].get<double>(),
+      j["ssim"].get<double>(), j["ovc"].get<double>(), j["object_pixel_agreement"].get<double>(),
       j["ofc_eq2"].get<double>(), j["triangle_mismatch"].get<double>(), w["epsilon"].get<double>(),
       fmt_psnr(w["psnr"]).c_str(), w["ssim"].get<double>(), w["ovc"].get<double>(),
-      w["ofc"].get<double>(), w["ofc_eq2"].get<double>(), w["triangle_mismatch"].get<double>());
+      w["object_pixel_agreement"].get<double>(), w["ofc_eq2"].get<double>(),
+      w["triangle_mismatch"].get<double>());
   std::fprintf(stderr,
                "  delta (Eqs. 7-8, radius %g px), mean (mean |delta|): morph %.4f (%.4f), no "
                "morph %.4f (%.4f)\n"

@@ -378,19 +378,19 @@ ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const
   }
   ObjectCompletion c;
   size_t seen = 0;
-  double ofc_sum = 0;
+  double agreement_sum = 0;
   size_t capped = 0, truth_total = 0;
   for (size_t o = 0; o < n_obj; ++o) {
     if (truth_pixels[o] == 0) continue;
     ++c.objects;
     if (in_test[o]) ++seen;
-    ofc_sum += double(covered[o]) / double(truth_pixels[o]);
+    agreement_sum += double(covered[o]) / double(truth_pixels[o]);
     capped += std::min(test_pixels[o], truth_pixels[o]);
     truth_total += truth_pixels[o];
   }
   if (c.objects > 0) {
     c.ovc = double(seen) / double(c.objects);
-    c.ofc = ofc_sum / double(c.objects);
+    c.object_pixel_agreement = agreement_sum / double(c.objects);
     c.ofc_eq2 = double(capped) / double(truth_total);
   }
   return c;
