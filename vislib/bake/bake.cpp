@@ -11,6 +11,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/id_universe.h"
 #include "vislib/bake/long_segments.h"

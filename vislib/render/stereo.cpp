@@ -11,6 +11,8 @@
 #include <cmath>
 #include <limits>
 
+#include "vislib/base/ray_triangle.h"
+
 namespace vislib {
 
 namespace {
@@ -334,23 +336,6 @@ size_t median_fill(Frame& f, std::vector<uint8_t> open) {
   return patched;
 }
 
-bool intersect(const Scene& scene, uint32_t tri, Vec3 o, Vec3 d, double* t_out) {
-  const auto c = scene.corners(tri, 0);
-  const Vec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
-  const Vec3 pv = cross(d, e2);
-  const double det = dot(e1, pv);
-  if (det == 0 || !std::isfinite(det)) return false;
-  const double inv = 1.0 / det;
-  const Vec3 tv = o - c[0];
-  const double u = dot(tv, pv) * inv;
-  if (u < 0 || u > 1) return false;
-  const Vec3 qv = cross(tv, e1);
-  const double v = dot(d, qv) * inv;
-  if (v < 0 || u + v > 1) return false;
-  *t_out = dot(e2, qv) * inv;
-  return true;
-}
-
 }  // namespace
 
 size_t Reprojection::count(HoleKind kind) const {
@@ -569,9 +554,9 @@ ReshadeStats reshade(Reprojection& r, const Scene& scene, const Camera& target) 
         uint32_t best_tri = kNoHit;
         for (size_t i = 0; i < cand.size(); ++i) {
           if (i > 0 && cand[i].first == cand[i - 1].first) continue;
-          double t = 0;
-          if (intersect(scene, cand[i].first, target.eye, d, &t) && t > target.z_near && t < best) {
-            best = t;
+          const auto t = ray_triangle(target.eye, d, scene.corners(cand[i].first, 0));
+          if (t && *t > target.z_near && *t < best) {
+            best = *t;
             best_tri = cand[i].first;
             best_q = cand[i].second;
           }
