@@ -980,30 +980,21 @@ void read_materials(Ctx& ctx, SceneAppearance& app) {
   }
 }
 
-}  // namespace
+// The node graph: every node's rest-pose TRS and its parent (-1 for none).
+struct NodeGraph {
+  std::vector<Trs> rest;
+  std::vector<int> parent;
+};
 
-SceneAppearance load_appearance(const std::string& path, const LoadOptions& options,
-                                std::vector<std::string>* warnings) {
-  std::vector<std::string> local;
-  SceneAppearance app;
-  std::string ext = file_extension(path);
-  if (ext == ".gltf" || ext == ".glb") load_gltf(path, options, warnings ? *warnings : local, &app);
-  return app;
-}
-
-Scene load_gltf(const std::string& path, const LoadOptions& options,
-                std::vector<std::string>& warnings, SceneAppearance* appearance) {
-  Ctx ctx;
-  ctx.path = path;
-  ctx.warnings = &warnings;
-  parse_file(ctx);
-  check_extensions(ctx);
+NodeGraph read_nodes(Ctx& ctx) {
   const auto& model = ctx.model;
   const size_t N = model.nodes.size();
-
   // Rest-pose TRS of every node, and the hierarchy (validated: indices, single parent, no cycle).
-  std::vector<Trs> rest(N);
-  std::vector<int> parent(N, -1);
+  NodeGraph g;
+  std::vector<Trs>& rest = g.rest;
+  std::vector<int>& parent = g.parent;
+  rest.resize(N);
+  parent.assign(N, -1);
   for (size_t n = 0; n < N; ++n) {
     const auto& nd = model.nodes[n];
     std::string who = "node " + std::to_string(n);
@@ -1031,6 +1022,18 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       parent[c] = int(n);
     }
   }
+  return g;
+}
+
+// The morph target count of each node's mesh (0 without a mesh) and each node's default weights.
+struct MorphDefaults {
+  std::vector<size_t> node_targets;
+  std::vector<std::vector<double>> rest_weights;
+};
+
+MorphDefaults read_morph_defaults(Ctx& ctx) {
+  const auto& model = ctx.model;
+  const size_t N = model.nodes.size();
   // Morph target count of each mesh (every primitive must have the same, glTF 2.0 §3.7.2.2) and
   // the default weights of each node: node `weights`, else mesh `weights`, else zeros.
   std::vector<size_t> mesh_targets(model.meshes.size(), 0);
@@ -1047,8 +1050,11 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
                std::to_string(mesh.weights.size()) + " numbers, but the mesh has " +
                std::to_string(mesh_targets[m]) + " morph targets");
   }
-  std::vector<size_t> node_targets(N, 0);
-  std::vector<std::vector<double>> rest_weights(N);
+  MorphDefaults d;
+  std::vector<size_t>& node_targets = d.node_targets;
+  std::vector<std::vector<double>>& rest_weights = d.rest_weights;
+  node_targets.assign(N, 0);
+  rest_weights.resize(N);
   for (size_t n = 0; n < N; ++n) {
     const auto& nd = model.nodes[n];
     if (nd.mesh >= 0) node_targets[n] = mesh_targets[size_t(nd.mesh)];
@@ -1064,6 +1070,13 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     for (double w : rest_weights[n])
       if (!std::isfinite(w)) ctx.fail("node " + std::to_string(n) + ": non-finite morph weight");
   }
+  return d;
+}
+
+// The nodes with a mesh, in depth-first order from the roots of the scene shown.
+std::vector<int> mesh_instances(Ctx& ctx, const std::vector<int>& parent) {
+  const auto& model = ctx.model;
+  const size_t N = model.nodes.size();
   for (size_t n = 0; n < N; ++n) {  // cycle check: walking up must end within N steps
     size_t steps = 0;
     for (int p = parent[n]; p != -1; p = parent[p])
@@ -1095,7 +1108,24 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
       for (auto it = ch.rbegin(); it != ch.rend(); ++it) stack.push_back(*it);
     }
   }
+  return instances;
+}
 
+// The K states of the scene: world matrices and morph weights of every node in each.
+struct Poses {
+  size_t K = 1;
+  std::vector<std::vector<Mat4>> world;
+  std::vector<std::vector<std::vector<double>>> morph_weights;
+};
+
+Poses pose_states(Ctx& ctx, const LoadOptions& options, const NodeGraph& nodes,
+                  const MorphDefaults& morph) {
+  const auto& model = ctx.model;
+  const size_t N = model.nodes.size();
+  const std::vector<Trs>& rest = nodes.rest;
+  const std::vector<int>& parent = nodes.parent;
+  const std::vector<size_t>& node_targets = morph.node_targets;
+  const std::vector<std::vector<double>>& rest_weights = morph.rest_weights;
   // Animation channels and sample times.
   std::vector<Channel> channels;
   if (options.states > 1 || options.animation >= 0)
@@ -1141,16 +1171,17 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     }
   }
 
-  if (appearance) {
-    *appearance = SceneAppearance{};
-    read_materials(ctx, *appearance);
-  }
-  Scene scene;
-  scene.positions.resize(K);
+  return {K, std::move(world), std::move(morph_weights)};
+}
+
+// Reserves the scene's arrays for `instances` and counts the instances of each mesh in `uses`.
+void reserve_scene(const Ctx& ctx, const std::vector<int>& instances, Scene& scene,
+                   std::vector<size_t>& uses) {
+  const auto& model = ctx.model;
   // Memory: the scene's arrays are reserved from the accessor counts (an upper bound: skipped
   // primitives are counted too), so they never grow by doubling; a decoded mesh is released after
   // its last instance.
-  std::vector<size_t> uses(model.meshes.size(), 0);
+  uses.assign(model.meshes.size(), 0);
   size_t vertex_bound = 0, triangle_bound = 0;
   for (int n : instances) {
     const auto& mesh = model.meshes[size_t(model.nodes[n].mesh)];
@@ -1174,6 +1205,150 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
     scene.triangles.reserve(triangle_bound);
     scene.triangle_object.reserve(triangle_bound);
   }
+}
+
+// Joint matrices per state of node `n`'s skin (none when the node is not skinned).
+std::vector<std::vector<Mat4>> joint_matrices(Ctx& ctx, int n, const Poses& poses) {
+  const auto& model = ctx.model;
+  const size_t N = model.nodes.size();
+  const auto& nd = model.nodes[size_t(n)];
+  const bool skinned = nd.skin >= 0;
+  const size_t K = poses.K;
+  const auto& world = poses.world;
+  // Joint matrices per state (skinned nodes): world(joint) * inverseBind.
+  std::vector<std::vector<Mat4>> joint_m;
+  if (skinned) {
+    const auto& skin = model.skins[nd.skin];
+    std::vector<double> ibm;
+    int nc;
+    if (skin.inverseBindMatrices >= 0)
+      ibm = read_accessor(ctx, skin.inverseBindMatrices,
+                          "inverseBindMatrices of skin " + std::to_string(nd.skin), nc, {16});
+    if (!ibm.empty() && ibm.size() < 16 * skin.joints.size())
+      ctx.fail("skin " + std::to_string(nd.skin) + ": fewer inverse bind matrices than joints");
+    joint_m.assign(K, std::vector<Mat4>(skin.joints.size()));
+    for (size_t j = 0; j < skin.joints.size(); ++j) {
+      int jn = skin.joints[j];
+      if (jn < 0 || size_t(jn) >= N)
+        ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) +
+                 " does not exist");
+      Mat4 inv;
+      if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inv.m);
+      for (size_t k = 0; k < K; ++k) joint_m[k][j] = world[k][jn] * inv;
+    }
+  }
+  return joint_m;
+}
+
+// Appends the vertices of primitive `p` of node `n` in every state to `scene.positions`.
+// `morphed`: scratch space.
+void append_positions(Ctx& ctx, const Prim& p, int n, const Poses& poses,
+                      const std::vector<std::vector<Mat4>>& joint_m, Scene& scene,
+                      std::vector<Vec3>& morphed) {
+  const auto& nd = ctx.model.nodes[size_t(n)];
+  const bool skinned = nd.skin >= 0;
+  const size_t K = poses.K;
+  const auto& world = poses.world;
+  const auto& morph_weights = poses.morph_weights;
+  for (size_t k = 0; k < K; ++k) {
+    auto& out = scene.positions[k];
+    // Morph first (base + sum_i w_i * target_i), then skin, then the node transform.
+    const std::vector<Vec3>* local = &p.local;
+    if (!p.targets.empty()) {
+      const auto& w = morph_weights[k][size_t(n)];
+      morphed = p.local;
+      for (size_t ti = 0; ti < p.targets.size(); ++ti) {
+        if (w[ti] == 0 || p.targets[ti].empty()) continue;
+        for (size_t v = 0; v < morphed.size(); ++v)
+          morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
+      }
+      local = &morphed;
+    }
+    for (size_t v = 0; v < p.local.size(); ++v) {
+      const Vec3 lv = (*local)[v];
+      if (!skinned || p.joints.empty()) {
+        out.push_back(transform(world[k][n], lv));
+        continue;
+      }
+      Vec3 acc{0, 0, 0};
+      double wsum = 0;
+      for (int c = 0; c < 4; ++c) {
+        double w = p.weights[v][c];
+        if (w == 0) continue;
+        uint32_t j = p.joints[v][c];
+        if (j >= joint_m[k].size())
+          ctx.fail("mesh " + std::to_string(nd.mesh) + ": joint index " + std::to_string(j) +
+                   " out of range of skin " + std::to_string(nd.skin));
+        acc = acc + transform(joint_m[k][j], lv) * w;
+        wsum += w;
+      }
+      out.push_back(wsum > 0 ? acc * (1.0 / wsum) : transform(world[k][n], lv));
+    }
+  }
+}
+
+// Appends the normals, texture coordinates and materials of primitive `p` of a node whose key
+// state 0 world matrix is `node_world` to `app`.
+void append_appearance(const Prim& p, bool skinned, const Mat4& node_world,
+                       const std::vector<std::vector<Mat4>>& joint_m, SceneAppearance& app) {
+  for (size_t v = 0; v < p.local.size(); ++v) {
+    Vec3 nrm{NAN, NAN, NAN};
+    if (!p.normals.empty()) {
+      if (!skinned || p.joints.empty()) {
+        nrm = unit_or_nan(transform_normal(node_world, p.normals[v]));
+      } else {
+        // The weight blend of the joints' normal transforms; joints whose matrix is
+        // singular (scaled to 0) are skipped, and the node transform is the fallback.
+        Vec3 acc{0, 0, 0};
+        for (int c = 0; c < 4; ++c) {
+          if (p.weights[v][c] == 0 || p.joints[v][c] >= joint_m[0].size()) continue;
+          Vec3 t = unit_or_nan(transform_normal(joint_m[0][p.joints[v][c]], p.normals[v]));
+          if (is_finite(t)) acc = acc + t * p.weights[v][c];
+        }
+        nrm = unit_or_nan(acc);
+        if (!is_finite(nrm)) nrm = unit_or_nan(transform_normal(node_world, p.normals[v]));
+      }
+    }
+    app.normals.push_back(nrm);
+    app.uvs.push_back(p.uvs.empty() ? std::array<double, 2>{NAN, NAN} : p.uvs[v]);
+  }
+  app.triangle_material.insert(app.triangle_material.end(), p.tris.size(), p.material);
+}
+
+}  // namespace
+
+SceneAppearance load_appearance(const std::string& path, const LoadOptions& options,
+                                std::vector<std::string>* warnings) {
+  std::vector<std::string> local;
+  SceneAppearance app;
+  std::string ext = file_extension(path);
+  if (ext == ".gltf" || ext == ".glb") load_gltf(path, options, warnings ? *warnings : local, &app);
+  return app;
+}
+
+Scene load_gltf(const std::string& path, const LoadOptions& options,
+                std::vector<std::string>& warnings, SceneAppearance* appearance) {
+  Ctx ctx;
+  ctx.path = path;
+  ctx.warnings = &warnings;
+  parse_file(ctx);
+  check_extensions(ctx);
+  const auto& model = ctx.model;
+
+  const NodeGraph nodes = read_nodes(ctx);
+  const MorphDefaults morph = read_morph_defaults(ctx);
+  const std::vector<int> instances = mesh_instances(ctx, nodes.parent);
+  const Poses poses = pose_states(ctx, options, nodes, morph);
+  const size_t K = poses.K;
+
+  if (appearance) {
+    *appearance = SceneAppearance{};
+    read_materials(ctx, *appearance);
+  }
+  Scene scene;
+  scene.positions.resize(K);
+  std::vector<size_t> uses;
+  reserve_scene(ctx, instances, scene, uses);
   std::vector<std::vector<Prim>> mesh_cache(model.meshes.size());
   std::vector<char> mesh_cached(model.meshes.size(), 0);
   for (int n : instances) {
@@ -1196,96 +1371,19 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
                                                              : "node" + std::to_string(n);
     uint32_t obj = uint32_t(scene.objects.size());
     scene.objects.push_back({name});
-    // Joint matrices per state (skinned nodes): world(joint) * inverseBind.
-    std::vector<std::vector<Mat4>> joint_m;
-    if (skinned) {
-      const auto& skin = model.skins[nd.skin];
-      std::vector<double> ibm;
-      int nc;
-      if (skin.inverseBindMatrices >= 0)
-        ibm = read_accessor(ctx, skin.inverseBindMatrices,
-                            "inverseBindMatrices of skin " + std::to_string(nd.skin), nc, {16});
-      if (!ibm.empty() && ibm.size() < 16 * skin.joints.size())
-        ctx.fail("skin " + std::to_string(nd.skin) + ": fewer inverse bind matrices than joints");
-      joint_m.assign(K, std::vector<Mat4>(skin.joints.size()));
-      for (size_t j = 0; j < skin.joints.size(); ++j) {
-        int jn = skin.joints[j];
-        if (jn < 0 || size_t(jn) >= N)
-          ctx.fail("skin " + std::to_string(nd.skin) + ": joint node " + std::to_string(jn) +
-                   " does not exist");
-        Mat4 inv;
-        if (!ibm.empty()) std::copy(ibm.begin() + 16 * j, ibm.begin() + 16 * (j + 1), inv.m);
-        for (size_t k = 0; k < K; ++k) joint_m[k][j] = world[k][jn] * inv;
-      }
-    }
+    const std::vector<std::vector<Mat4>> joint_m = joint_matrices(ctx, n, poses);
     std::vector<Vec3> morphed;
     for (const Prim& p : mesh_cache[nd.mesh]) {
       size_t base = scene.positions[0].size();
       if (base + p.local.size() >= UINT32_MAX) ctx.fail("too many vertices for 32-bit indices");
-      for (size_t k = 0; k < K; ++k) {
-        auto& out = scene.positions[k];
-        // Morph first (base + sum_i w_i * target_i), then skin, then the node transform.
-        const std::vector<Vec3>* local = &p.local;
-        if (!p.targets.empty()) {
-          const auto& w = morph_weights[k][size_t(n)];
-          morphed = p.local;
-          for (size_t ti = 0; ti < p.targets.size(); ++ti) {
-            if (w[ti] == 0 || p.targets[ti].empty()) continue;
-            for (size_t v = 0; v < morphed.size(); ++v)
-              morphed[v] = morphed[v] + p.targets[ti][v] * w[ti];
-          }
-          local = &morphed;
-        }
-        for (size_t v = 0; v < p.local.size(); ++v) {
-          const Vec3 lv = (*local)[v];
-          if (!skinned || p.joints.empty()) {
-            out.push_back(transform(world[k][n], lv));
-            continue;
-          }
-          Vec3 acc{0, 0, 0};
-          double wsum = 0;
-          for (int c = 0; c < 4; ++c) {
-            double w = p.weights[v][c];
-            if (w == 0) continue;
-            uint32_t j = p.joints[v][c];
-            if (j >= joint_m[k].size())
-              ctx.fail("mesh " + std::to_string(nd.mesh) + ": joint index " + std::to_string(j) +
-                       " out of range of skin " + std::to_string(nd.skin));
-            acc = acc + transform(joint_m[k][j], lv) * w;
-            wsum += w;
-          }
-          out.push_back(wsum > 0 ? acc * (1.0 / wsum) : transform(world[k][n], lv));
-        }
-      }
+      append_positions(ctx, p, n, poses, joint_m, scene, morphed);
       for (auto t : p.tris) {
         scene.triangles.push_back(
             {uint32_t(t[0] + base), uint32_t(t[1] + base), uint32_t(t[2] + base)});
         scene.triangle_object.push_back(obj);
       }
       if (appearance) {
-        SceneAppearance& app = *appearance;
-        for (size_t v = 0; v < p.local.size(); ++v) {
-          Vec3 nrm{NAN, NAN, NAN};
-          if (!p.normals.empty()) {
-            if (!skinned || p.joints.empty()) {
-              nrm = unit_or_nan(transform_normal(world[0][n], p.normals[v]));
-            } else {
-              // The weight blend of the joints' normal transforms; joints whose matrix is
-              // singular (scaled to 0) are skipped, and the node transform is the fallback.
-              Vec3 acc{0, 0, 0};
-              for (int c = 0; c < 4; ++c) {
-                if (p.weights[v][c] == 0 || p.joints[v][c] >= joint_m[0].size()) continue;
-                Vec3 t = unit_or_nan(transform_normal(joint_m[0][p.joints[v][c]], p.normals[v]));
-                if (is_finite(t)) acc = acc + t * p.weights[v][c];
-              }
-              nrm = unit_or_nan(acc);
-              if (!is_finite(nrm)) nrm = unit_or_nan(transform_normal(world[0][n], p.normals[v]));
-            }
-          }
-          app.normals.push_back(nrm);
-          app.uvs.push_back(p.uvs.empty() ? std::array<double, 2>{NAN, NAN} : p.uvs[v]);
-        }
-        app.triangle_material.insert(app.triangle_material.end(), p.tris.size(), p.material);
+        append_appearance(p, skinned, poses.world[0][size_t(n)], joint_m, *appearance);
       }
     }
   }
