@@ -141,4 +141,31 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
     }
 }
 
+void print_view_stereo(const json& j) {
+  for (const char* name : {"left", "right"}) {
+    const json& ej = j["eyes"][name];
+    if (ej["rendered"].get<bool>() || !show_progress()) continue;  // -q: the JSON has it all
+    const json& m = ej["method_error"];
+    std::fprintf(stderr,
+                 "stereo %s eye (cells %zu, %zu triangles): holes %.4f%s, method error PSNR %s "
+                 "SSIM %.4f triangle "
+                 "mismatch %.4f; total error SSIM %.4f\n",
+                 name, j["cells"].size(), j["visible_triangles"].get<size_t>(),
+                 ej["holes"]["share"].get<double>(),
+                 ej["fallback"].get<bool>() ? " (fallback: rendered)" : "",
+                 m["psnr"].is_null() ? "inf" : std::to_string(m["psnr"].get<double>()).c_str(),
+                 m["ssim"].get<double>(), m["triangle_mismatch"].get<double>(),
+                 ej["total_error"]["ssim"].get<double>());
+  }
+  const json& cpu = j["cpu_seconds"];
+  if (show_progress())
+    std::fprintf(
+        stderr,
+        "stereo CPU time: render %.4f s + reproject %.4f s + patch %.4f s vs both eyes %.4f s; "
+        "rays %zu vs %zu\n",
+        cpu["render"].get<double>(), cpu["reproject"].get<double>(), cpu["patch"].get<double>(),
+        cpu["render_both_eyes"].get<double>(), j["rays"]["cast"].get<size_t>(),
+        j["rays"]["both_eyes"].get<size_t>());
+}
+
 }  // namespace pvs_cli

@@ -39,4 +39,7 @@ nlohmann::json growth_json(const vislib::GrowthRun& g);
 // The summary on stderr of the view's JSON `j`.
 void print_view(const nlohmann::json& j, const vislib::RegionCounts& rc, bool dynamic);
 
+// The summary on stderr of the `stereo` block `j` of the view's JSON (run_view_stereo).
+void print_view_stereo(const nlohmann::json& j);
+
 }  // namespace pvs_cli
