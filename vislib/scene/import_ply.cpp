@@ -469,10 +469,7 @@ Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
     }
   }
   body.expect_end();
-  if (short_faces)
-    warnings.push_back(path + ": " + std::to_string(short_faces) +
-                       " face(s) with fewer than 3 vertices skipped");
-  if (scene.triangles.empty()) warnings.push_back(path + ": no faces");
+  mesh_reader::warn_faces(path, short_faces, scene, warnings);
   return scene;
 }
 
