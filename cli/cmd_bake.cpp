@@ -17,6 +17,7 @@
 #include "cli/options.h"
 #include "vislib/bake/bake.h"
 #include "vislib/bake/bake_report.h"
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"

@@ -15,6 +15,8 @@
 #include "cli/options.h"
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/cell_set.h"
+#include "vislib/bake/cell_visibility.h"
+#include "vislib/bake/free_space.h"
 #include "vislib/bake/pvs_summary.h"
 #include "vislib/bake/scene_subset.h"
 #include "vislib/bake/view_cells.h"

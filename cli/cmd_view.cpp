@@ -1,7 +1,8 @@
 // pvs view: the near-far frame of a cell's visible set (near-far paper §3, CloVR §3) from a user
 // eye, its ground truth (the full scene) and error heat map, and the metrics: epsilon, PSNR, SSIM,
-// OVC, OFC with and without the Eq. 1 morph, triangles per region, and with --grow the continuity
-// (minimum SSIM between consecutive frames) while the near region grows ring by ring.
+// OVC, object pixel agreement, CloVR's OFC with and without the Eq. 1 morph, triangles per region,
+// and with --grow the continuity (minimum SSIM between consecutive frames) while the near region
+// grows ring by ring.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>

@@ -239,26 +239,7 @@ json run_view_stereo(const ViewStereoArgs& a, const std::string& pvs_file,
               {"render_both_eyes", t.both.cpu}}},
             {"rays", {{"cast", t.rays}, {"both_eyes", 2 * pixels}}},
             {"images", images}};
-  for (const char* name : {"left", "right"}) {
-    const json& ej = j["eyes"][name];
-    if (ej["rendered"].get<bool>() || !show_progress()) continue;  // -q: the JSON has it all
-    const json& m = ej["method_error"];
-    std::fprintf(stderr,
-                 "stereo %s eye (cells %zu, %zu triangles): holes %.4f%s, method error PSNR %s "
-                 "SSIM %.4f triangle "
-                 "mismatch %.4f; total error SSIM %.4f\n",
-                 name, cells.size(), tris.size(), ej["holes"]["share"].get<double>(),
-                 ej["fallback"].get<bool>() ? " (fallback: rendered)" : "",
-                 m["psnr"].is_null() ? "inf" : std::to_string(m["psnr"].get<double>()).c_str(),
-                 m["ssim"].get<double>(), m["triangle_mismatch"].get<double>(),
-                 ej["total_error"]["ssim"].get<double>());
-  }
-  if (show_progress())
-    std::fprintf(
-        stderr,
-        "stereo CPU time: render %.4f s + reproject %.4f s + patch %.4f s vs both eyes %.4f s; "
-        "rays %zu vs %zu\n",
-        t.render.cpu, t.reproject.cpu, t.patch.cpu, t.both.cpu, t.rays, 2 * pixels);
+  print_view_stereo(j);
   return j;
 }
 

@@ -31,7 +31,7 @@ json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
   json j = frame_error_json(truth, test);
   const vislib::ObjectCompletion c = vislib::object_completion(scene, truth, test);
   j["ovc"] = c.ovc;
-  j["ofc"] = c.ofc;
+  j["object_pixel_agreement"] = c.object_pixel_agreement;
   j["ofc_eq2"] = c.ofc_eq2;
   j["objects_in_truth"] = c.objects;
   return j;
@@ -102,16 +102,17 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
   std::fprintf(
       stderr,
       "cell %u: visible %zu triangles: near %zu, intermediate %zu, far %zu (env map %zu)\n"
-      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f (CloVR Eq. 2: %.3f) triangle "
-      "mismatch %.4f\n"
-      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f OFC %.3f (CloVR Eq. 2: %.3f) triangle "
-      "mismatch %.4f\n",
+      "  morph:    epsilon %.4f PSNR %s SSIM %.4f OVC %.3f object pixel agreement %.3f OFC (CloVR "
+      "Eq. 2) %.3f triangle mismatch %.4f\n"
+      "  no morph: epsilon %.4f PSNR %s SSIM %.4f OVC %.3f object pixel agreement %.3f OFC (CloVR "
+      "Eq. 2) %.3f triangle mismatch %.4f\n",
       j["cell"].get<uint32_t>(), j["triangles"]["visible"].get<size_t>(), rc.near, rc.intermediate,
       rc.far, rc.env_map, j["epsilon"].get<double>(), fmt_psnr(j["psnr"]).c_str(),
-      j["ssim"].get<double>(), j["ovc"].get<double>(), j["ofc"].get<double>(),
+      j["ssim"].get<double>(), j["ovc"].get<double>(), j["object_pixel_agreement"].get<double>(),
       j["ofc_eq2"].get<double>(), j["triangle_mismatch"].get<double>(), w["epsilon"].get<double>(),
       fmt_psnr(w["psnr"]).c_str(), w["ssim"].get<double>(), w["ovc"].get<double>(),
-      w["ofc"].get<double>(), w["ofc_eq2"].get<double>(), w["triangle_mismatch"].get<double>());
+      w["object_pixel_agreement"].get<double>(), w["ofc_eq2"].get<double>(),
+      w["triangle_mismatch"].get<double>());
   std::fprintf(stderr,
                "  delta (Eqs. 7-8, radius %g px), mean (mean |delta|): morph %.4f (%.4f), no "
                "morph %.4f (%.4f)\n"
@@ -138,6 +139,33 @@ void print_view(const json& j, const vislib::RegionCounts& rc, bool dynamic) {
                    g["min_consecutive_ssim"].get<double>(),
                    g["min_consecutive_whole_ssim"].get<double>());
     }
+}
+
+void print_view_stereo(const json& j) {
+  for (const char* name : {"left", "right"}) {
+    const json& ej = j["eyes"][name];
+    if (ej["rendered"].get<bool>() || !show_progress()) continue;  // -q: the JSON has it all
+    const json& m = ej["method_error"];
+    std::fprintf(stderr,
+                 "stereo %s eye (cells %zu, %zu triangles): holes %.4f%s, method error PSNR %s "
+                 "SSIM %.4f triangle "
+                 "mismatch %.4f; total error SSIM %.4f\n",
+                 name, j["cells"].size(), j["visible_triangles"].get<size_t>(),
+                 ej["holes"]["share"].get<double>(),
+                 ej["fallback"].get<bool>() ? " (fallback: rendered)" : "",
+                 m["psnr"].is_null() ? "inf" : std::to_string(m["psnr"].get<double>()).c_str(),
+                 m["ssim"].get<double>(), m["triangle_mismatch"].get<double>(),
+                 ej["total_error"]["ssim"].get<double>());
+  }
+  const json& cpu = j["cpu_seconds"];
+  if (show_progress())
+    std::fprintf(
+        stderr,
+        "stereo CPU time: render %.4f s + reproject %.4f s + patch %.4f s vs both eyes %.4f s; "
+        "rays %zu vs %zu\n",
+        cpu["render"].get<double>(), cpu["reproject"].get<double>(), cpu["patch"].get<double>(),
+        cpu["render_both_eyes"].get<double>(), j["rays"]["cast"].get<size_t>(),
+        j["rays"]["both_eyes"].get<size_t>());
 }
 
 }  // namespace pvs_cli

@@ -16,8 +16,8 @@ namespace pvs_cli {
 // triangle than the truth, of `test` against `truth`.
 nlohmann::json frame_error_json(const vislib::Frame& truth, const vislib::Frame& test);
 
-// frame_error_json and OVC, OFC and the share of pixels showing another
-// triangle than the truth, of `test` against `truth`.
+// frame_error_json and OVC, the object pixel agreement, CloVR's OFC (ofc_eq2) and the share of
+// pixels showing another triangle than the truth, of `test` against `truth` (object_completion).
 nlohmann::json quality_json(const vislib::Scene& scene, const vislib::Frame& truth,
                             const vislib::Frame& test);
 
@@ -38,5 +38,8 @@ nlohmann::json growth_json(const vislib::GrowthRun& g);
 
 // The summary on stderr of the view's JSON `j`.
 void print_view(const nlohmann::json& j, const vislib::RegionCounts& rc, bool dynamic);
+
+// The summary on stderr of the `stereo` block `j` of the view's JSON (run_view_stereo).
+void print_view_stereo(const nlohmann::json& j);
 
 }  // namespace pvs_cli

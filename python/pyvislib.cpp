@@ -183,13 +183,8 @@ void same_size(const vislib::Frame& a, const vislib::Frame& b) {
     throw py::value_error("the two frames differ in size");
 }
 
-}  // namespace
-
-PYBIND11_MODULE(pyvislib, m) {
-  m.doc() =
-      "vislib from Python: scenes, from-segment/region visibility, PVS files, reference frames "
-      "and their metrics (docs/python.md).";
-
+// The exceptions of the module and their translation (see the top of this file).
+void bind_errors(py::module_& m) {
   static py::exception<vislib::InputError> input_error(m, "InputError", PyExc_ValueError);
   static py::exception<pvs::FormatError> format_error(m, "FormatError", PyExc_ValueError);
   py::register_exception_translator([](std::exception_ptr p) {
@@ -206,7 +201,9 @@ PYBIND11_MODULE(pyvislib, m) {
       PyErr_SetObject(PyExc_OSError, err.ptr());
     }
   });
+}
 
+void bind_scenes(py::module_& m) {
   // ---- Scenes --------------------------------------------------------------------------------
   py::class_<PyScene, ScenePtr>(m, "Scene",
                                 "A loaded scene (vislib::Scene); triangle ids in file order.")
@@ -264,7 +261,9 @@ PYBIND11_MODULE(pyvislib, m) {
       py::arg("path"), py::arg("states") = 1, py::arg("animation") = -1,
       "Loads .glb .gltf .obj .ply .off .stl .spheres .bsp (vislib::load_scene). Raises "
       "pyvislib.InputError naming the file on a missing or malformed file.");
+}
 
+void bind_visibility(py::module_& m) {
   // ---- Visibility -----------------------------------------------------------------------------
   py::class_<PySegmentResult>(m, "SegmentResult")
       .def_property_readonly(
@@ -359,7 +358,9 @@ PYBIND11_MODULE(pyvislib, m) {
       py::arg("threads") = 0,
       "Triangles visible from the box box_min..box_max (vislib::region_visibility): runs cube "
       "orientations on each perimeter segment, united. Same as `pvs region --box ... --runs K`.");
+}
 
+void bind_pvs_files(py::module_& m) {
   // ---- PVS files ------------------------------------------------------------------------------
   py::class_<PyPvs>(m, "Pvs", "A PVS file opened through the runtime (pvs_runtime::Pvs, mmap).")
       .def(py::init([](const std::string& path, std::optional<uint64_t> expected_fingerprint,
@@ -426,7 +427,9 @@ PYBIND11_MODULE(pyvislib, m) {
             return to_numpy(p.pvs.neighbours(checked_cell(p, cell), margin));
           },
           py::arg("cell"), py::arg("margin") = 0.0);
+}
 
+void bind_frames(py::module_& m) {
   // ---- Frames ---------------------------------------------------------------------------------
   py::class_<vislib::Frame>(m, "Frame", "A rendered frame (vislib::Frame).")
       .def_readonly("width", &vislib::Frame::width)
@@ -512,7 +515,9 @@ PYBIND11_MODULE(pyvislib, m) {
           py::arg("visible") = py::none(), py::arg("threads") = 0,
           "Renders the full scene, or only the triangle ids in `visible` (a visible set), from "
           "a perspective camera (render.h's convention).");
+}
 
+void bind_metrics(py::module_& m) {
   // ---- Metrics --------------------------------------------------------------------------------
   py::class_<vislib::FrameQuality>(m, "FrameQuality")
       .def_readonly("pixels", &vislib::FrameQuality::pixels)
@@ -652,4 +657,19 @@ PYBIND11_MODULE(pyvislib, m) {
       py::arg("set"), py::arg("reference"),
       "Sizes of set, reference, their intersection, reference ids the set misses and extra ids "
       "(vislib::compare_sets)");
+}
+
+}  // namespace
+
+PYBIND11_MODULE(pyvislib, m) {
+  m.doc() =
+      "vislib from Python: scenes, from-segment/region visibility, PVS files, reference frames "
+      "and their metrics (docs/python.md).";
+
+  bind_errors(m);
+  bind_scenes(m);
+  bind_visibility(m);
+  bind_pvs_files(m);
+  bind_frames(m);
+  bind_metrics(m);
 }

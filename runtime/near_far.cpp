@@ -140,20 +140,6 @@ NearFarPartition partition_near_far(const float* positions, size_t vertex_count,
 
 // ---- Range cube map -------------------------------------------------------------------------
 
-namespace {
-struct Axes {
-  Point3 f, s, t;
-};
-const Axes kFaces[6] = {
-    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},   // +X
-    {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},   // -X
-    {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},     // +Y
-    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},   // -Y
-    {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},    // +Z
-    {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}},  // -Z
-};
-}  // namespace
-
 CubePixel cube_pixel(const Point3& d, int size) {
   assert(size > 0 && dot(d, d) > 0);
   const double ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
@@ -164,7 +150,7 @@ CubePixel cube_pixel(const Point3& d, int size) {
     face = d.y >= 0 ? 2 : 3;
   else
     face = d.z >= 0 ? 4 : 5;
-  const Axes& a = kFaces[face];
+  const CubeFaceAxes& a = kCubeFaceAxes[face];
   const double m = dot(d, a.f);  // > 0
   const double sc = dot(d, a.s) / m, tc = dot(d, a.t) / m;
   auto pix = [size](double u) {
@@ -175,7 +161,7 @@ CubePixel cube_pixel(const Point3& d, int size) {
 
 Point3 cube_pixel_direction(int face, int x, int y, int size) {
   assert(face >= 0 && face < 6 && size > 0);
-  const Axes& a = kFaces[face];
+  const CubeFaceAxes& a = kCubeFaceAxes[face];
   const double sc = double(2 * x + 1) / double(size) - 1.0,
                tc = double(2 * y + 1) / double(size) - 1.0;
   return a.f + a.s * sc + a.t * tc;

@@ -109,6 +109,20 @@ NearFarPartition partition_near_far(const float* positions, size_t vertex_count,
 // pixel (x, y) (column, row) has the centre direction F + sc S + tc T, sc = (2x+1)/size - 1,
 // tc = (2y+1)/size - 1. range[(face * size + y) * size + x] is the Euclidean distance from O to
 // the first stationary far surface along that pixel, +infinity where there is none.
+// The face table above, the one copy of the convention (vislib/base/cubemap.h reads it too):
+// kCubeFaceAxes[face] = {F, S, T}.
+struct CubeFaceAxes {
+  Point3 f, s, t;
+};
+inline constexpr CubeFaceAxes kCubeFaceAxes[6] = {
+    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},   // +X
+    {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},   // -X
+    {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},     // +Y
+    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},   // -Y
+    {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},    // +Z
+    {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}},  // -Z
+};
+
 struct RangeCubeMap {
   int size = 0;
   const float* range = nullptr;  // 6 * size * size values, not owned

@@ -78,7 +78,7 @@ TEST(NearFarRender, EverythingNearEqualsTheFullFrame) {
   const vislib::ObjectCompletion c = vislib::object_completion(s, truth, nf);
   EXPECT_EQ(c.objects, 3u);
   EXPECT_EQ(c.ovc, 1.0);
-  EXPECT_EQ(c.ofc, 1.0);
+  EXPECT_EQ(c.object_pixel_agreement, 1.0);
 }
 
 // A far triangle whose lowest vertex P lies exactly on the r2 cylinder, seen from an eye 2 units
@@ -238,9 +238,10 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
   for (const char* name : {"/v.png", "/v_truth.png", "/v_heat.png", "/v_nomorph.png"})
     EXPECT_TRUE(std::ifstream(dir + name).good()) << name;
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir + "/v.json"));
-  for (const char* key :
-       {"psnr", "ssim", "epsilon", "ovc", "ofc", "triangles", "without_morph", "continuity"})
+  for (const char* key : {"psnr", "ssim", "epsilon", "ovc", "object_pixel_agreement", "ofc_eq2",
+                          "triangles", "without_morph", "continuity"})
     EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_FALSE(j.contains("ofc"));  // one name, one meaning: CloVR's OFC is ofc_eq2
   for (const char* key : {"near", "intermediate", "far", "visible"})
     EXPECT_TRUE(j["triangles"].contains(key)) << key;
   EXPECT_EQ(j["triangles"]["near"].get<size_t>() + j["triangles"]["intermediate"].get<size_t>() +
@@ -290,9 +291,10 @@ TEST(PvsView, WritesFramesAndMetricsOnABakedCity) {
 }  // namespace
 
 // CloVR's Eq. 2 counts footprints (pixels of an object anywhere), capped at the truth's, weighted
-// by footprint; the per-object mean of per-pixel agreement (ofc) does not. A 4 x 1 frame: truth
-// shows object 0 on 3 pixels and object 1 on 1 pixel; the test shows object 0 shifted by one
-// pixel (3 pixels, 2 in place) and object 1 not at all; then object 0 over all 4 pixels.
+// by footprint; the per-object mean of per-pixel agreement (object_pixel_agreement) does
+// not. A 4 x 1 frame: truth shows object 0 on 3 pixels and object 1 on 1 pixel; the test shows
+// object 0 shifted by one pixel (3 pixels, 2 in place) and object 1 not at all; then object 0
+// over all 4 pixels.
 TEST(NearFarRender, ObjectFootprintCompletionFollowsClovrEquation2) {
   vislib::Scene s;
   vislib_test::add_quad(s, {0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0});  // triangles 0, 1: object 0
@@ -310,12 +312,12 @@ TEST(NearFarRender, ObjectFootprintCompletionFollowsClovrEquation2) {
   const vislib::Frame truth = frame({0, 1, 0, 2});
   // Object 0 drawn on pixels 1..3 (2 of its 3 truth pixels), object 1 missing.
   vislib::ObjectCompletion c = vislib::object_completion(s, truth, frame({none, 0, 1, 0}));
-  EXPECT_DOUBLE_EQ(c.ofc, (2.0 / 3.0 + 0.0) / 2.0);
+  EXPECT_DOUBLE_EQ(c.object_pixel_agreement, (2.0 / 3.0 + 0.0) / 2.0);
   EXPECT_DOUBLE_EQ(c.ofc_eq2, (3.0 + 0.0) / 4.0);  // min(3, 3) + min(0, 1) over 3 + 1
   // Object 0 grown over object 1's pixel: capped at its truth footprint.
   c = vislib::object_completion(s, truth, frame({0, 0, 0, 1}));
   EXPECT_DOUBLE_EQ(c.ofc_eq2, 3.0 / 4.0);
-  EXPECT_DOUBLE_EQ(c.ofc, (1.0 + 0.0) / 2.0);
+  EXPECT_DOUBLE_EQ(c.object_pixel_agreement, (1.0 + 0.0) / 2.0);
 }
 
 // The setup of a near-far view of a cell (vislib/render/view_setup.h) and both growths.

@@ -9,6 +9,8 @@
 #include <optional>
 
 #include "tests/scene_builders.h"
+#include "vislib/bake/cell_visibility.h"
+#include "vislib/bake/free_space.h"
 
 using namespace vislib;
 using vislib_test::add_quad;

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/id_universe.h"
 #include "vislib/bake/long_segments.h"
@@ -98,17 +99,10 @@ std::vector<SegmentEnds> all_edges(const pvs::CellLayout& layout) {
   return all;
 }
 
-}  // namespace
-
-BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& requested,
-                Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
-  assert(shard.count >= 1 && shard.index < shard.count);
-  std::unique_ptr<FileLock> lock;
-  if (files.lock)
-    lock = std::make_unique<FileLock>(files.output + ".lock", "the output " + files.output);
-  BakeReport report;
-  // One BVH for every static run of this bake (the runs walk it per tile).
-  TriangleBvh tree;
+// One BVH for every static run of this bake (the runs walk it per tile): `requested`'s own, else
+// one built into `tree` when the bake asks for it and the scene allows it, else none.
+const TriangleBvh* bake_bvh(const Scene& scene, const BakeSettings& requested, TriangleBvh& tree,
+                            BakeReport& report) {
   const TriangleBvh* bvh = requested.region.segment.bvh;
   if (requested.bvh && !bvh && bvh_applies(scene)) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -117,6 +111,13 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     report.bvh_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
+  return bvh;
+}
+
+// `requested` with --long-segments auto (0) resolved.
+BakeSettings resolved_settings(const Scene& scene, const ViewCells& cells,
+                               const BakeSettings& requested, const TriangleBvh* bvh,
+                               BakeReport& report) {
   // --long-segments auto: L from a pilot over every cell of the layout (not only this shard's),
   // so that every shard and every resumed run chooses the same L (long_segments.h).
   BakeSettings settings = requested;
@@ -130,14 +131,14 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     }
   }
   report.long_segments = uses_long_segments(scene, settings) ? settings.long_segments : 1;
-  pvs::FileInfo info = bake_file_info(scene, cells, settings);
-  info.partial = shard.count > 1;
-  const uint32_t n = info.layout.cell_count();
-  report.cells = n;
-  report.cell_seconds.assign(n, 0.0);
+  return settings;
+}
 
-  // Cells recovered from the checkpoint (resume); each is released once written.
-  std::vector<std::optional<std::vector<uint32_t>>> recovered;
+// Opens the checkpoint of `files` (none when not asked for); `recovered` receives its cells.
+std::unique_ptr<Checkpoint> open_checkpoint(
+    const BakeFiles& files, const pvs::FileInfo& info, Shard shard,
+    std::vector<std::optional<std::vector<uint32_t>>>& recovered, BakeReport& report) {
+  const uint32_t n = info.layout.cell_count();
   std::unique_ptr<Checkpoint> checkpoint;
   if (!files.checkpoint.empty()) {
     checkpoint = std::make_unique<Checkpoint>(files.checkpoint, bake_key(info, shard), n,
@@ -149,41 +150,43 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
         throw InputError(files.checkpoint,
                          "holds cell " + std::to_string(c) + ", which is not in this shard");
   }
-  if (recovered.empty()) recovered.resize(n);
+  return checkpoint;
+}
+
+// Announces to `shared_runs` the runs of the cells this bake computes (settings.share_segments).
+void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const pvs::FileInfo& info,
+                      Shard shard,
+                      const std::vector<std::optional<std::vector<uint32_t>>>& recovered,
+                      SegmentRunCache& shared_runs, BakeReport& report) {
+  const uint32_t n = info.layout.cell_count();
+  if (uses_long_segments(scene, settings)) {
+    // The plan covers every cell of the layout, so that it does not depend on the shard or on
+    // the cells recovered from a checkpoint.
+    shared_runs.plan_chains(all_edges(info.layout), settings.long_segments);
+  }
   for (uint32_t c = 0; c < n; ++c) {
-    if (!in_shard(c, shard)) continue;
-    ++report.shard_cells;
-    if (recovered[c]) ++report.resumed;
+    if (!in_shard(c, shard) || recovered[c]) continue;
+    for (const Box3& rect : cell_rectangles(info.layout, c))
+      for (const Segment& s : perimeter_segments(rect)) shared_runs.expect(s.from, s.to);
   }
+  // The pilot's runs of the chosen L are runs of this bake: not computed again.
+  for (LongSegmentChoice::Run& run : report.long_segment_choice.runs)
+    shared_runs.provide(run.from, run.to, run.splits, std::move(run.result));
+  report.long_segment_choice.runs.clear();
+}
 
-  // Shared edges: announce run 0 of every perimeter segment of the cells this run computes, so
-  // that an edge common to two cells is computed once and freed after its last use.
-  SegmentRunCache shared_runs;
-  BakeSettings run_settings = settings;
-  if (settings.share_segments) {
-    run_settings.region.shared_runs = &shared_runs;
-    if (uses_long_segments(scene, settings)) {
-      // The plan covers every cell of the layout, so that it does not depend on the shard or on
-      // the cells recovered from a checkpoint.
-      shared_runs.plan_chains(all_edges(info.layout), settings.long_segments);
-    }
-    for (uint32_t c = 0; c < n; ++c) {
-      if (!in_shard(c, shard) || recovered[c]) continue;
-      for (const Box3& rect : cell_rectangles(info.layout, c))
-        for (const Segment& s : perimeter_segments(rect)) shared_runs.expect(s.from, s.to);
-    }
-    // The pilot's runs of the chosen L are runs of this bake: not computed again.
-    for (LongSegmentChoice::Run& run : report.long_segment_choice.runs)
-      shared_runs.provide(run.from, run.to, run.splits, std::move(run.result));
-    report.long_segment_choice.runs.clear();
-  }
-  run_settings.region.segment.bvh = bvh;
-  std::atomic<uint64_t> runs_done{0};
-
-  // Streaming: cells are baked in parallel and written in cell order as soon as every earlier
-  // cell is written (a TBB pipeline whose last stage is serial and in order), so the memory held
-  // is the cells in flight (a bounded number of tokens) plus what pvs::StreamWriter keeps for
-  // delta references, whatever the cell count. The bytes are those of pvs::write_pvs.
+// Streaming: cells are baked in parallel and written in cell order as soon as every earlier
+// cell is written (a TBB pipeline whose last stage is serial and in order), so the memory held
+// is the cells in flight (a bounded number of tokens) plus what pvs::StreamWriter keeps for
+// delta references, whatever the cell count. The bytes are those of pvs::write_pvs.
+// Writes files.output, baking the cells of `shard` not in `recovered` with `run_settings`
+// (`runs` orientations each); adds the runs of the baked cells to `runs_done`.
+void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
+                  const BakeSettings& run_settings, int runs,
+                  std::vector<std::optional<std::vector<uint32_t>>>& recovered,
+                  Checkpoint* checkpoint, const BakeFiles& files, const BakeProgressFn& progress,
+                  std::atomic<uint64_t>& runs_done, BakeReport& report) {
+  const uint32_t n = info.layout.cell_count();
   AtomicFile out(files.output);
   pvs::StreamWriter writer(
       info, [&out](uint64_t offset, std::string_view bytes) { out.write_at(offset, bytes); });
@@ -235,7 +238,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                       "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
                         return bake_cell(scene, info.layout, c, run_settings, &seconds, in_cell);
                       });
-                  runs_done += cell_runs(info.layout, c, settings.region.runs);
+                  runs_done += cell_runs(info.layout, c, runs);
                   if (checkpoint) checkpoint->append(c, ids);
                   *set = std::move(ids);
                   report.cell_seconds[c] = seconds;
@@ -259,10 +262,53 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     throw;
   }
   report.seconds = elapsed();
-  report.segment_runs_shared = shared_runs.runs_shared();
-  report.segment_runs_computed = runs_done.load() - report.segment_runs_shared;
   report.stats = writer.finish();
   out.commit();
+}
+
+}  // namespace
+
+BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& requested,
+                Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
+  assert(shard.count >= 1 && shard.index < shard.count);
+  std::unique_ptr<FileLock> lock;
+  if (files.lock)
+    lock = std::make_unique<FileLock>(files.output + ".lock", "the output " + files.output);
+  BakeReport report;
+  TriangleBvh tree;
+  const TriangleBvh* bvh = bake_bvh(scene, requested, tree, report);
+  const BakeSettings settings = resolved_settings(scene, cells, requested, bvh, report);
+  pvs::FileInfo info = bake_file_info(scene, cells, settings);
+  info.partial = shard.count > 1;
+  const uint32_t n = info.layout.cell_count();
+  report.cells = n;
+  report.cell_seconds.assign(n, 0.0);
+
+  // Cells recovered from the checkpoint (resume); each is released once written.
+  std::vector<std::optional<std::vector<uint32_t>>> recovered;
+  std::unique_ptr<Checkpoint> checkpoint = open_checkpoint(files, info, shard, recovered, report);
+  if (recovered.empty()) recovered.resize(n);
+  for (uint32_t c = 0; c < n; ++c) {
+    if (!in_shard(c, shard)) continue;
+    ++report.shard_cells;
+    if (recovered[c]) ++report.resumed;
+  }
+
+  // Shared edges: announce run 0 of every perimeter segment of the cells this run computes, so
+  // that an edge common to two cells is computed once and freed after its last use.
+  SegmentRunCache shared_runs;
+  BakeSettings run_settings = settings;
+  if (settings.share_segments) {
+    run_settings.region.shared_runs = &shared_runs;
+    plan_shared_runs(scene, settings, info, shard, recovered, shared_runs, report);
+  }
+  run_settings.region.segment.bvh = bvh;
+  std::atomic<uint64_t> runs_done{0};
+
+  stream_cells(scene, info, shard, run_settings, settings.region.runs, recovered, checkpoint.get(),
+               files, progress, runs_done, report);
+  report.segment_runs_shared = shared_runs.runs_shared();
+  report.segment_runs_computed = runs_done.load() - report.segment_runs_shared;
   if (checkpoint) checkpoint->remove();
   return report;
 }

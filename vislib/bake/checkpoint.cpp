@@ -1,8 +1,6 @@
 // checkpoint.cpp: append-only, CRC-checked, fsync'd records of finished cells (checkpoint.h).
 #include "vislib/bake/checkpoint.h"
 
-#include <fcntl.h>
-#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -65,19 +63,9 @@ Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_coun
   if (recovered) recovered->assign(cell_count, std::nullopt);
   // Open without truncating and lock before reading or cutting anything: a second bake or resume
   // on the same checkpoint must not touch the records of the one that holds it.
-  fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
-  if (fd_ < 0) io_error(path, "cannot open the checkpoint");
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-    int err = errno;
-    ::close(fd_);
-    fd_ = -1;
-    if (err == EWOULDBLOCK)
-      throw InputError(path,
-                       "the checkpoint is locked by another process (another pvs bake or resume of "
-                       "this bake is running); wait for it to finish or stop it");
-    errno = err;
-    io_error(path, "cannot lock the checkpoint");
-  }
+  fd_ = open_locked(path, 0644, "the checkpoint",
+                    "the checkpoint is locked by another process (another pvs bake or resume of "
+                    "this bake is running); wait for it to finish or stop it");
   size_t keep = 0;  // bytes of the existing file to keep
   struct stat st;
   if (resume) {
@@ -160,13 +148,7 @@ Checkpoint::Checkpoint(const std::string& path, uint64_t key, uint32_t cell_coun
     if (::ftruncate(fd_, 0) != 0) io_error(path, "cannot empty the checkpoint");
     write_all(fd_, header_bytes(key), path);
     // Make the new file's directory entry durable too (a power cut, not only a killed process).
-    std::string dir =
-        path.find('/') == std::string::npos ? "." : path.substr(0, path.rfind('/') + 1);
-    int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (dfd >= 0) {
-      ::fsync(dfd);
-      ::close(dfd);
-    }
+    fsync_folder_of(path);
   } else {
     if (::ftruncate(fd_, off_t(keep)) != 0)
       io_error(path, "cannot cut the torn tail of the checkpoint");

@@ -12,9 +12,7 @@
 // Both give a pvs::CellLayout, the form the PVS file stores, so a cell's view region is the same
 // whether computed at bake time or read back from the file (pvs::CellLayout::view_region).
 //
-// A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeter of
-// the view region's bottom and top rectangles (the paper's perimeter heuristic, §4.1, applied at
-// the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell.
+// A cell's visible set: cell_visibility.h; points of a cell inside the geometry: free_space.h.
 #pragma once
 
 #include <array>
@@ -123,61 +121,5 @@ class PlacementError : public std::invalid_argument {
 // PlacementProblem, before placing anything. May return no cell (walkable: no floor in box).
 // Deterministic; `scene` is read only for walkable cells.
 ViewCells place_view_cells(const Scene& scene, const CellPlacement& placement);
-
-// The segments a cell's visibility is computed on: the four sides of the view region's bottom
-// rectangle (y = min.y) then those of its top rectangle (y = max.y), each in the order of
-// perimeter_segments; only the four of the bottom when the region is flat in y.
-std::vector<Segment> cell_boundary_segments(const Box3& view_region);
-
-// Seed of cell `cell`'s runs for a bake seeded `seed`; the bottom rectangle's runs use
-// Rng::derive(cell_seed, 0), the top's Rng::derive(cell_seed, 1).
-uint64_t cell_seed(uint64_t seed, uint32_t cell);
-
-struct CellVisibility {
-  std::vector<uint32_t> triangles;  // visible triangle ids, sorted
-  std::vector<uint32_t> spheres;    // visible sphere indices, sorted
-  std::vector<Segment> segments;    // cell_boundary_segments(view region)
-  double seconds = 0;               // kernel seconds
-};
-
-// Visible triangles of cell `cell` of `layout`: region_visibility (options.runs orientations,
-// options.segment settings) on the bottom and the top rectangle of the view region, united.
-// Depends only on the scene, the view region, `options` and `cell` (not on the thread count).
-// Thread-safe; parallel inside (TBB). `progress(fraction)`, if given, is called after each
-// from-segment run with the fraction in (0, 1] of the cell's runs done (from the calling thread
-// or a worker; never two calls at once).
-// The rectangles whose perimeters cell_visibility runs: the bottom and top of the cell's view
-// region (one when the region is flat in y).
-std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell);
-
-CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                               const RegionOptions& options,
-                               const std::function<void(double)>& progress = {});
-
-// --- Free space ---------------------------------------------------------------------------------
-// Walkable cells are columns over floor: a column that straddles a building holds points inside
-// it. These functions find such points without Embree (brute force over the triangles, so cost is
-// O(triangles) per ray: meant for a few points per cell, not for whole bakes).
-
-// True when `p` is enclosed by the geometry of state `state`: every one of kEnclosureRays fixed
-// directions (the 6 axes and 8 diagonals, tilted by fixed small rotations so that no ray runs
-// along an edge of an axis-aligned model) hits a triangle, and more than half of the nearest hits
-// are back faces (the ray meets the triangle from the side its normal (b-a)x(c-a) points to, the
-// inside of a closed, outward-facing solid). A point in a street sees the sky (some ray escapes);
-// a point under a bridge or in a tunnel sees front faces. Open or inward-facing models may be
-// misjudged either way; degenerate triangles are ignored. Deterministic, thread-safe.
-constexpr int kEnclosureRays = 14;
-bool point_enclosed(const Scene& scene, Vec3 p, size_t state = 0);
-
-// Enclosure of the samples of a view region: its centre, then a 4 x 4 grid (cell centres of a
-// 4 x 4 split in x and z) at the mid height of the region, in z-major order.
-struct CellFreeSpace {
-  int samples = 0;
-  int enclosed = 0;                // samples enclosed (point_enclosed)
-  bool centre_enclosed = false;    // the first sample
-  std::optional<Vec3> free_point;  // the free sample nearest the centre (the centre when free);
-                                   // none when every sample is enclosed
-};
-CellFreeSpace cell_free_space(const Scene& scene, const Box3& view_region, size_t state = 0);
 
 }  // namespace vislib

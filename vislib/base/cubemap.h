@@ -12,6 +12,7 @@
 
 #include <cstdint>
 
+#include "runtime/near_far.h"
 #include "vislib/base/vec.h"
 
 namespace vislib {
@@ -22,17 +23,10 @@ struct FaceAxes {
   Vec3 F, S, T;
 };
 
-// The local (unrotated) axes of face k.
+// The local (unrotated) axes of face k: the runtime's table (runtime/near_far.h), its one copy.
 inline FaceAxes face_axes_local(int k) {
-  static const FaceAxes table[6] = {
-      {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},   // +X
-      {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},   // -X
-      {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},     // +Y
-      {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},   // -Y
-      {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},    // +Z
-      {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}},  // -Z
-  };
-  return table[k];
+  const pvs_runtime::CubeFaceAxes& a = pvs_runtime::kCubeFaceAxes[k];
+  return {{a.f.x, a.f.y, a.f.z}, {a.s.x, a.s.y, a.s.z}, {a.t.x, a.t.y, a.t.z}};
 }
 
 // World axes of face k for orientation R.

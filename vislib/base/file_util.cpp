@@ -172,9 +172,7 @@ void AtomicFile::commit() {
   if (::rename(tmp_.c_str(), path_.c_str()) != 0)
     io_fail(path_, "cannot rename " + tmp_ + " into place", errno);
   committed_ = true;
-  std::string dir, name;
-  split_path(path_, dir, name);
-  fsync_folder(dir);
+  fsync_folder_of(path_);
 }
 
 void write_file_atomic(const std::string& path, const std::string& bytes) {
@@ -183,23 +181,33 @@ void write_file_atomic(const std::string& path, const std::string& bytes) {
   f.commit();
 }
 
+void fsync_folder_of(const std::string& path) {
+  std::string dir, name;
+  split_path(path, dir, name);
+  fsync_folder(dir);
+}
+
+int open_locked(const std::string& path, unsigned mode, const std::string& noun,
+                const std::string& held_message) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, mode_t(mode));
+  if (fd < 0) io_fail(path, "cannot open " + noun, errno);
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    int err = errno;
+    ::close(fd);
+    if (err == EWOULDBLOCK) throw InputError(path, held_message);
+    io_fail(path, "cannot lock " + noun, err);
+  }
+  return fd;
+}
+
 FileLock::FileLock(const std::string& path, const std::string& what) : path_(path) {
   // Lock, then check that the file we locked is still the one at `path` (not unlinked and
   // replaced meanwhile); retry otherwise.
   for (int attempt = 0; attempt < 100; ++attempt) {
-    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0666);
-    if (fd_ < 0) io_fail(path, "cannot open the lock file", errno);
-    if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-      int err = errno;
-      ::close(fd_);
-      fd_ = -1;
-      if (err == EWOULDBLOCK)
-        throw InputError(path,
-                         "is locked by another process: " + what +
-                             " is in use (another pvs bake or resume is running); wait for it to "
-                             "finish or stop it");
-      io_fail(path, "cannot lock", err);
-    }
+    fd_ = open_locked(path, 0666, "the lock file",
+                      "is locked by another process: " + what +
+                          " is in use (another pvs bake or resume is running); wait for it to "
+                          "finish or stop it");
     struct stat a, b;
     if (::fstat(fd_, &a) == 0 && ::stat(path.c_str(), &b) == 0 && a.st_ino == b.st_ino &&
         a.st_dev == b.st_dev)

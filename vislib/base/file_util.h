@@ -48,6 +48,18 @@ class AtomicFile {
 // Writes `bytes` to `path` through an AtomicFile (see above).
 void write_file_atomic(const std::string& path, const std::string& bytes);
 
+// Makes the directory entry of `path` durable (a power cut, not only a killed process): fsyncs
+// the folder holding it. Best effort: a folder that cannot be opened or synced is left as it is.
+void fsync_folder_of(const std::string& path);
+
+// Opens `path` for reading and writing (created with permission bits `mode` if missing, never
+// through a symbolic link, close-on-exec) and takes an exclusive advisory lock (flock) on it
+// without waiting. Returns the descriptor; closing it releases the lock. Throws
+// InputError(path, held_message) if another process holds the lock, std::runtime_error
+// ("cannot open <noun>", "cannot lock <noun>") on I/O failure.
+int open_locked(const std::string& path, unsigned mode, const std::string& noun,
+                const std::string& held_message);
+
 // An exclusive advisory lock (flock) on the file `path` (created if missing, never through a
 // symbolic link), held until the object is destroyed. Used by pvs bake on OUTPUT.lock so that two
 // bakes of one output cannot run at once. The lock file is removed when the lock is released

@@ -14,21 +14,10 @@
 namespace vislib {
 
 std::optional<std::array<double, 2>> project_to_pixel(const Camera& c, Vec3 point) {
-  const Vec3 f = c.forward * (1.0 / length(c.forward));
-  const Vec3 r0 = cross(f, c.up);
-  const Vec3 r = r0 * (1.0 / length(r0));
-  const Vec3 u = cross(r, f);
-  const Vec3 rel = point - c.eye;
-  const double z = dot(rel, f);
-  if (!(z > 0) || !std::isfinite(z)) return std::nullopt;
-  const double t = std::tan(c.vfov_degrees * M_PI / 360.0);
-  const double w = c.width, h = c.height;
-  const double sx = dot(rel, r) / z, sy = dot(rel, u) / z;
-  // camera_ray: sx = ((2x+1)/W - 1 + shift_x) t W/H, sy = (1 - (2y+1)/H + shift_y) t.
-  const double x = ((sx / (t * w / h) + 1.0 - c.shift_x) * w - 1.0) / 2.0;
-  const double y = ((1.0 + c.shift_y - sy / t) * h - 1.0) / 2.0;
-  if (!std::isfinite(x) || !std::isfinite(y)) return std::nullopt;
-  return std::array<double, 2>{x, y};
+  const std::optional<PixelPosition> p = camera_project(c, point);
+  if (!p || !std::isfinite(p->view_depth)) return std::nullopt;
+  if (!std::isfinite(p->x) || !std::isfinite(p->y)) return std::nullopt;
+  return std::array<double, 2>{p->x, p->y};
 }
 
 Discontinuity discontinuity(int width, int height, const std::vector<double>& truth_xy,

@@ -34,8 +34,9 @@ namespace vislib {
 constexpr double kDiscontinuityRadius = 17.0;
 
 // The position (column, row) of world point `point` in `camera`'s image, in pixels, continuous:
-// the exact inverse of camera_ray (render.h), so the centre of pixel (x, y) maps to (x, y) up to
-// rounding. nullopt when the point is not in front of the camera (view depth <= 0) or not finite.
+// camera_project's (render.h), the exact inverse of camera_ray, so the centre of pixel (x, y) maps
+// to (x, y) up to rounding. nullopt when the point is not in front of the camera (view depth <= 0)
+// or not finite.
 std::optional<std::array<double, 2>> project_to_pixel(const Camera& camera, Vec3 point);
 
 struct Discontinuity {

@@ -12,16 +12,35 @@ namespace vislib {
 
 namespace {
 
-struct CameraBasis {
-  Vec3 f, r, u;
-  double sx_scale, sy_scale;
-};
-
 Vec3 normalized(Vec3 v) {
   return v * (1.0 / length(v));
 }
 
-CameraBasis basis(const Camera& c) {
+uint64_t splitmix(uint64_t x) {
+  uint64_t z = x + 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+uint8_t to_byte(double v) {
+  double s = std::round(v * 255.0);
+  return uint8_t(s < 0 ? 0 : (s > 255 ? 255 : s));
+}
+
+// Image position of view-space coordinates (a, b) = (q.r / q.f, q.u / q.f).
+PixelPosition to_pixel(const CameraBasis& b, const Camera& c, double a, double bb,
+                       double view_depth) {
+  PixelPosition p;
+  p.x = (a / b.sx_scale - c.shift_x + 1.0) * double(c.width) * 0.5 - 0.5;
+  p.y = (1.0 + c.shift_y - bb / b.sy_scale) * double(c.height) * 0.5 - 0.5;
+  p.view_depth = view_depth;
+  return p;
+}
+
+}  // namespace
+
+CameraBasis camera_basis(const Camera& c) {
   assert(is_finite(c.forward) && length(c.forward) > 0);
   assert(c.vfov_degrees > 0 && c.vfov_degrees < 180);
   assert(c.width >= 1 && c.height >= 1 && c.z_near > 0);
@@ -37,29 +56,42 @@ CameraBasis basis(const Camera& c) {
   return b;
 }
 
-Vec3 ray(const CameraBasis& b, const Camera& c, int x, int y) {
+Vec3 camera_ray(const CameraBasis& b, const Camera& c, int x, int y) {
   const double sx = (double(2 * x + 1) / double(c.width) - 1.0 + c.shift_x) * b.sx_scale;
   const double sy = (1.0 - double(2 * y + 1) / double(c.height) + c.shift_y) * b.sy_scale;
   return b.f + b.r * sx + b.u * sy;
 }
 
-uint64_t splitmix(uint64_t x) {
-  uint64_t z = x + 0x9E3779B97F4A7C15ull;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-
-uint8_t to_byte(double v) {
-  double s = std::round(v * 255.0);
-  return uint8_t(s < 0 ? 0 : (s > 255 ? 255 : s));
-}
-
-}  // namespace
-
 Vec3 camera_ray(const Camera& camera, int x, int y) {
   assert(x >= 0 && x < camera.width && y >= 0 && y < camera.height);
-  return ray(basis(camera), camera, x, y);
+  return camera_ray(camera_basis(camera), camera, x, y);
+}
+
+std::optional<PixelPosition> camera_project(const CameraBasis& b, const Camera& c, Vec3 world) {
+  const Vec3 q = world - c.eye;
+  const double z = dot(q, b.f);
+  if (!(z > 0)) return std::nullopt;
+  return to_pixel(b, c, dot(q, b.r) / z, dot(q, b.u) / z, z);
+}
+
+std::optional<PixelPosition> camera_project_direction(const CameraBasis& b, const Camera& c,
+                                                      Vec3 dir) {
+  const double z = dot(dir, b.f);
+  if (!(z > 0)) return std::nullopt;
+  return to_pixel(b, c, dot(dir, b.r) / z, dot(dir, b.u) / z,
+                  std::numeric_limits<double>::infinity());
+}
+
+std::optional<PixelPosition> camera_project(const Camera& camera, Vec3 world) {
+  return camera_project(camera_basis(camera), camera, world);
+}
+
+std::optional<PixelPosition> camera_project_direction(const Camera& camera, Vec3 dir) {
+  return camera_project_direction(camera_basis(camera), camera, dir);
+}
+
+bool in_image(const Camera& c, const PixelPosition& p) {
+  return p.x >= -0.5 && p.x < double(c.width) - 0.5 && p.y >= -0.5 && p.y < double(c.height) - 0.5;
 }
 
 std::array<uint8_t, 3> object_colour(uint32_t object) {
@@ -110,7 +142,7 @@ std::array<uint8_t, 3> shade_triangle(const Scene& scene, uint32_t tri, Vec3 dir
 Frame render_frame(const Scene& scene, const EmbreeScene& rt, const Camera& camera,
                    const uint8_t* allowed) {
   assert(rt.triangle_count() == scene.triangle_count());
-  const CameraBasis b = basis(camera);
+  const CameraBasis b = camera_basis(camera);
   Frame frame;
   frame.width = camera.width;
   frame.height = camera.height;
@@ -123,7 +155,7 @@ Frame render_frame(const Scene& scene, const EmbreeScene& rt, const Camera& came
         std::vector<Vec3> dirs(w);
         std::vector<Hit> hits(w);
         for (int y = rows.begin(); y != rows.end(); ++y) {
-          for (int x = 0; x < camera.width; ++x) dirs[size_t(x)] = ray(b, camera, x, y);
+          for (int x = 0; x < camera.width; ++x) dirs[size_t(x)] = camera_ray(b, camera, x, y);
           rt.first_hits_among(camera.eye, dirs.data(), w, camera.z_near, allowed, hits.data());
           for (size_t x = 0; x < w; ++x) {
             const size_t p = size_t(y) * w + x;

@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "vislib/base/tolerances.h"
@@ -60,9 +61,40 @@ struct Frame {
   size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
 
+// The camera's frame of the convention above: the unit vectors f, r, u and the image-window
+// scales sx_scale = tan(vfov/2) * W/H, sy_scale = tan(vfov/2). Every pixel ray and projection of
+// vislib is computed from it, so a frame computed once serves a whole image.
+struct CameraBasis {
+  Vec3 f, r, u;
+  double sx_scale = 0, sy_scale = 0;
+};
+// `camera` must satisfy the Camera preconditions.
+CameraBasis camera_basis(const Camera& camera);
+
 // The un-normalised direction d of pixel (x, y) (see the convention above); world coordinates.
 // `camera` must satisfy the Camera preconditions; 0 <= x < width, 0 <= y < height.
 Vec3 camera_ray(const Camera& camera, int x, int y);
+// The same from basis = camera_basis(camera) (bit-identical); x and y may lie outside the image.
+Vec3 camera_ray(const CameraBasis& basis, const Camera& camera, int x, int y);
+
+// Where a world point appears in a camera: continuous pixel coordinates (pixel (x, y)'s centre is
+// at exactly (x, y); the image covers [-0.5, W-0.5) x [-0.5, H-0.5)) and its view depth (distance
+// along the unit forward axis). nullopt when the point is not in front of the camera
+// (view depth <= 0). The exact inverse of camera_ray, off-axis shift included.
+struct PixelPosition {
+  double x = 0, y = 0;
+  double view_depth = 0;
+};
+std::optional<PixelPosition> camera_project(const Camera& camera, Vec3 world);
+// The same for a point at infinity in direction `dir` (non-zero): view_depth is +inf.
+std::optional<PixelPosition> camera_project_direction(const Camera& camera, Vec3 dir);
+// The same two from basis = camera_basis(camera) (bit-identical).
+std::optional<PixelPosition> camera_project(const CameraBasis& basis, const Camera& camera,
+                                            Vec3 world);
+std::optional<PixelPosition> camera_project_direction(const CameraBasis& basis,
+                                                      const Camera& camera, Vec3 dir);
+// True when a PixelPosition lies in the image of `camera`.
+bool in_image(const Camera& camera, const PixelPosition& p);
 
 // The colour of object `object`: hue, saturation in [0.45, 0.8] and value in [0.65, 1] from a
 // SplitMix64 hash of the id. Same id, same colour on every platform.

@@ -38,22 +38,6 @@ const Vec3 kNanPoint{std::numeric_limits<double>::quiet_NaN(),
                      std::numeric_limits<double>::quiet_NaN(),
                      std::numeric_limits<double>::quiet_NaN()};
 
-uint8_t to_byte(double v) {
-  double s = std::round(v * 255.0);
-  return uint8_t(s < 0 ? 0 : (s > 255 ? 255 : s));
-}
-
-// render_frame's shading of triangle `tri` seen along `dir`.
-void shade(const Scene& scene, uint32_t tri, Vec3 dir, uint8_t* out) {
-  const auto c = scene.corners(tri, 0);
-  const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
-  const double nl = length(normal), len = length(dir);
-  const double lambert = nl > 0 ? std::fabs(dot(normal, dir)) / (nl * len) : 0.0;
-  const double s = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
-  const auto albedo = object_colour(scene.triangle_object[tri]);
-  for (int k = 0; k < 3; ++k) out[k] = to_byte(double(albedo[size_t(k)]) / 255.0 * s);
-}
-
 // Renders the triangles `ids` of `scene` with vertex v displaced to displace(v) (one new vertex
 // per triangle corner), from `camera`, through render_frame; tri ids mapped back to scene ids.
 // If `original` is given, it receives per pixel the hit carried back to the undisplaced triangle
@@ -196,7 +180,8 @@ EnvironmentMap render_environment_map(const Scene& scene, const EmbreeScene& rt,
             }
             env.tri[p] = h.tri;
             env.range[p] = float(h.lambda * length(dirs[size_t(x)]));
-            shade(scene, h.tri, dirs[size_t(x)], out);
+            const auto c = shade_triangle(scene, h.tri, dirs[size_t(x)]);
+            out[0] = c[0], out[1] = c[1], out[2] = c[2];
           }
         }
       });
@@ -393,19 +378,19 @@ ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const
   }
   ObjectCompletion c;
   size_t seen = 0;
-  double ofc_sum = 0;
+  double agreement_sum = 0;
   size_t capped = 0, truth_total = 0;
   for (size_t o = 0; o < n_obj; ++o) {
     if (truth_pixels[o] == 0) continue;
     ++c.objects;
     if (in_test[o]) ++seen;
-    ofc_sum += double(covered[o]) / double(truth_pixels[o]);
+    agreement_sum += double(covered[o]) / double(truth_pixels[o]);
     capped += std::min(test_pixels[o], truth_pixels[o]);
     truth_total += truth_pixels[o];
   }
   if (c.objects > 0) {
     c.ovc = double(seen) / double(c.objects);
-    c.ofc = ofc_sum / double(c.objects);
+    c.object_pixel_agreement = agreement_sum / double(c.objects);
     c.ofc_eq2 = double(capped) / double(truth_total);
   }
   return c;

@@ -164,8 +164,9 @@ std::vector<double> ring_visible_triangle_contribution(const Scene& scene,
 // CloVR's completion metrics of `test` against `truth` (same size; tri ids of the same scene):
 //  - OVC, object visualization completion: the share of objects with at least one pixel in
 //    `truth` that have at least one pixel anywhere in `test`;
-//  - OFC, object footprint completion: per object of `truth`, the share of its truth pixels at
-//    which `test` shows the same object; averaged uniformly over those objects.
+//  - object_pixel_agreement: per object of `truth`, the share of its truth pixels at which `test`
+//    shows the same object, averaged uniformly over those objects (not CloVR's OFC: per-pixel
+//    agreement, unweighted by footprint);
 //  - ofc_eq2, CloVR's own OFC (its Eq. 2): sum over the objects of truth of min(F*(o), F(o)) over
 //    the sum of F(o), F(o) / F*(o) the object's pixel counts in truth / test, wherever they are
 //    (footprints, not per-pixel agreement; capped so that an object grown by a missing occluder
@@ -173,7 +174,7 @@ std::vector<double> ring_visible_triangle_contribution(const Scene& scene,
 // All are 1 when `truth` shows no object.
 struct ObjectCompletion {
   size_t objects = 0;  // objects with a pixel in truth
-  double ovc = 1, ofc = 1, ofc_eq2 = 1;
+  double ovc = 1, object_pixel_agreement = 1, ofc_eq2 = 1;
 };
 ObjectCompletion object_completion(const Scene& scene, const Frame& truth, const Frame& test);
 

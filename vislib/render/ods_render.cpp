@@ -33,17 +33,6 @@ uint8_t to_byte(double v) {
   return uint8_t(s < 0 ? 0 : (s > 255 ? 255 : s));
 }
 
-// render_frame's shading of triangle `tri` seen along `dir`.
-void shade(const Scene& scene, uint32_t tri, Vec3 dir, uint8_t* out) {
-  const auto c = scene.corners(tri, 0);
-  const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
-  const double nl = length(normal), dl = length(dir);
-  const double lambert = nl > 0 ? std::fabs(dot(normal, dir)) / (nl * dl) : 0.0;
-  const double s = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
-  const auto albedo = object_colour(scene.triangle_object[tri]);
-  for (int k = 0; k < 3; ++k) out[k] = to_byte(double(albedo[size_t(k)]) / 255.0 * s);
-}
-
 Frame empty_frame(int w, int h) {
   Frame f;
   f.width = w;
@@ -68,7 +57,8 @@ void shade_frame(const Scene& scene, Frame& f) {
           continue;
         }
         const LonLat ll = pvs_runtime::pixel_to_lonlat(x + 0.5, y + 0.5, f.width, f.height);
-        shade(scene, f.tri[p], to_vec(pvs_runtime::lonlat_direction(ll)), out);
+        const auto c = shade_triangle(scene, f.tri[p], to_vec(pvs_runtime::lonlat_direction(ll)));
+        out[0] = c[0], out[1] = c[1], out[2] = c[2];
       }
   });
 }

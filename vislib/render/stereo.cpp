@@ -11,65 +11,13 @@
 #include <cmath>
 #include <limits>
 
+#include "vislib/base/ray_triangle.h"
+
 namespace vislib {
 
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// The camera basis exactly as render.cpp computes it (same operations, so the same doubles: the
-// test StereoProject.RayOfEveryPixelEqualsCameraRay checks it bit for bit).
-struct Basis {
-  Vec3 f, r, u;
-  double sx_scale = 0, sy_scale = 0;
-};
-
-Vec3 normalized(Vec3 v) {
-  return v * (1.0 / length(v));
-}
-
-Basis basis(const Camera& c) {
-  Basis b;
-  b.f = normalized(c.forward);
-  b.r = normalized(cross(b.f, c.up));
-  b.u = cross(b.r, b.f);
-  const double t = std::tan(c.vfov_degrees * (M_PI / 360.0));
-  b.sy_scale = t;
-  b.sx_scale = t * double(c.width) / double(c.height);
-  return b;
-}
-
-Vec3 pixel_ray(const Basis& b, const Camera& c, int x, int y) {
-  const double sx = (double(2 * x + 1) / double(c.width) - 1.0 + c.shift_x) * b.sx_scale;
-  const double sy = (1.0 - double(2 * y + 1) / double(c.height) + c.shift_y) * b.sy_scale;
-  return b.f + b.r * sx + b.u * sy;
-}
-
-// Image position of view-space coordinates (a, b) = (q.r / q.f, q.u / q.f).
-PixelPosition to_pixel(const Basis& b, const Camera& c, double a, double bb, double view_depth) {
-  PixelPosition p;
-  p.x = (a / b.sx_scale - c.shift_x + 1.0) * double(c.width) * 0.5 - 0.5;
-  p.y = (1.0 + c.shift_y - bb / b.sy_scale) * double(c.height) * 0.5 - 0.5;
-  p.view_depth = view_depth;
-  return p;
-}
-
-std::optional<PixelPosition> project(const Basis& b, const Camera& c, Vec3 world) {
-  const Vec3 q = world - c.eye;
-  const double z = dot(q, b.f);
-  if (!(z > 0)) return std::nullopt;
-  return to_pixel(b, c, dot(q, b.r) / z, dot(q, b.u) / z, z);
-}
-
-std::optional<PixelPosition> project_dir(const Basis& b, const Camera& c, Vec3 dir) {
-  const double z = dot(dir, b.f);
-  if (!(z > 0)) return std::nullopt;
-  return to_pixel(b, c, dot(dir, b.r) / z, dot(dir, b.u) / z, kInf);
-}
-
-bool inside(const Camera& c, double x, double y) {
-  return x >= -0.5 && x < double(c.width) - 0.5 && y >= -0.5 && y < double(c.height) - 0.5;
-}
 
 // Rec. 601 luminance of an 8-bit RGB pixel.
 double luminance(const uint8_t* c) {
@@ -88,22 +36,22 @@ struct Landing {
   float range = std::numeric_limits<float>::infinity();  // |P - target eye|
 };
 
-Landing land(const Frame& src, const Camera& sc, const Basis& sb, const Camera& tc, const Basis& tb,
-             int x, int y) {
+Landing land(const Frame& src, const Camera& sc, const CameraBasis& sb, const Camera& tc,
+             const CameraBasis& tb, int x, int y) {
   Landing l;
   const size_t i = size_t(y) * size_t(src.width) + size_t(x);
-  const Vec3 d = pixel_ray(sb, sc, x, y);
+  const Vec3 d = camera_ray(sb, sc, x, y);
   std::optional<PixelPosition> p;
   Vec3 world;
   const bool background = src.tri[i] == kNoHit || !std::isfinite(src.depth[i]);
   if (background) {
-    p = project_dir(tb, tc, d);
+    p = camera_project_direction(tb, tc, d);
   } else {
     world = sc.eye + d * (double(src.depth[i]) / length(d));
-    p = project(tb, tc, world);
+    p = camera_project(tb, tc, world);
     if (p && !(p->view_depth > tc.z_near)) p.reset();
   }
-  if (!p || !inside(tc, p->x, p->y)) return l;
+  if (!p || !in_image(tc, *p)) return l;
   const int tx = int(std::floor(p->x + 0.5)), ty = int(std::floor(p->y + 0.5));
   if (tx < 0 || tx >= tc.width || ty < 0 || ty >= tc.height) return l;
   l.target = uint32_t(size_t(ty) * size_t(tc.width) + size_t(tx));
@@ -140,7 +88,7 @@ void write_sample(Reprojection& r, const Frame& src, size_t p, uint32_t s, float
 void classify_holes(Reprojection& r, const std::vector<float>& vdepth, const Frame& src,
                     const Camera& sc, const Camera& tc) {
   const int w = r.width, h = r.height;
-  const Basis sb = basis(sc), tb = basis(tc);
+  const CameraBasis sb = camera_basis(sc), tb = camera_basis(tc);
   auto filled = [&](int x, int y) {
     return r.source[size_t(y) * size_t(w) + size_t(x)] != kNoSource;
   };
@@ -155,15 +103,15 @@ void classify_holes(Reprojection& r, const std::vector<float>& vdepth, const Fra
   // Outside the source view when the target pixel's ray at `range` from the target eye (inf: its
   // direction) does not project into the source image.
   auto outside = [&](int x, int y, double range) {
-    const Vec3 d = pixel_ray(tb, tc, x, y);
+    const Vec3 d = camera_ray(tb, tc, x, y);
     std::optional<PixelPosition> p;
     if (std::isinf(range)) {
-      p = project_dir(sb, sc, d);
+      p = camera_project_direction(sb, sc, d);
     } else {
-      p = project(sb, sc, tc.eye + d * (range / length(d)));
+      p = camera_project(sb, sc, tc.eye + d * (range / length(d)));
       if (p && !(p->view_depth > sc.z_near)) p.reset();
     }
-    return !p || !inside(sc, p->x, p->y);
+    return !p || !in_image(sc, *p);
   };
   std::vector<HoleKind>& kind = r.hole;  // classification reads r.source and r.depth only
   tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
@@ -217,7 +165,7 @@ void classify_holes(Reprojection& r, const std::vector<float>& vdepth, const Fra
 }
 
 Reprojection reproject_exact(const Frame& src, const Camera& sc, const Camera& tc) {
-  const Basis sb = basis(sc), tb = basis(tc);
+  const CameraBasis sb = camera_basis(sc), tb = camera_basis(tc);
   const size_t n = src.pixel_count();
   // Where each source sample lands (slot i): target pixel and target view depth (float: only
   // compared, ties go to the smaller source index).
@@ -278,7 +226,7 @@ bool same_vec(Vec3 a, Vec3 b, double tol) {
 // Alg. 2 as printed (one row per task), on the exact landing positions (for parallel eyes with
 // identical projections, Alg. 1 without a perspective divide gives the same columns).
 Reprojection reproject_alg2(const Frame& src, const Camera& sc, const Camera& tc) {
-  const Basis sb = basis(sc), tb = basis(tc);
+  const CameraBasis sb = camera_basis(sc), tb = camera_basis(tc);
   const Vec3 offset = tc.eye - sc.eye;
   const double tol = 1e-12;
   if (!(same_vec(sb.f, tb.f, tol) && same_vec(sb.u, tb.u, tol) &&
@@ -388,44 +336,15 @@ size_t median_fill(Frame& f, std::vector<uint8_t> open) {
   return patched;
 }
 
-bool intersect(const Scene& scene, uint32_t tri, Vec3 o, Vec3 d, double* t_out) {
-  const auto c = scene.corners(tri, 0);
-  const Vec3 e1 = c[1] - c[0], e2 = c[2] - c[0];
-  const Vec3 pv = cross(d, e2);
-  const double det = dot(e1, pv);
-  if (det == 0 || !std::isfinite(det)) return false;
-  const double inv = 1.0 / det;
-  const Vec3 tv = o - c[0];
-  const double u = dot(tv, pv) * inv;
-  if (u < 0 || u > 1) return false;
-  const Vec3 qv = cross(tv, e1);
-  const double v = dot(d, qv) * inv;
-  if (v < 0 || u + v > 1) return false;
-  *t_out = dot(e2, qv) * inv;
-  return true;
-}
-
 }  // namespace
 
 size_t Reprojection::count(HoleKind kind) const {
   return size_t(std::count(hole.begin(), hole.end(), kind));
 }
 
-std::optional<PixelPosition> camera_project(const Camera& camera, Vec3 world) {
-  return project(basis(camera), camera, world);
-}
-
-std::optional<PixelPosition> camera_project_direction(const Camera& camera, Vec3 dir) {
-  return project_dir(basis(camera), camera, dir);
-}
-
-bool in_image(const Camera& camera, const PixelPosition& p) {
-  return inside(camera, p.x, p.y);
-}
-
 StereoPair stereo_pair(const Camera& centre, double ipd, double toe_in_degrees, double shift) {
   assert(ipd >= 0);
-  const Basis b = basis(centre);
+  const CameraBasis b = camera_basis(centre);
   StereoPair s{centre, centre};
   s.left.eye = centre.eye - b.r * (ipd / 2);
   s.right.eye = centre.eye + b.r * (ipd / 2);
@@ -563,7 +482,7 @@ Frame patch_yoro(const Reprojection& r, bool as_printed, size_t* patched) {
 Frame patch_rays(const Reprojection& r, const Scene& scene, const EmbreeScene& rt,
                  const Camera& target, const uint8_t* allowed, size_t* rays) {
   assert(r.width == target.width && r.height == target.height);
-  const Basis b = basis(target);
+  const CameraBasis b = camera_basis(target);
   Frame f = frame_of(r);
   const int w = r.width;
   std::vector<size_t> row_rays(size_t(r.height), 0);
@@ -576,7 +495,7 @@ Frame patch_rays(const Reprojection& r, const Scene& scene, const EmbreeScene& r
       xs.clear();
       for (int x = 0; x < w; ++x)
         if (r.hole[size_t(y) * size_t(w) + size_t(x)] != HoleKind::Filled) {
-          dirs.push_back(pixel_ray(b, target, x, y));
+          dirs.push_back(camera_ray(b, target, x, y));
           xs.push_back(x);
         }
       if (dirs.empty()) continue;
@@ -610,7 +529,7 @@ Frame patch_rays(const Reprojection& r, const Scene& scene, const EmbreeScene& r
 
 ReshadeStats reshade(Reprojection& r, const Scene& scene, const Camera& target) {
   assert(r.width == target.width && r.height == target.height);
-  const Basis b = basis(target);
+  const CameraBasis b = camera_basis(target);
   const int w = r.width, h = r.height;
   const Reprojection in = r;  // candidates come from the unmodified reprojection
   std::vector<size_t> row_resolved(size_t(h), 0), row_unresolved(size_t(h), 0);
@@ -629,15 +548,15 @@ ReshadeStats reshade(Reprojection& r, const Scene& scene, const Camera& target) 
               cand.push_back({in.tri[q], q});
           }
         std::sort(cand.begin(), cand.end());
-        const Vec3 d = pixel_ray(b, target, x, y);
+        const Vec3 d = camera_ray(b, target, x, y);
         double best = kInf;
         size_t best_q = 0;
         uint32_t best_tri = kNoHit;
         for (size_t i = 0; i < cand.size(); ++i) {
           if (i > 0 && cand[i].first == cand[i - 1].first) continue;
-          double t = 0;
-          if (intersect(scene, cand[i].first, target.eye, d, &t) && t > target.z_near && t < best) {
-            best = t;
+          const auto t = ray_triangle(target.eye, d, scene.corners(cand[i].first, 0));
+          if (t && *t > target.z_near && *t < best) {
+            best = *t;
             best_tri = cand[i].first;
             best_q = cand[i].second;
           }

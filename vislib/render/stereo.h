@@ -56,20 +56,6 @@ constexpr std::array<uint8_t, 3> kStereoHoleColour = {0, 0, 0};
 enum class HoleKind : uint8_t { Filled = 0, Disocclusion = 1, Crack = 2, OutsideView = 3 };
 enum class Splatting : uint8_t { Exact = 0, Alg2AsPrinted = 1 };
 
-// Where a world point appears in a camera: continuous pixel coordinates (pixel (x, y)'s centre is
-// at exactly (x, y); the image covers [-0.5, W-0.5) x [-0.5, H-0.5)) and its view depth (distance
-// along the unit forward axis). nullopt when the point is not in front of the camera
-// (view depth <= 0). The exact inverse of camera_ray (render.h), off-axis shift included.
-struct PixelPosition {
-  double x = 0, y = 0;
-  double view_depth = 0;
-};
-std::optional<PixelPosition> camera_project(const Camera& camera, Vec3 world);
-// The same for a point at infinity in direction `dir` (non-zero): view_depth is +inf.
-std::optional<PixelPosition> camera_project_direction(const Camera& camera, Vec3 dir);
-// True when a PixelPosition lies in the image of `camera`.
-bool in_image(const Camera& camera, const PixelPosition& p);
-
 // The eye cameras of a head at `centre` (its eye is the point between the eyes): both copy
 // `centre` and are moved by -/+ ipd/2 along the camera's right vector r = normalize(forward x up).
 // `toe_in_degrees` > 0 cants each eye inward by that angle about the up vector (converging);

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "vislib/bake/free_space.h"
 #include "vislib/bake/view_cells.h"
 
 namespace vislib {

@@ -146,10 +146,7 @@ Scene load_off(const std::string& path, std::vector<std::string>& warnings) {
       mesh_reader::add_fan(scene, face);
   }
   // Edges (ne) are not listed in OFF files in practice; anything after the faces is ignored.
-  if (short_faces)
-    warnings.push_back(path + ": " + std::to_string(short_faces) +
-                       " face(s) with fewer than 3 vertices skipped");
-  if (scene.triangles.empty()) warnings.push_back(path + ": no faces");
+  mesh_reader::warn_faces(path, short_faces, scene, warnings);
   return scene;
 }
 

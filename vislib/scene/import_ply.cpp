@@ -232,10 +232,14 @@ class Body {
   size_t line_;
 };
 
-}  // namespace
+// The header of a PLY file: its format, its elements, where the body starts (byte and line).
+struct Header {
+  Format format = Format::Ascii;
+  std::vector<Element> elements;
+  size_t body_at = 0, lines = 0;
+};
 
-Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
-  const std::string bytes = read_file(path);
+Header read_header(const std::string& path, const std::string& bytes) {
   // --- Header: lines up to "end_header". ---
   size_t at = 0, line_no = 0;
   auto next_line = [&](std::string& line) {
@@ -254,8 +258,9 @@ Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
   if (!next_line(line) || split(line) != std::vector<std::string>{"ply"})
     throw InputError(path, "not a PLY file (the first line must be 'ply')");
   bool have_format = false, ended = false;
-  Format format = Format::Ascii;
-  std::vector<Element> elements;
+  Header h;
+  Format& format = h.format;
+  std::vector<Element>& elements = h.elements;
   while (next_line(line)) {
     std::vector<std::string> tok = split(line);
     if (tok.empty()) continue;
@@ -309,14 +314,30 @@ Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
   }
   if (!have_format) throw InputError(path, "no 'format' line in the header");
   if (!ended) throw InputError(path, "the header has no 'end_header' line");
+  h.body_at = at;
+  h.lines = line_no;
+  return h;
+}
 
-  // --- Which element is what, and whether the declared counts can fit in the file. ---
+// Which element holds the vertices (with the property index of x, y, z) and which the faces
+// (with the index of its vertex list); none when absent.
+struct Roles {
   const Element* vertex_el = nullptr;
   const Element* face_el = nullptr;
   int xyz[3] = {-1, -1, -1};
   int face_list = -1;
+};
+
+Roles element_roles(const std::string& path, const Header& h, uint64_t body_bytes) {
+  const Format format = h.format;
+  const std::vector<Element>& elements = h.elements;
+  Roles r;
+  const Element*& vertex_el = r.vertex_el;
+  const Element*& face_el = r.face_el;
+  int(&xyz)[3] = r.xyz;
+  int& face_list = r.face_list;
+  // --- Which element is what, and whether the declared counts can fit in the file. ---
   uint64_t min_total = 0;
-  const uint64_t body_bytes = bytes.size() - at;
   for (const Element& e : elements) {
     for (size_t i = 0; i < e.props.size(); ++i)
       for (size_t j = 0; j < i; ++j)
@@ -371,6 +392,22 @@ Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
         throw InputError(path, "the face element has no list property 'vertex_indices'");
     }
   }
+  return r;
+}
+
+}  // namespace
+
+Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
+  const std::string bytes = read_file(path);
+  const Header header = read_header(path, bytes);
+  const Format format = header.format;
+  const std::vector<Element>& elements = header.elements;
+  const size_t at = header.body_at, line_no = header.lines;
+  const Roles roles = element_roles(path, header, bytes.size() - at);
+  const Element* vertex_el = roles.vertex_el;
+  const Element* face_el = roles.face_el;
+  const int* xyz = roles.xyz;
+  const int face_list = roles.face_list;
   uint64_t nv = vertex_el ? vertex_el->count : 0;
   if (nv >= UINT32_MAX) throw InputError(path, "more than 2^32-2 vertices");
 
@@ -432,10 +469,7 @@ Scene load_ply(const std::string& path, std::vector<std::string>& warnings) {
     }
   }
   body.expect_end();
-  if (short_faces)
-    warnings.push_back(path + ": " + std::to_string(short_faces) +
-                       " face(s) with fewer than 3 vertices skipped");
-  if (scene.triangles.empty()) warnings.push_back(path + ": no faces");
+  mesh_reader::warn_faces(path, short_faces, scene, warnings);
   return scene;
 }
 

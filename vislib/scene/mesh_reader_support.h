@@ -44,5 +44,15 @@ inline void add_fan(Scene& scene, const std::vector<uint32_t>& face) {
   }
 }
 
+// The warnings of a PLY or OFF reader at the end: `short_faces` faces of fewer than 3 vertices
+// skipped, and a scene without a face.
+inline void warn_faces(const std::string& path, size_t short_faces, const Scene& scene,
+                       std::vector<std::string>& warnings) {
+  if (short_faces)
+    warnings.push_back(path + ": " + std::to_string(short_faces) +
+                       " face(s) with fewer than 3 vertices skipped");
+  if (scene.triangles.empty()) warnings.push_back(path + ": no faces");
+}
+
 }  // namespace mesh_reader
 }  // namespace vislib

@@ -82,17 +82,12 @@ bool finite3(const Vec3& v) {
   return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
 
-}  // namespace
-
-std::string scene_to_glb(const Scene& scene, const SceneAppearance* appearance) {
-  const size_t K = scene.positions.size() ? scene.positions.size() : 1;
+// The meshes of the objects of `scene` (see scene_to_glb).
+std::vector<ObjectMesh> object_meshes(const Scene& scene, const SceneAppearance* app, size_t K) {
   const size_t nobj = scene.objects.size();
-  assert(scene.triangle_object.size() == scene.triangles.size());
-  const SceneAppearance* app = appearance;
   const bool has_normals = app && app->normals.size() == scene.vertex_count();
   const bool has_uvs = app && app->uvs.size() == scene.vertex_count();
   const bool has_materials = app && app->triangle_material.size() == scene.triangle_count();
-
   // Bucket triangles by object (stable: id order within an object), split into runs of one
   // material, re-index each run over the vertices it uses (numbered by first use).
   std::vector<std::vector<uint32_t>> by_object(nobj);
@@ -137,14 +132,13 @@ std::string scene_to_glb(const Scene& scene, const SceneAppearance* appearance) 
       }
     }
   }
+  return meshes;
+}
 
-  std::vector<unsigned char> bin;
-  Writer w(bin);
+// Writes the materials of `app` that `meshes` use; returns the glTF index of each (-1: unused).
+std::vector<int> write_materials(Writer& w, const std::vector<ObjectMesh>& meshes,
+                                 const SceneAppearance* app) {
   tinygltf::Model& model = w.model;
-  model.asset.version = "2.0";
-  model.asset.generator = "vislib scene_to_glb";
-  if (app) model.asset.copyright = app->copyright;
-
   // Materials and their images (embedded), only those some kept triangle uses, in index order.
   std::vector<int> material_id(app ? app->materials.size() : 0, -1);
   for (const auto& m : meshes)
@@ -193,95 +187,77 @@ std::string scene_to_glb(const Scene& scene, const SceneAppearance* appearance) 
     material_id[i] = int(model.materials.size());
     model.materials.push_back(mat);
   }
+  return material_id;
+}
 
-  bool animated = false;
-  for (const auto& m : meshes) animated = animated || m.dynamic;
+// The key times and morph weights of the "states" animation (key state k at time k, its morph
+// target k - 1 at weight 1): their accessors.
+struct StateKeys {
   int time_accessor = -1, weight_accessor = -1;
-  tinygltf::Animation anim;
-  anim.name = "states";
-  if (animated) {
-    std::vector<float> times(K), weights(K * (K - 1), 0.0f);
-    for (size_t k = 0; k < K; ++k) {
-      times[k] = float(k);
-      if (k > 0) weights[k * (K - 1) + (k - 1)] = 1.0f;
-    }
-    time_accessor = w.add_accessor(w.add_view(times.data(), 4 * K, 0),
-                                   TINYGLTF_COMPONENT_TYPE_FLOAT, K, TINYGLTF_TYPE_SCALAR);
-    model.accessors[time_accessor].minValues = {0.0};
-    model.accessors[time_accessor].maxValues = {double(K - 1)};
-    weight_accessor =
-        w.add_accessor(w.add_view(weights.data(), 4 * weights.size(), 0),
-                       TINYGLTF_COMPONENT_TYPE_FLOAT, weights.size(), TINYGLTF_TYPE_SCALAR);
+};
+StateKeys write_state_keys(Writer& w, size_t K) {
+  tinygltf::Model& model = w.model;
+  StateKeys keys;
+  int& time_accessor = keys.time_accessor;
+  int& weight_accessor = keys.weight_accessor;
+  std::vector<float> times(K), weights(K * (K - 1), 0.0f);
+  for (size_t k = 0; k < K; ++k) {
+    times[k] = float(k);
+    if (k > 0) weights[k * (K - 1) + (k - 1)] = 1.0f;
   }
+  time_accessor = w.add_accessor(w.add_view(times.data(), 4 * K, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                 K, TINYGLTF_TYPE_SCALAR);
+  model.accessors[time_accessor].minValues = {0.0};
+  model.accessors[time_accessor].maxValues = {double(K - 1)};
+  weight_accessor =
+      w.add_accessor(w.add_view(weights.data(), 4 * weights.size(), 0),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, weights.size(), TINYGLTF_TYPE_SCALAR);
+  return keys;
+}
 
-  tinygltf::Scene root;
-  for (size_t o = 0; o < nobj; ++o) {
-    const ObjectMesh& m = meshes[o];
-    tinygltf::Node node;
-    node.name = scene.objects[o].name;
-    if (!m.prims.empty()) {
-      tinygltf::Mesh mesh;
-      mesh.name = scene.objects[o].name;
-      for (const Primitive& p : m.prims) {
-        tinygltf::Primitive prim;
-        prim.mode = TINYGLTF_MODE_TRIANGLES;
-        prim.indices = w.add_accessor(
-            w.add_view(p.indices.data(), 4 * p.indices.size(), kElementArrayBuffer),
-            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, p.indices.size(), TINYGLTF_TYPE_SCALAR);
-        std::vector<float> f;
-        f.reserve(3 * p.vertices.size());
-        for (size_t k = 0; k < (m.dynamic ? K : 1); ++k) {
-          f.clear();
-          for (uint32_t v : p.vertices) {
-            Vec3 q = k == 0 ? scene.positions[0][v] : scene.positions[k][v] - scene.positions[0][v];
-            f.insert(f.end(), {float(q.x), float(q.y), float(q.z)});
-          }
-          int a = w.add_floats(f, 3, true);
-          if (k == 0)
-            prim.attributes["POSITION"] = a;
-          else
-            prim.targets.push_back({{"POSITION", a}});
-        }
-        if (p.normals) {
-          f.clear();
-          for (uint32_t v : p.vertices) {
-            // Unit length in float too (the validator checks |n| = 1 within 5e-4).
-            const Vec3& n = app->normals[v];
-            f.insert(f.end(), {float(n.x), float(n.y), float(n.z)});
-          }
-          prim.attributes["NORMAL"] = w.add_floats(f, 3, false);
-        }
-        if (p.uvs) {
-          f.clear();
-          for (uint32_t v : p.vertices)
-            f.insert(f.end(), {float(app->uvs[v][0]), float(app->uvs[v][1])});
-          prim.attributes["TEXCOORD_0"] = w.add_floats(f, 2, false);
-        }
-        if (p.material >= 0) prim.material = material_id[size_t(p.material)];
-        mesh.primitives.push_back(prim);
-      }
-      if (m.dynamic) {
-        mesh.weights.assign(K - 1, 0.0);
-        tinygltf::AnimationSampler s;
-        s.input = time_accessor;
-        s.output = weight_accessor;
-        s.interpolation = "LINEAR";
-        anim.samplers.push_back(s);
-        tinygltf::AnimationChannel c;
-        c.sampler = int(anim.samplers.size() - 1);
-        c.target_node = int(o);
-        c.target_path = "weights";
-        anim.channels.push_back(c);
-      }
-      node.mesh = int(model.meshes.size());
-      model.meshes.push_back(mesh);
+// The primitive `p` of an object (morph targets when `dynamic`).
+tinygltf::Primitive write_primitive(Writer& w, const Scene& scene, const SceneAppearance* app,
+                                    const Primitive& p, bool dynamic, size_t K,
+                                    const std::vector<int>& material_id) {
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  prim.indices =
+      w.add_accessor(w.add_view(p.indices.data(), 4 * p.indices.size(), kElementArrayBuffer),
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, p.indices.size(), TINYGLTF_TYPE_SCALAR);
+  std::vector<float> f;
+  f.reserve(3 * p.vertices.size());
+  for (size_t k = 0; k < (dynamic ? K : 1); ++k) {
+    f.clear();
+    for (uint32_t v : p.vertices) {
+      Vec3 q = k == 0 ? scene.positions[0][v] : scene.positions[k][v] - scene.positions[0][v];
+      f.insert(f.end(), {float(q.x), float(q.y), float(q.z)});
     }
-    model.nodes.push_back(node);
-    root.nodes.push_back(int(o));
+    int a = w.add_floats(f, 3, true);
+    if (k == 0)
+      prim.attributes["POSITION"] = a;
+    else
+      prim.targets.push_back({{"POSITION", a}});
   }
-  model.scenes.push_back(root);
-  model.defaultScene = 0;
-  if (animated) model.animations.push_back(anim);
+  if (p.normals) {
+    f.clear();
+    for (uint32_t v : p.vertices) {
+      // Unit length in float too (the validator checks |n| = 1 within 5e-4).
+      const Vec3& n = app->normals[v];
+      f.insert(f.end(), {float(n.x), float(n.y), float(n.z)});
+    }
+    prim.attributes["NORMAL"] = w.add_floats(f, 3, false);
+  }
+  if (p.uvs) {
+    f.clear();
+    for (uint32_t v : p.vertices) f.insert(f.end(), {float(app->uvs[v][0]), float(app->uvs[v][1])});
+    prim.attributes["TEXCOORD_0"] = w.add_floats(f, 2, false);
+  }
+  if (p.material >= 0) prim.material = material_id[size_t(p.material)];
+  return prim;
+}
+
+// The GLB bytes of `model` with the binary chunk `bin`.
+std::string glb_bytes(tinygltf::Model& model, std::vector<unsigned char>& bin) {
   while (bin.size() % 4) bin.push_back(0);
   if (!bin.empty()) {
     tinygltf::Buffer b;
@@ -302,4 +278,66 @@ std::string scene_to_glb(const Scene& scene, const SceneAppearance* appearance) 
   return out.str();
 }
 
+}  // namespace
+
+std::string scene_to_glb(const Scene& scene, const SceneAppearance* appearance) {
+  const size_t K = scene.positions.size() ? scene.positions.size() : 1;
+  const size_t nobj = scene.objects.size();
+  assert(scene.triangle_object.size() == scene.triangles.size());
+  const SceneAppearance* app = appearance;
+
+  const std::vector<ObjectMesh> meshes = object_meshes(scene, app, K);
+
+  std::vector<unsigned char> bin;
+  Writer w(bin);
+  tinygltf::Model& model = w.model;
+  model.asset.version = "2.0";
+  model.asset.generator = "vislib scene_to_glb";
+  if (app) model.asset.copyright = app->copyright;
+
+  // Materials and their images (embedded), only those some kept triangle uses, in index order.
+  const std::vector<int> material_id = write_materials(w, meshes, app);
+
+  bool animated = false;
+  for (const auto& m : meshes) animated = animated || m.dynamic;
+  tinygltf::Animation anim;
+  anim.name = "states";
+  StateKeys keys;
+  if (animated) keys = write_state_keys(w, K);
+  tinygltf::Scene root;
+  for (size_t o = 0; o < nobj; ++o) {
+    const ObjectMesh& m = meshes[o];
+    tinygltf::Node node;
+    node.name = scene.objects[o].name;
+    if (!m.prims.empty()) {
+      tinygltf::Mesh mesh;
+      mesh.name = scene.objects[o].name;
+      for (const Primitive& p : m.prims) {
+        tinygltf::Primitive prim = write_primitive(w, scene, app, p, m.dynamic, K, material_id);
+        mesh.primitives.push_back(prim);
+      }
+      if (m.dynamic) {
+        mesh.weights.assign(K - 1, 0.0);
+        tinygltf::AnimationSampler s;
+        s.input = keys.time_accessor;
+        s.output = keys.weight_accessor;
+        s.interpolation = "LINEAR";
+        anim.samplers.push_back(s);
+        tinygltf::AnimationChannel c;
+        c.sampler = int(anim.samplers.size() - 1);
+        c.target_node = int(o);
+        c.target_path = "weights";
+        anim.channels.push_back(c);
+      }
+      node.mesh = int(model.meshes.size());
+      model.meshes.push_back(mesh);
+    }
+    model.nodes.push_back(node);
+    root.nodes.push_back(int(o));
+  }
+  model.scenes.push_back(root);
+  model.defaultScene = 0;
+  if (animated) model.animations.push_back(anim);
+  return glb_bytes(model, bin);
+}
 }  // namespace vislib

@@ -1,0 +1,49 @@
+// cell_visibility.h: a view cell's visible set.
+//
+// A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeter of
+// the view region's bottom and top rectangles (the paper's perimeter heuristic, §4.1, applied at
+// the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "pvs_format/pvs_format.h"
+#include "vislib/base/vec.h"
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+// The segments a cell's visibility is computed on: the four sides of the view region's bottom
+// rectangle (y = min.y) then those of its top rectangle (y = max.y), each in the order of
+// perimeter_segments; only the four of the bottom when the region is flat in y.
+std::vector<Segment> cell_boundary_segments(const Box3& view_region);
+
+// Seed of cell `cell`'s runs for a bake seeded `seed`; the bottom rectangle's runs use
+// Rng::derive(cell_seed, 0), the top's Rng::derive(cell_seed, 1).
+uint64_t cell_seed(uint64_t seed, uint32_t cell);
+
+struct CellVisibility {
+  std::vector<uint32_t> triangles;  // visible triangle ids, sorted
+  std::vector<uint32_t> spheres;    // visible sphere indices, sorted
+  std::vector<Segment> segments;    // cell_boundary_segments(view region)
+  double seconds = 0;               // kernel seconds
+};
+
+// The rectangles whose perimeters cell_visibility runs: the bottom and top of the cell's view
+// region (one when the region is flat in y).
+std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell);
+
+// Visible triangles of cell `cell` of `layout`: region_visibility (options.runs orientations,
+// options.segment settings) on the bottom and the top rectangle of the view region, united.
+// Depends only on the scene, the view region, `options` and `cell` (not on the thread count).
+// Thread-safe; parallel inside (TBB). `progress(fraction)`, if given, is called after each
+// from-segment run with the fraction in (0, 1] of the cell's runs done (from the calling thread
+// or a worker; never two calls at once).
+CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress = {});
+
+}  // namespace vislib
