@@ -125,8 +125,10 @@ void add_to(std::atomic<double>* sum, double seconds) {
 }
 
 // Cells baked inside another cell on the same thread (a thread waiting in its cell ran another's
-// pipeline task): only the outermost is timed.
+// pipeline task): the outermost's wall time counts once, and a cell's own CPU seconds leave out
+// those of the cells run inside it (their sum, per thread, while a cell runs).
 thread_local int g_cell_depth = 0;
+thread_local double g_nested_cpu = 0;
 
 }  // namespace
 
@@ -166,6 +168,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   const uint32_t n = info.layout.cell_count();
   report.cells = n;
   report.cell_seconds.assign(n, 0.0);
+  report.cell_cpu_seconds.assign(n, 0.0);
 
   // Cells recovered from the checkpoint (resume); each is released once written.
   std::vector<std::optional<std::vector<uint32_t>>> recovered;
@@ -283,6 +286,8 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                       add_to(&t_progress, wall_now() - w0);
                     };
                   const bool outer = g_cell_depth++ == 0;
+                  const double nested_before = g_nested_cpu;
+                  g_nested_cpu = 0;
                   const double w0 = wall_now(), c0 = thread_cpu_now();
                   std::vector<uint32_t> ids;
                   try {
@@ -292,12 +297,16 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                         });
                   } catch (...) {
                     --g_cell_depth;
+                    g_nested_cpu = nested_before;
                     throw;
                   }
                   --g_cell_depth;
+                  const double cpu = thread_cpu_now() - c0;
+                  report.cell_cpu_seconds[c] = cpu - g_nested_cpu;
+                  g_nested_cpu = nested_before + cpu;
                   if (outer) {
                     add_to(&t_cells, wall_now() - w0);
-                    add_to(&t_cells_cpu, thread_cpu_now() - c0);
+                    add_to(&t_cells_cpu, cpu);
                   }
                   runs_done += cell_runs(info.layout, c, settings.region.runs);
                   const double k0 = wall_now();

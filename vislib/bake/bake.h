@@ -122,7 +122,11 @@ struct BakeReport {
   uint32_t resumed = 0;              // taken from the checkpoint
   uint32_t baked = 0;                // computed in this run
   std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
-  double seconds = 0;                // wall time of this run's baking
+  // CPU seconds per cell id computed in this run (else 0) of the thread that ran it, cells it ran
+  // inside this one left out: the cell's whole cost on one thread (-j 1); with more threads, the
+  // tiles other threads took are missing and tiles of other cells it took are in.
+  std::vector<double> cell_cpu_seconds;
+  double seconds = 0;  // wall time of this run's baking
   // Threads the bake ran on: tbb::this_task_arena::max_concurrency() of the caller's arena (a
   // tbb::task_arena of N slots runs it on N threads, whatever the core count).
   int threads = 0;

@@ -70,6 +70,7 @@ std::string bake_report_json(const BakeRunInfo& info, const BakeReport& r) {
         {"checkpoint_seconds", r.times.checkpoint},
         {"writing_seconds", r.times.writing}}},
       {"cell_seconds", r.cell_seconds},
+      {"cell_cpu_seconds", r.cell_cpu_seconds},
       {"bytes",
        {{"file", r.stats.file_bytes},
         {"header", r.stats.header_bytes},
