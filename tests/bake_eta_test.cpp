@@ -1,7 +1,7 @@
 // Tests of the bake's ETA (bake_eta.h): the expected work of cells counted by hand on a small
 // grid, and the weighted ETA replayed against the per-cell kernel seconds recorded from a real
-// bake (tests/data/bake_cell_seconds_city.txt): its error must be smaller than the one of
-// counting cells alike. No timing is measured here.
+// bake (tests/data/bake_cell_seconds_city.txt, and bake_cell_seconds_fdm6.txt of a shared real
+// level): its error must be smaller than the one of counting cells alike. No timing is measured.
 #include "vislib/bake/bake_eta.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "tests/test_support.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/scene/import.h"
 
@@ -59,12 +60,12 @@ TEST(BakeEta, EtaIsElapsedTimesWorkLeftOverWorkDone) {
   EXPECT_TRUE(std::isnan(eta_seconds(10, 0, 6)));
 }
 
-// The quick start's bake of data/city.glb (README), as tests/data/bake_cell_seconds_city.txt
-// records it: the cells and their kernel seconds at -j 1, in cell order.
-TEST(BakeEta, WeightedEtaBeatsCountingCellsOnARecordedBake) {
-  const std::string dir = VISLIB_SOURCE_DIR;
-  std::ifstream in(dir + "/tests/data/bake_cell_seconds_city.txt");
-  ASSERT_TRUE(in) << "tests/data/bake_cell_seconds_city.txt";
+// Replays the per-cell CPU seconds recorded in tests/data/`file` for the cells of `layout`, cells
+// finishing in cell order as on one thread, and checks at 10%, 25% and 50% of the cells that the
+// ETA weighted by expected work errs less than the one counting cells alike.
+void replay(const std::string& file, const pvs::CellLayout& layout) {
+  std::ifstream in(std::string(VISLIB_SOURCE_DIR) + "/tests/data/" + file);
+  ASSERT_TRUE(in) << file;
   std::vector<double> seconds;
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
@@ -75,21 +76,12 @@ TEST(BakeEta, WeightedEtaBeatsCountingCellsOnARecordedBake) {
     ASSERT_EQ(cell, seconds.size()) << line;
     seconds.push_back(t);
   }
-  const Scene scene = load_scene(dir + "/data/city.glb");
-  CellPlacement p;
-  p.walkable = true;
-  p.cell_size = 24;
-  p.box = Box3{};
-  p.box->extend({-120, -1, -120});
-  p.box->extend({120, 1, 120});
-  const pvs::CellLayout layout = place_view_cells(scene, p).layout;
   const uint32_t n = layout.cell_count();
-  ASSERT_EQ(seconds.size(), n);
+  ASSERT_EQ(seconds.size(), n) << file;
   const std::vector<double> work = expected_cell_work(layout, std::vector<uint8_t>(n, 1), 1, true);
   double total = 0, total_work = 0;
   for (uint32_t c = 0; c < n; ++c) total += seconds[c], total_work += work[c];
   for (double fraction : {0.10, 0.25, 0.50}) {
-    // At -j 1 the cells finish in cell order; the elapsed time is the kernel seconds so far.
     const uint32_t k = uint32_t(std::lround(fraction * n));
     double elapsed = 0, work_done = 0;
     for (uint32_t c = 0; c < k; ++c) elapsed += seconds[c], work_done += work[c];
@@ -97,11 +89,35 @@ TEST(BakeEta, WeightedEtaBeatsCountingCellsOnARecordedBake) {
     const double by_cells = eta_seconds(elapsed, k, n - k);
     const double by_work = eta_seconds(elapsed, work_done, total_work - work_done);
     std::printf(
-        "after %u of %u cells: %.2f s left, ETA by cells %.2f s (%+.0f%%), by work %.2f s "
-        "(%+.0f%%)\n",
-        k, n, truth, by_cells, 100 * (by_cells / truth - 1), by_work, 100 * (by_work / truth - 1));
-    EXPECT_LT(std::abs(by_work - truth), std::abs(by_cells - truth)) << "at " << fraction;
+        "%s: after %u of %u cells: %.2f s left, ETA by cells %.2f s (%+.0f%%), by work "
+        "%.2f s (%+.0f%%)\n",
+        file.c_str(), k, n, truth, by_cells, 100 * (by_cells / truth - 1), by_work,
+        100 * (by_work / truth - 1));
+    EXPECT_LT(std::abs(by_work - truth), std::abs(by_cells - truth)) << file << " at " << fraction;
   }
+}
+
+// The quick start's bake of data/city.glb (README).
+TEST(BakeEta, WeightedEtaBeatsCountingCellsOnARecordedBake) {
+  const Scene scene = load_scene(std::string(VISLIB_SOURCE_DIR) + "/data/city.glb");
+  CellPlacement p;
+  p.walkable = true;
+  p.cell_size = 24;
+  p.box = Box3{};
+  p.box->extend({-120, -1, -120});
+  p.box->extend({120, 1, 120});
+  replay("bake_cell_seconds_city.txt", place_view_cells(scene, p).layout);
+}
+
+// A real level: the shared Sauerbraten arena fdm6 (skipped without ../shared).
+TEST(BakeEta, WeightedEtaBeatsCountingCellsOnARealLevel) {
+  VISLIB_REQUIRE_SHARED(shared);
+  const std::string path = shared + "/scenes/sauer_fdm6/fdm6.obj";
+  CellPlacement p;
+  p.walkable = true;
+  p.cell_size = 32;
+  p.eye = EyeBand{12, 16};
+  replay("bake_cell_seconds_fdm6.txt", place_view_cells(load_scene(path), p).layout);
 }
 
 }  // namespace
