@@ -9,6 +9,7 @@
 
 #include "cli/commands.h"
 #include "cli/options.h"
+#include "cli/threads.h"
 
 namespace pvs_cli {
 namespace {
@@ -219,8 +220,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
   cmd->add_option("-j,--threads", a.threads,
-                  "Worker threads (0 = all cores); never changes the output")
-      ->check(non_negative());
+                  "Threads, as make -j (0 = one per core); never changes the output")
+      ->check(in_range(0, kMaxThreads));
   cmd->add_option("--shard", a.shard,
                   "Bake only cells c with c % N == i, into a shard file for pvs merge")
       ->capture_default_str();

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "cli/options.h"
+#include "vislib/bake/bake_eta.h"
 
 namespace pvs_cli {
 
@@ -32,9 +33,9 @@ vislib::BakeProgressFn progress_printer() {
   auto st = std::make_shared<State>();
   return [st](const vislib::BakeProgress& p) {
     if (!show_progress()) return;
-    // Cells finished plus the finished share of the running ones (a long cell shows progress).
-    const double work = double(p.done - p.resumed) + p.running;
-    double eta = work > 0 ? p.elapsed / work * (double(p.total - p.done) - p.running) : NAN;
+    // The cells left weighted by their expected work (bake_eta.h), the running ones' finished
+    // share counted as done (a long cell shows progress).
+    const double eta = vislib::eta_seconds(p.elapsed, p.work_done, p.work_total - p.work_done);
     if (st->tty) {
       const int width = 30;
       int fill = p.total ? int(double(width) * (p.done + p.running) / p.total) : width;

@@ -2,7 +2,6 @@
 // shard files of a sharded bake.
 #include <fmt/format.h>
 #include <sys/stat.h>
-#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -15,6 +14,7 @@
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "cli/threads.h"
 #include "vislib/bake/bake.h"
 #include "vislib/bake/bake_report.h"
 #include "vislib/bake/cell_visibility.h"
@@ -63,6 +63,14 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
         r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a.output.c_str(),
         static_cast<unsigned long long>(r.segment_runs_computed + r.segment_runs_shared),
         static_cast<unsigned long long>(r.segment_runs_shared));
+  const vislib::BakeTimes& t = r.times;
+  pvs_cli::info(fmt::format(
+      "bake: {} threads x {:.2f} s = {:.2f} thread-seconds; process CPU {:.2f} s; in cells "
+      "{:.2f} s ({:.2f} CPU s; of it {:.2f} s in shared edges another cell computed, {:.2f} s "
+      "reporting progress), checkpoint {:.2f} s, writing {:.2f} s; before the cells: BVH {:.2f} "
+      "s, pilot {:.2f} s",
+      r.threads, r.seconds, r.threads * r.seconds, t.process_cpu, t.cells, t.cells_cpu,
+      t.shared_wait, t.progress, t.checkpoint, t.writing, r.bvh_seconds, pilot.seconds));
   if (a.json_out.empty()) return;
   const std::string text = vislib::bake_report_json(info, r);
   if (a.json_out == "-")
@@ -86,10 +94,6 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
   check_output_file(a.output, "--output");
   check_output_file(a.checkpoint.empty() ? a.output + ".ckpt" : a.checkpoint, "--checkpoint");
   if (!a.json_out.empty()) check_output_file(a.json_out, "--json", true);
-  std::unique_ptr<tbb::global_control> limit;
-  if (a.threads > 0)
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  a.threads);
   std::string checkpoint = a.checkpoint.empty() ? a.output + ".ckpt" : a.checkpoint;
   // One bake per output at a time (the checkpoint has its own lock too): taken before looking
   // at the checkpoint, so a second bake is told that the first is running (exit 2).
@@ -151,7 +155,7 @@ void add_bake(CLI::App& app) {
       "on the perimeter of the bottom and top rectangles of each cell's eye band. Cells: a grid "
       "over --box, or --walkable cells over the floors of the scene.");
   add_bake_options(cmd, *a);
-  cmd->callback([a, cmd] { run_bake(*a, *cmd); });
+  cmd->callback([a, cmd] { run_with_threads(a->threads, [&] { run_bake(*a, *cmd); }); });
 }
 
 Registration bake_registration("bake", add_bake);

@@ -3,7 +3,6 @@
 // matplotlib) PNG plots into --out. docs/bench.md describes every file and key.
 #include <sys/stat.h>
 #include <sys/wait.h>
-#include <tbb/global_control.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -18,6 +17,7 @@
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "cli/threads.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/bench_report.h"
 #include "vislib/eval/benchmark_compare.h"
@@ -71,10 +71,6 @@ std::vector<std::string> make_plots(const BenchArgs& a) {
 
 void run(BenchArgs& a) {
   check_output_dir(a.out, "--out");  // before any work
-  std::unique_ptr<tbb::global_control> limit;
-  if (a.threads > 0)
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  size_t(a.threads));
   auto b = parse_doubles(a.box, "--box", 6);
   a.o.box = vislib::Box3{};
   a.o.box.extend({b[0], b[1], b[2]});
@@ -185,8 +181,8 @@ void add_bench(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--seed", a->o.seed, "Seed of orientations, viewpoints and test views")
       ->capture_default_str();
-  cmd->add_option("-j,--threads", a->threads, "Worker threads (0 = all cores)")
-      ->check(non_negative());
+  cmd->add_option("-j,--threads", a->threads, "Threads, as make -j (0 = one per core)")
+      ->check(in_range(0, kMaxThreads));
   cmd->add_flag("--no-frames", a->no_frames, "Do not write the equal-time frames and heat maps");
   cmd->add_flag("--no-plots", a->no_plots, "Do not run the plotting script");
   cmd->add_option("--python", a->python, "Python with matplotlib for the plots")
@@ -194,7 +190,7 @@ void add_bench(CLI::App& app) {
   cmd->add_option("--plot-script", a->plot_script,
                   "Path of bench/plot_bench.py (default: found "
                   "from the build tree)");
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a] { run_with_threads(a->threads, [&] { run(*a); }); });
 }
 
 Registration bench_registration("bench", add_bench);

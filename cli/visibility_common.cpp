@@ -8,6 +8,7 @@
 
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "cli/threads.h"
 #include "vislib/base/file_util.h"
 
 namespace pvs_cli {
@@ -28,8 +29,8 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
   cmd->add_option("--granularity", a.granularity, "Report visible triangles or objects")
       ->check(CLI::IsMember({"triangle", "object"}))
       ->capture_default_str();
-  cmd->add_option("-j,--threads", a.threads, "Worker threads (0 = all cores)")
-      ->check(non_negative());
+  cmd->add_option("-j,--threads", a.threads, "Threads, as make -j (0 = one per core)")
+      ->check(in_range(0, kMaxThreads));
   cmd->add_option("--tile", a.tile,
                   "Tile side in pixels (memory/parallelism grain); 0: 32 for static scenes, 16 "
                   "with moving triangles or spheres")
@@ -148,12 +149,6 @@ vislib::Scene load(const VisibilityArgs& a, double& seconds) {
   vislib::Scene scene = load_scene_for_cli(a.scene, a.states, a.import);
   seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return scene;
-}
-
-std::unique_ptr<tbb::global_control> thread_limit(int threads) {
-  if (threads <= 0) return nullptr;
-  return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                               threads);
 }
 
 }  // namespace pvs_cli

@@ -2,8 +2,6 @@
 // common options, the kernel options they map to, and their JSON output.
 #pragma once
 
-#include <tbb/global_control.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <memory>
@@ -58,7 +56,5 @@ std::vector<uint32_t> at_granularity(const vislib::Scene& scene, const std::vect
 void write_json(const std::string& path, const nlohmann::json& j);
 // Loads the scene of `a`; `seconds` gets the time it took.
 vislib::Scene load(const VisibilityArgs& a, double& seconds);
-// Limits TBB to `threads` workers while the result lives (none when threads <= 0).
-std::unique_ptr<tbb::global_control> thread_limit(int threads);
 
 }  // namespace pvs_cli

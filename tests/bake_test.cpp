@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <atomic>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include <thread>
 
 #include "tests/test_support.h"
+#include "vislib/bake/bake_eta.h"
 #include "vislib/bake/bake_report.h"
 #include "vislib/bake/cell_set.h"
 #include "vislib/bake/checkpoint.h"
@@ -385,8 +387,44 @@ TEST(BakeReportJson, StatesTheRunTheCellsTimingsAndTheFileSizes) {
   EXPECT_DOUBLE_EQ(j["timings"]["kernel_seconds"].get<double>(), sum);
   EXPECT_EQ(kernel_seconds(r), sum);
   EXPECT_EQ(j["timings"]["setup_seconds"], 0.5);
+  // The threads of the caller's arena, and where their time went.
+  EXPECT_EQ(j["threads"].get<int>(), tbb::this_task_arena::max_concurrency());
+  ASSERT_EQ(j["cell_cpu_seconds"].size(), 9u);
+  double cpu = 0;
+  for (const json& s : j["cell_cpu_seconds"]) {
+    EXPECT_GE(s.get<double>(), 0);
+    cpu += s.get<double>();
+  }
+  EXPECT_GT(cpu, 0);
+  const json& t = j["timings"];
+  EXPECT_GT(t["process_cpu_seconds"].get<double>(), 0);
+  EXPECT_GT(t["cells_seconds"].get<double>(), 0);
+  EXPECT_LE(t["shared_wait_seconds"].get<double>(), t["cells_seconds"].get<double>());
+  for (const char* k :
+       {"cells_cpu_seconds", "progress_seconds", "checkpoint_seconds", "writing_seconds"})
+    EXPECT_GE(t[k].get<double>(), 0) << k;
   info.cell_size = 8;
   EXPECT_EQ(json::parse(bake_report_json(info, r))["preset"]["cell_size"], 8.0);
+}
+
+// The progress carries the expected work of the cells (bake_eta.h): its total is that of every
+// cell to bake, and all of it is done by the last call.
+TEST(Bake, ProgressCountsTheExpectedWorkOfTheCells) {
+  const Scene scene = small_city();
+  const std::string dir = temp_dir("bake_work");
+  const ViewCells cells = small_grid();
+  std::vector<BakeProgress> calls;
+  bake(scene, cells, settings(), Shard{}, {dir + "/c.pvs", dir + "/c.ckpt", false},
+       [&](const BakeProgress& p) { calls.push_back(p); });
+  const uint32_t n = cells.layout.cell_count();
+  double total = 0;
+  for (double w : expected_cell_work(cells.layout, std::vector<uint8_t>(n, 1), 1, true)) total += w;
+  ASSERT_GE(calls.size(), 2u);
+  EXPECT_EQ(calls.front().work_done, 0);
+  EXPECT_DOUBLE_EQ(calls.front().work_total, total);
+  EXPECT_EQ(calls.back().done, n);
+  EXPECT_NEAR(calls.back().work_done, total, 1e-9 * total);
+  for (size_t i = 1; i < calls.size(); ++i) EXPECT_LE(calls[i].work_done, total * (1 + 1e-9)) << i;
 }
 
 TEST(CellSet, ReadCellViewSetFindsThePointsCellOrSaysWhyNot) {

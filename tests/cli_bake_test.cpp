@@ -122,9 +122,19 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
 TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {
   std::string dir = temp_dir("cli_bake_shards");
   std::string out;
-  ASSERT_EQ(run_pvs(grid_bake(dir + "/one.pvs") + " --threads 1", &out), 0) << out;
-  ASSERT_EQ(run_pvs(grid_bake(dir + "/two.pvs") + " --threads 2", &out), 0) << out;
-  EXPECT_EQ(vislib::read_file(dir + "/one.pvs"), vislib::read_file(dir + "/two.pvs"));
+  // -j N runs N threads (a task arena of N slots), more than the cores too; same bytes.
+  for (int threads : {1, 2, 16}) {
+    const std::string name = dir + "/j" + std::to_string(threads);
+    ASSERT_EQ(run_pvs(grid_bake(name + ".pvs") + " --threads " + std::to_string(threads) +
+                          " --json " + name + ".json",
+                      &out),
+              0)
+        << out;
+    EXPECT_EQ(nlohmann::json::parse(vislib::read_file(name + ".json"))["threads"].get<int>(),
+              threads);
+  }
+  EXPECT_EQ(vislib::read_file(dir + "/j1.pvs"), vislib::read_file(dir + "/j2.pvs"));
+  EXPECT_EQ(vislib::read_file(dir + "/j1.pvs"), vislib::read_file(dir + "/j16.pvs"));
   std::string shards;
   for (int i = 0; i < 3; ++i) {
     std::string s = dir + "/shard" + std::to_string(i) + ".pvs";
@@ -132,7 +142,7 @@ TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {
     shards = s + " " + shards;
   }
   ASSERT_EQ(run_pvs("merge " + shards + "-o " + dir + "/merged.pvs", &out), 0) << out;
-  EXPECT_EQ(vislib::read_file(dir + "/merged.pvs"), vislib::read_file(dir + "/one.pvs"));
+  EXPECT_EQ(vislib::read_file(dir + "/merged.pvs"), vislib::read_file(dir + "/j1.pvs"));
   // A missing shard is an error naming the cell.
   ASSERT_EQ(
       run_pvs("merge " + dir + "/shard0.pvs " + dir + "/shard1.pvs -o " + dir + "/bad.pvs", &out),
@@ -448,6 +458,12 @@ TEST(CliBake, TheBvhWalkGivesTheSameFileAndTheSameSets) {
     const auto j = nlohmann::json::parse(vislib::read_file(path));
     sets[on] = j["visible"].dump() + j["witnesses"].dump();
     EXPECT_EQ(j["timings"]["bvh_seconds"].get<double>() > 0, on == 1);
+    // Both times whatever --bvh says, the kernel's without the build.
+    EXPECT_EQ(j["bvh"].get<bool>(), on == 1);
+    EXPECT_GT(j["timings"]["visibility_seconds"].get<double>(), 0);
+    EXPECT_EQ(j["timings"]["bvh_and_visibility_seconds"].get<double>(),
+              j["timings"]["bvh_seconds"].get<double>() +
+                  j["timings"]["visibility_seconds"].get<double>());
     EXPECT_EQ(j["counts"]["bvh_nodes_opened"].get<uint64_t>() > 0, on == 1);
     // Without the tree every triangle is bounded on each of the six faces (the count the
     // long-segment pilot weighs, long_segments.cpp).

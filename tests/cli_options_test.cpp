@@ -257,6 +257,21 @@ TEST(CliConventions, DashJIsThreads) {
     EXPECT_EQ(run_pvs(std::string(c) + " --help", &out), 0);
     EXPECT_NE(out.find("-j,--threads"), std::string::npos) << c;
   }
+  // -j N runs N threads, more than the cores too (cli/threads.h), with the same result.
+  std::string visible[2];
+  for (int i = 0; i < 2; ++i) {
+    const std::string path = dir + "/s" + std::to_string(i) + ".json";
+    ASSERT_EQ(run_pvs("segment " + city() + " --from 0,1.6,0 --to 1,1.6,0 --res 8 -j " +
+                          (i ? "16" : "1") + " --json " + path,
+                      &out),
+              0)
+        << out;
+    visible[i] = json::parse(vislib::read_file(path))["visible"].dump();
+  }
+  EXPECT_EQ(visible[0], visible[1]);
+  // Beyond kMaxThreads: refused, naming the option.
+  EXPECT_EQ(run_pvs(small_bake("-j 5000 -o " + dir + "/c.pvs"), &out), 2) << out;
+  EXPECT_NE(out.find("--threads"), std::string::npos) << out;
 }
 
 TEST(CliConventions, PresetSetsResolutionRunsAndCellSizeAndIsReported) {

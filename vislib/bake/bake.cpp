@@ -1,8 +1,10 @@
 // bake.cpp: parallel bake over view cells with checkpoint and shards (bake.h, docs/bake.md).
 #include "vislib/bake/bake.h"
 
-#include <tbb/global_control.h>
+#include <sys/resource.h>
 #include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+#include <time.h>
 
 #include <atomic>
 #include <cassert>
@@ -11,6 +13,7 @@
 #include <mutex>
 #include <nlohmann/json.hpp>
 
+#include "vislib/bake/bake_eta.h"
 #include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/id_universe.h"
@@ -98,6 +101,35 @@ std::vector<SegmentEnds> all_edges(const pvs::CellLayout& layout) {
       for (const Segment& s : perimeter_segments(rect)) all.emplace_back(s.from, s.to);
   return all;
 }
+
+// Wall and CPU clocks of the calling thread, and of the whole process.
+double wall_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+double thread_cpu_now() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+double process_cpu_now() {
+  rusage u;
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// Adds `seconds` to `*sum` (std::atomic<double> has no fetch_add before C++20).
+void add_to(std::atomic<double>* sum, double seconds) {
+  double old = sum->load(std::memory_order_relaxed);
+  while (!sum->compare_exchange_weak(old, old + seconds, std::memory_order_relaxed)) {
+  }
+}
+
+// Cells baked inside another cell on the same thread (a thread waiting in its cell ran another's
+// pipeline task): the outermost's wall time counts once, and a cell's own CPU seconds leave out
+// those of the cells run inside it (their sum, per thread, while a cell runs).
+thread_local int g_cell_depth = 0;
+thread_local double g_nested_cpu = 0;
 
 // One BVH for every static run of this bake (the runs walk it per tile): `requested`'s own, else
 // one built into `tree` when the bake asks for it and the scene allows it, else none.
@@ -198,10 +230,28 @@ void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
   uint32_t done = report.resumed;
   std::vector<double> partial(n, 0.0);  // fraction of each running cell's runs done
   double running = 0;                   // their sum
-  if (progress) progress({done, report.shard_cells, report.resumed, 0.0, 0.0});
-  const size_t threads =
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism);
-  const size_t tokens = 4 * std::max<size_t>(1, threads);
+  // Expected work of the cells to bake (bake_eta.h), finished and in the running cells.
+  std::vector<uint8_t> to_bake(n, 0);
+  for (uint32_t c = 0; c < n; ++c) to_bake[c] = in_shard(c, shard) && !recovered[c];
+  const std::vector<double> work =
+      expected_cell_work(info.layout, to_bake, runs, run_settings.share_segments);
+  double work_total = 0, work_finished = 0, work_running = 0;
+  for (double w : work) work_total += w;
+  auto state = [&] {
+    BakeProgress p;
+    p.done = done;
+    p.total = report.shard_cells;
+    p.resumed = report.resumed;
+    p.elapsed = elapsed();
+    p.running = std::max(0.0, running);
+    p.work_done = work_finished + std::max(0.0, work_running);
+    p.work_total = work_total;
+    return p;
+  };
+  if (progress) progress(state());
+  std::atomic<double> t_cells{0}, t_cells_cpu{0}, t_progress{0}, t_checkpoint{0}, t_writing{0};
+  const double cpu_start = process_cpu_now();
+  const size_t tokens = 4 * size_t(std::max(1, report.threads));
   uint32_t next = 0;
   try {
     tbb::parallel_pipeline(
@@ -228,33 +278,58 @@ void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
                   std::function<void(double)> in_cell;  // progress inside the cell
                   if (progress)
                     in_cell = [&, c](double fraction) {
+                      const double w0 = wall_now();
                       std::lock_guard<std::mutex> guard(progress_mutex);
                       running += fraction - partial[c];
+                      work_running += (fraction - partial[c]) * work[c];
                       partial[c] = fraction;
-                      progress({done, report.shard_cells, report.resumed, elapsed(),
-                                std::max(0.0, running)});
+                      progress(state());
+                      add_to(&t_progress, wall_now() - w0);
                     };
-                  std::vector<uint32_t> ids = with_memory_stage(
-                      "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
-                        return bake_cell(scene, info.layout, c, run_settings, &seconds, in_cell);
-                      });
+                  const bool outer = g_cell_depth++ == 0;
+                  const double nested_before = g_nested_cpu;
+                  g_nested_cpu = 0;
+                  const double w0 = wall_now(), c0 = thread_cpu_now();
+                  std::vector<uint32_t> ids;
+                  try {
+                    ids = with_memory_stage(
+                        "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
+                          return bake_cell(scene, info.layout, c, run_settings, &seconds, in_cell);
+                        });
+                  } catch (...) {
+                    --g_cell_depth;
+                    g_nested_cpu = nested_before;
+                    throw;
+                  }
+                  --g_cell_depth;
+                  const double cpu = thread_cpu_now() - c0;
+                  report.cell_cpu_seconds[c] = cpu - g_nested_cpu;
+                  g_nested_cpu = nested_before + cpu;
+                  if (outer) {
+                    add_to(&t_cells, wall_now() - w0);
+                    add_to(&t_cells_cpu, cpu);
+                  }
                   runs_done += cell_runs(info.layout, c, runs);
+                  const double k0 = wall_now();
                   if (checkpoint) checkpoint->append(c, ids);
+                  add_to(&t_checkpoint, wall_now() - k0);
                   *set = std::move(ids);
                   report.cell_seconds[c] = seconds;
                   std::lock_guard<std::mutex> guard(progress_mutex);
                   ++done;
                   ++report.baked;
                   running -= partial[c];
+                  work_running -= partial[c] * work[c];
+                  work_finished += work[c];
                   partial[c] = 0;
-                  if (progress)
-                    progress({done, report.shard_cells, report.resumed, elapsed(),
-                              std::max(0.0, running)});
+                  if (progress) progress(state());
                   return set;
                 }) &
             tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
                 tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
+                  const double w0 = wall_now();
                   with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
+                  add_to(&t_writing, wall_now() - w0);
                 }));
   } catch (...) {
     // A bake that recorded nothing leaves no checkpoint behind.
@@ -262,6 +337,12 @@ void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
     throw;
   }
   report.seconds = elapsed();
+  report.times.process_cpu = process_cpu_now() - cpu_start;
+  report.times.cells = t_cells;
+  report.times.cells_cpu = t_cells_cpu;
+  report.times.progress = t_progress;
+  report.times.checkpoint = t_checkpoint;
+  report.times.writing = t_writing;
   report.stats = writer.finish();
   out.commit();
 }
@@ -275,6 +356,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   if (files.lock)
     lock = std::make_unique<FileLock>(files.output + ".lock", "the output " + files.output);
   BakeReport report;
+  report.threads = tbb::this_task_arena::max_concurrency();
   TriangleBvh tree;
   const TriangleBvh* bvh = bake_bvh(scene, requested, tree, report);
   const BakeSettings settings = resolved_settings(scene, cells, requested, bvh, report);
@@ -283,6 +365,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   const uint32_t n = info.layout.cell_count();
   report.cells = n;
   report.cell_seconds.assign(n, 0.0);
+  report.cell_cpu_seconds.assign(n, 0.0);
 
   // Cells recovered from the checkpoint (resume); each is released once written.
   std::vector<std::optional<std::vector<uint32_t>>> recovered;
@@ -307,6 +390,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
 
   stream_cells(scene, info, shard, run_settings, settings.region.runs, recovered, checkpoint.get(),
                files, progress, runs_done, report);
+  report.times.shared_wait = shared_runs.wait_seconds();
   report.segment_runs_shared = shared_runs.runs_shared();
   report.segment_runs_computed = runs_done.load() - report.segment_runs_shared;
   if (checkpoint) checkpoint->remove();

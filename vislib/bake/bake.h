@@ -82,6 +82,11 @@ struct BakeProgress {
   // Work inside the cells being baked: the sum over them of the fraction of their from-segment
   // runs done, so done + running (<= total) counts the cells' work finished (a long cell shows).
   double running = 0;
+  // The same in expected work (bake_eta.h: expected_cell_work of the cells this run bakes):
+  // finished cells' work plus each running cell's fraction of its own, and the total to bake;
+  // eta_seconds(elapsed, work_done, work_total - work_done) weights the cells left by their work.
+  double work_done = 0;
+  double work_total = 0;
 };
 // Called once before the first cell (done = resumed), after every from-segment run inside a cell
 // and after every finished cell, serialised (never two calls at once) but from any worker thread.
@@ -96,14 +101,37 @@ struct BakeFiles {
   bool lock = true;
 };
 
+// Where a bake's threads spent the pipeline over cells (the BVH and the pilot come before it:
+// BakeReport::bvh_seconds, long_segment_choice.seconds). Seconds summed over the calls, from
+// timers inside the bake; the threads had threads * BakeReport::seconds of wall time in all.
+struct BakeTimes {
+  double process_cpu = 0;  // CPU seconds (user + system) of the whole process in the pipeline
+  // Inside the cells' computation (bake_cell), summed over cells: wall seconds, and CPU seconds of
+  // the threads that ran them over the same calls. A thread waiting inside its cell may run tiles
+  // or a whole cell of another; a cell run inside another on the same thread is counted once.
+  double cells = 0, cells_cpu = 0;
+  double shared_wait = 0;  // of `cells`: in shared runs another cell was computing (wall)
+  double progress = 0;     // of `cells`: waiting for the progress lock and reporting (wall)
+  double checkpoint = 0;   // appending finished cells to the checkpoint (wall)
+  double writing = 0;      // in the writer stage, one cell at a time in cell order (wall)
+};
+
 struct BakeReport {
   uint32_t cells = 0;                // in the layout
   uint32_t shard_cells = 0;          // in this shard
   uint32_t resumed = 0;              // taken from the checkpoint
   uint32_t baked = 0;                // computed in this run
   std::vector<double> cell_seconds;  // kernel seconds per cell id computed in this run, else 0
-  double seconds = 0;                // wall time of this run's baking
-  pvs::WriteStats stats;             // sizes of the written file
+  // CPU seconds per cell id computed in this run (else 0) of the thread that ran it, cells it ran
+  // inside this one left out: the cell's whole cost on one thread (-j 1); with more threads, the
+  // tiles other threads took are missing and tiles of other cells it took are in.
+  std::vector<double> cell_cpu_seconds;
+  double seconds = 0;  // wall time of this run's baking
+  // Threads the bake ran on: tbb::this_task_arena::max_concurrency() of the caller's arena (a
+  // tbb::task_arena of N slots runs it on N threads, whatever the core count).
+  int threads = 0;
+  BakeTimes times;        // where the threads' time went
+  pvs::WriteStats stats;  // sizes of the written file
   // From-segment runs: computed by the kernel in this run (a long segment counts once), and
   // served from the shared-edge cache or a long segment's part instead (share_segments,
   // long_segments); computed + shared = runs of the baked cells. A long segment's kernel seconds
@@ -122,6 +150,7 @@ struct BakeReport {
 // too), records each finished cell in the checkpoint before counting it done, and streams the
 // blocks to a temporary file in cell order as cells finish (index and header patched at the end;
 // pvs::StreamWriter), renamed over `files.output` once complete; then deletes the checkpoint.
+// Runs on the calling thread's TBB arena: its max_concurrency() is the thread count.
 // Memory: the cells in flight (4 per thread at most) and the delta references of StreamWriter,
 // plus O(cells) bytes of index and timings; not the sets of all cells (on resume, the recovered
 // cells are held until written). Throws InputError for a checkpoint of another bake or a bake

@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 
 namespace vislib {
@@ -199,6 +200,7 @@ std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, co
   // The first caller computes; callers that arrive meanwhile work on the same run's tiles (the
   // kernel is TBB-parallel inside) and see its parts, or its error, once it is done.
   bool ran = false;
+  const auto t0 = std::chrono::steady_clock::now();
   tbb::collaborative_call_once(*c.once, [&] {
     ran = true;
     try {
@@ -208,7 +210,12 @@ std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, co
     }
   });
   if (computed) *computed = ran || claims;
-  if (!ran && !claims) shared_.fetch_add(1);
+  if (!ran && !claims) {
+    shared_.fetch_add(1);
+    wait_ns_.fetch_add(uint64_t(
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0)
+            .count()));
+  }
   lock.lock();
   const bool last = c.remaining[part] > 0 && --c.remaining[part] == 0;
   if (c.error) std::rethrow_exception(c.error);

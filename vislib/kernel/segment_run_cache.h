@@ -81,7 +81,11 @@ class SegmentRunCache {
 
   uint64_t runs_computed() const { return computed_.load(); }
   uint64_t runs_shared() const { return shared_.load(); }  // get() calls served from the cache
-  size_t entries_held() const;                             // results awaiting a later use
+  // Wall seconds, summed over calls, that get() calls served from the cache spent in them: ~0 for
+  // a run stored already; for one another caller was computing, the time until it was done
+  // (working on its tiles meanwhile, or waiting idle when none was left).
+  double wait_seconds() const { return 1e-9 * double(wait_ns_.load()); }
+  size_t entries_held() const;  // results awaiting a later use
   size_t chains_planned() const { return planned_; }
 
  private:
@@ -114,7 +118,7 @@ class SegmentRunCache {
   std::vector<Chain> chains_;
   std::map<Key, ChainRef> chain_of_;  // every segment announced or planned
   size_t planned_ = 0;                // chains of two or more segments
-  std::atomic<uint64_t> computed_{0}, shared_{0};
+  std::atomic<uint64_t> computed_{0}, shared_{0}, wait_ns_{0};
 };
 
 }  // namespace vislib

@@ -1,0 +1,65 @@
+// bake_eta.cpp: the expected work of the cells of a bake and the ETA it gives (bake_eta.h).
+#include "vislib/bake/bake_eta.h"
+
+#include <array>
+#include <cassert>
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "vislib/bake/view_cells.h"
+#include "vislib/kernel/region_visibility.h"
+
+namespace vislib {
+
+namespace {
+
+// The bits of a segment's end points: shared runs match them exactly (segment_run_cache.h).
+std::array<uint64_t, 6> key_of(const Segment& s) {
+  const double v[6] = {s.from.x, s.from.y, s.from.z, s.to.x, s.to.y, s.to.z};
+  std::array<uint64_t, 6> k;
+  std::memcpy(k.data(), v, sizeof v);
+  return k;
+}
+
+}  // namespace
+
+std::vector<double> expected_cell_work(const pvs::CellLayout& layout,
+                                       const std::vector<uint8_t>& bake, int runs,
+                                       bool share_segments) {
+  const uint32_t n = layout.cell_count();
+  assert(bake.size() == n && runs >= 1);
+  std::vector<std::vector<Segment>> segments(n);
+  double total = 0;
+  size_t count = 0;
+  for (uint32_t c = 0; c < n; ++c) {
+    if (!bake[c]) continue;
+    for (const Box3& rect : cell_rectangles(layout, c))
+      for (const Segment& s : perimeter_segments(rect)) {
+        segments[c].push_back(s);
+        total += length(s.to - s.from);
+        ++count;
+      }
+  }
+  std::vector<double> work(n, 0.0);
+  if (count == 0) return work;
+  const double mean = total / double(count);
+  const double fixed = kRunFixedEdges * mean;
+  const double unit = mean + fixed;
+  std::set<std::array<uint64_t, 6>> computed;  // run 0 of these segments is counted already
+  for (uint32_t c = 0; c < n; ++c)
+    for (const Segment& s : segments[c]) {
+      const double run = (length(s.to - s.from) + fixed) / unit;
+      const bool first = !share_segments || computed.insert(key_of(s)).second;
+      work[c] += run * double(runs - 1 + (first ? 1 : 0));
+    }
+  return work;
+}
+
+double eta_seconds(double elapsed, double done, double left) {
+  if (left <= 0) return 0.0;
+  if (!(done > 0)) return NAN;
+  return elapsed * left / done;
+}
+
+}  // namespace vislib
