@@ -201,6 +201,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")
       ->check(in_range(1, 100000));
+  cmd->add_option("--see-through", a.see_through,
+                  "Objects whose names match these shell patterns (comma-separated; a literal * "
+                  "is [*]) are see-through: seen, never hiding anything (static scenes; glTF "
+                  "objects with BLEND or MASK materials are see-through already; "
+                  "docs/scene-model.md)")
+      ->delimiter(',');
   cmd->add_option("--mode", a.mode,
                   "Dynamic scenes: 'diagonal' or 'decoupled' (as for pvs segment)")
       ->check(CLI::IsMember({"diagonal", "decoupled"}))

@@ -26,6 +26,7 @@ struct BakeArgs {
   std::string coplanar = "both";
   double eps_z = vislib::kDefaultEpsZ;
   int states = 1;
+  std::vector<std::string> see_through;  // --see-through: object name patterns
   std::string preset = "default";
   std::string bvh = "on";           // --bvh on|off
   std::string long_segments = "1";  // --long-segments: 1..8 or auto

@@ -14,10 +14,11 @@ struct InfoOptions {
   std::string scene;
   bool json = false;
   int states = 1;
+  std::vector<std::string> see_through;
 };
 
 void run_info(const InfoOptions& o) {
-  vislib::Scene scene = load_scene_for_cli(o.scene, o.states);
+  vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.see_through);
   vislib::SceneInfo info = vislib::scene_info(scene);
   if (o.json) {
     std::printf("%s\n", vislib::to_json(info).c_str());
@@ -31,6 +32,8 @@ void run_info(const InfoOptions& o) {
   row("triangles", num(info.triangles));
   row("vertices", num(info.vertices));
   row("objects", num(info.objects));
+  row("see-through", num(info.see_through_triangles) + " triangles in " +
+                         num(info.see_through_objects) + " objects");
   row("states", num(info.states) + (info.dynamic ? " (dynamic)" : " (static)"));
   row("spheres", num(info.spheres));
   if (info.bbox.empty()) {
@@ -65,6 +68,10 @@ const Registration reg("info", [](CLI::App& app) {
   cmd->add_flag("--json", o->json, "Machine-readable JSON on stdout");
   cmd->add_option("--states", o->states, "Key states to sample animations into (glTF)")
       ->check(positive());
+  cmd->add_option("--see-through", o->see_through,
+                  "Mark objects whose names match these shell patterns see-through "
+                  "(comma-separated, as for pvs bake)")
+      ->delimiter(',');
   cmd->callback([o] { run_info(*o); });
 });
 

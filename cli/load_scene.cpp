@@ -9,7 +9,8 @@
 
 namespace pvs_cli {
 
-vislib::Scene load_scene_for_cli(const std::string& path, int states) {
+vislib::Scene load_scene_for_cli(const std::string& path, int states,
+                                 const std::vector<std::string>& see_through) {
   if (states < 1)
     throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
   vislib::LoadOptions options;
@@ -18,6 +19,10 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states) {
   const auto t0 = std::chrono::steady_clock::now();
   vislib::Scene scene = vislib::load_scene(path, options, &warnings);
   for (const auto& w : warnings) warn(w);
+  for (const std::string& p : see_through)
+    if (vislib::mark_see_through(scene, {p}) == 0)
+      throw CLI::ValidationError("--see-through",
+                                 "pattern '" + p + "' matches no object of " + path);
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "loaded %s: %zu triangles, %zu objects, %zu spheres, %zu key states in %.2f s",
