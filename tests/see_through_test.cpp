@@ -221,7 +221,7 @@ TEST(SegmentVisibilitySeeThrough, DynamicScenesAndSpheresWithSeeThroughObjectsAr
 // missed), and every witness re-casts to its triangle (nothing extra). About a second.
 TEST(SegmentOracleSeeThrough, RandomSoupWithSeeThroughShareHasNoMissAndEveryWitnessRecasts) {
   for (uint64_t seed : {21u, 22u, 23u}) {
-    Scene s = vislib_test::random_soup(250, seed, 8, 2);
+    Scene s = vislib_test::random_soup(900, seed, 6, 2.5);  // dense: most of it hidden
     Rng rng(Rng::derive(seed, 1));
     size_t marked = 0;
     for (Object& ob : s.objects) {
