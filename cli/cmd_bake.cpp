@@ -21,6 +21,7 @@
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/kernel/segment_visibility.h"
 
 namespace pvs_cli {
 namespace {
@@ -111,6 +112,8 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
   vislib::Scene scene = load_scene_for_cli(a.scene, a.states, a.import);
   if (scene.triangle_count() + scene.sphere_count() >= 0xFFFFFFFFull)
     throw vislib::InputError(a.scene, "more than 2^32-1 triangles and spheres");
+  if (scene.has_see_through() && (scene.sphere_count() > 0 || scene.is_dynamic()))
+    throw vislib::InputError(a.scene, vislib::kSeeThroughStaticOnly);
   vislib::ViewCells cells =
       vislib::with_memory_stage("placing view cells", [&] { return make_cells(a, scene); });
   info.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

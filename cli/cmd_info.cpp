@@ -33,6 +33,8 @@ void run_info(const InfoOptions& o) {
   row("triangles", num(info.triangles));
   row("vertices", num(info.vertices));
   row("objects", num(info.objects));
+  row("see-through", num(info.see_through_triangles) + " triangles in " +
+                         num(info.see_through_objects) + " objects");
   row("states", num(info.states) + (info.dynamic ? " (dynamic)" : " (static)"));
   row("spheres", num(info.spheres));
   if (info.bbox.empty()) {

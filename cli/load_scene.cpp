@@ -15,8 +15,14 @@ void add_import_options(CLI::App* cmd, ImportArgs& args) {
       ->check(CLI::IsMember({"world", "all"}));
   cmd->add_option("--bsp-liquids", args.bsp_liquids,
                   "Quake maps, faces with '*' textures: 'opaque' (default), 'omit' or "
-                  "'see-through' (not supported yet)")
+                  "'see-through' (seen, not occluding)")
       ->check(CLI::IsMember({"opaque", "omit", "see-through"}));
+  cmd->add_option("--see-through", args.see_through,
+                  "Objects whose names match these shell patterns (comma-separated; a literal * "
+                  "is [*]) are see-through: seen, never hiding anything (static scenes; glTF "
+                  "objects with BLEND or MASK materials are see-through already; "
+                  "docs/scene-model.md)")
+      ->delimiter(',');
 }
 
 vislib::Scene load_scene_for_cli(const std::string& path, int states, const ImportArgs& import) {
@@ -33,6 +39,14 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states, const Impo
   const auto t0 = std::chrono::steady_clock::now();
   vislib::Scene scene = vislib::load_scene(path, options, &warnings);
   for (const auto& w : warnings) warn(w);
+  for (const std::string& p : import.see_through)
+    if (vislib::mark_see_through(scene, {p}) == 0)
+      throw CLI::ValidationError("--see-through",
+                                 "pattern '" + p + "' matches no object of " + path);
+  for (const std::string& p : see_through)
+    if (vislib::mark_see_through(scene, {p}) == 0)
+      throw CLI::ValidationError("--see-through",
+                                 "pattern '" + p + "' matches no object of " + path);
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "loaded %s: %zu triangles, %zu objects, %zu spheres, %zu key states in %.2f s",

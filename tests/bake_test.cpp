@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <memory>
@@ -113,6 +114,23 @@ TEST(Bake, ObjectGranularityStoresObjectsOfTheVisibleTriangles) {
   EXPECT_EQ(r.info().granularity, pvs::Granularity::Object);
   EXPECT_EQ(r.info().universe, scene.objects.size());
   EXPECT_EQ(r.read_cell(4), objects_of(scene, bake_cell(scene, r.info().layout, 4, settings())));
+}
+
+TEST(Bake, SeeThroughBuildingsOnlyAddToEachCellsSet) {
+  Scene scene = small_city();
+  Scene glass = scene;
+  for (size_t o = 1; o < glass.objects.size(); o += 2) glass.objects[o].see_through = true;
+  ASSERT_GT(glass.see_through_triangle_count(), 0u);
+  const ViewCells cells = small_grid();
+  size_t opaque_total = 0, glass_total = 0;
+  for (uint32_t c = 0; c < cells.layout.cell_count(); ++c) {
+    const std::vector<uint32_t> a = bake_cell(scene, cells.layout, c, settings());
+    const std::vector<uint32_t> b = bake_cell(glass, cells.layout, c, settings());
+    EXPECT_TRUE(std::includes(b.begin(), b.end(), a.begin(), a.end())) << "cell " << c;
+    opaque_total += a.size();
+    glass_total += b.size();
+  }
+  EXPECT_GT(glass_total, opaque_total);  // something behind the glass buildings is seen
 }
 
 TEST(Bake, ResumeFromACheckpointGivesTheSameBytes) {

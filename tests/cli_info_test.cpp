@@ -74,6 +74,34 @@ TEST(CliInfo, JsonReportsCountsAndBox) {
   EXPECT_EQ(j["degenerate_triangles"], 0);
 }
 
+TEST(CliInfo, CountsSeeThroughFromBlendAndMaskMaterialsAndNamePatterns) {
+  std::string dir = temp_dir("cli_see_through");
+  for (const char* mode : {"OPAQUE", "BLEND", "MASK"}) {
+    GltfSpec g = triangle();
+    g.alpha_mode = mode;
+    std::string out;
+    ASSERT_EQ(run_pvs("info --json '" + write_gltf(dir + "/" + mode + ".gltf", g) + "'", &out), 0)
+        << out;
+    json j = json::parse(out);
+    const int expect = std::string(mode) == "OPAQUE" ? 0 : 1;
+    EXPECT_EQ(j["see_through_triangles"], expect) << mode;
+    EXPECT_EQ(j["see_through_objects"], expect) << mode;
+  }
+  const std::string obj = write_text(dir + "/groups.obj",
+                                     "v 0 0 0\nv 1 0 0\nv 0 1 0\no glass_a\nf 1 2 3\nf 1 3 2\n"
+                                     "o wall\nf 1 2 3\no *water\nf 2 3 1\n");
+  std::string out;
+  ASSERT_EQ(run_pvs("info --json --see-through 'glass*,[*]*' '" + obj + "'", &out), 0) << out;
+  json j = json::parse(out);
+  EXPECT_EQ(j["see_through_triangles"], 3);
+  EXPECT_EQ(j["see_through_objects"], 2);
+  ASSERT_EQ(run_pvs("info --see-through glass_a '" + obj + "'", &out), 0) << out;
+  EXPECT_NE(out.find("2 triangles in 1 objects"), std::string::npos) << out;
+  // A pattern that matches nothing is an error naming it.
+  EXPECT_EQ(run_pvs("info --see-through 'nothing*' '" + obj + "'", &out), 2) << out;
+  EXPECT_NE(out.find("nothing*"), std::string::npos) << out;
+}
+
 TEST(CliInfo, SharedScenesReportTheReadmeTriangleCounts) {
   VISLIB_REQUIRE_SHARED(shared);
   std::string out;

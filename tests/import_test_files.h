@@ -58,6 +58,7 @@ struct GltfSpec {
   size_t view_length_extra = 0;
   int position_component_type = 5126;
   size_t position_count_override = 0;
+  std::string alpha_mode;  // non-empty: the primitive uses material 0 with this alphaMode
 };
 
 inline std::string write_gltf(const std::string& path, const GltfSpec& g) {
@@ -86,6 +87,10 @@ inline std::string write_gltf(const std::string& path, const GltfSpec& g) {
                                 {"count", g.indices.size()},
                                 {"type", "SCALAR"}});
     prim["indices"] = 1;
+  }
+  if (!g.alpha_mode.empty()) {
+    doc["materials"] = json::array({{{"name", "mat0"}, {"alphaMode", g.alpha_mode}}});
+    prim["material"] = 0;
   }
   doc["meshes"] = json::array({{{"name", "mesh0"}, {"primitives", json::array({prim})}}});
   doc["nodes"] = g.nodes;

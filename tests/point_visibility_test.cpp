@@ -248,3 +248,57 @@ TEST(EmbreeScene, BuildsAtAnimationTime) {
   EXPECT_EQ(h.tri, 0u);
   EXPECT_NEAR(h.lambda, 2.0, 1e-6);
 }
+
+// The see-through rule in the Embree from-point baseline: every pixel's first opaque hit and the
+// see-through hits in front of it (brute_force_hits, double), nothing else.
+TEST(PointVisibility, SeeThroughTrianglesAreSeenAndHideNothingAsInTheDoubleReference) {
+  Scene scene = random_soup(300, 8);
+  scene.objects = {{"opaque"}, {"glass", true}};
+  Rng pick(3);
+  for (uint32_t& o : scene.triangle_object) o = pick.uniform() < 0.4 ? 1 : 0;
+  const int n = 32;
+  const double z_near = 0.05;
+  size_t required = 0, missed = 0, extra = 0, see_through_seen = 0;
+  for (uint64_t view = 0; view < 3; ++view) {
+    Rng rng(Rng::derive(77, view));
+    const Vec3 eye{rng.uniform(-3, 3), rng.uniform(-3, 3), rng.uniform(-3, 3)};
+    const Mat3 R = random_orientation(Rng::derive(6, view));
+    const EmbreeScene es(scene, 0.0, eye);
+    ASSERT_TRUE(es.has_see_through());
+    const std::vector<uint32_t> set = point_visible_set(es, eye, R, n, z_near);
+    std::vector<uint32_t> reference, unstable;
+    for (int f = 0; f < kCubeFaces; ++f)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const Vec3 d = pixel_direction(face_axes(f, R), x, y, n);
+          const OracleRay ray = brute_force_hits(scene, 0.0, eye, d, z_near);
+          if (ray.opaque.tri != kNoHit)
+            (ray.opaque.ambiguous ? unstable : reference).push_back(ray.opaque.tri);
+          reference.insert(reference.end(), ray.see_through.begin(), ray.see_through.end());
+          unstable.insert(unstable.end(), ray.see_through_ambiguous.begin(),
+                          ray.see_through_ambiguous.end());
+          if (ray.opaque.ambiguous) {  // what lies behind an unstable opaque hit is unstable too
+            const OracleSample all = brute_force_first_hit(scene, 0.0, eye, d, z_near);
+            if (all.tri != kNoHit) unstable.push_back(all.tri);
+          }
+        }
+    for (auto* v : {&reference, &unstable}) {
+      std::sort(v->begin(), v->end());
+      v->erase(std::unique(v->begin(), v->end()), v->end());
+    }
+    auto in = [](const std::vector<uint32_t>& v, uint32_t id) {
+      return std::binary_search(v.begin(), v.end(), id);
+    };
+    for (uint32_t id : reference) {
+      ++required;
+      if (!in(set, id) && !in(unstable, id)) ++missed;
+    }
+    for (uint32_t id : set) {
+      if (!in(reference, id) && !in(unstable, id)) ++extra;
+      see_through_seen += scene.triangle_see_through(id) ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(missed, 0u) << "of " << required;
+  EXPECT_EQ(extra, 0u);
+  EXPECT_GT(see_through_seen, 20u);
+}

@@ -221,12 +221,19 @@ TEST(QuakeBsp, OptionsSelectModelsAndLiquids) {
   ASSERT_EQ(omit.triangle_count(), 3u);
   EXPECT_EQ(omit.objects[1].name, "face2_sky4");
   EXPECT_EQ(omit.positions[0][4], (Vec3{0, 0, 0}));  // the sky triangle's first corner
-  try {
-    load(path, BspModels::world, BspLiquids::see_through);
-    FAIL() << "see-through liquids were accepted";
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("not supported yet"), std::string::npos) << e.what();
+  // See-through liquids: the same triangles as opaque ones, on see-through objects ('*' only).
+  Scene opaque = load(path);
+  Scene see = load(path, BspModels::world, BspLiquids::see_through);
+  ASSERT_EQ(see.triangle_count(), opaque.triangle_count());
+  ASSERT_EQ(see.objects.size(), opaque.objects.size());
+  size_t liquid_objects = 0;
+  for (const auto& o : see.objects) {
+    const bool liquid = o.name.find("_*") != std::string::npos;
+    EXPECT_EQ(o.see_through, liquid) << o.name;
+    liquid_objects += liquid;
   }
+  EXPECT_GT(liquid_objects, 0u);
+  EXPECT_EQ(opaque.has_see_through(), false);
   // The face -> triangle table behind both.
   QuakeBsp m = tiny_map();
   LoadOptions o;
@@ -390,8 +397,8 @@ TEST(QuakeBsp, CliInfoReportsQuakeUnitsAndExitsTwoOnABadMap) {
   EXPECT_NE(out.find("\"triangles\": 8"), std::string::npos) << out;
   ASSERT_EQ(run_pvs("info --json --bsp-liquids omit " + good, &out), 0) << out;
   EXPECT_NE(out.find("\"triangles\": 3"), std::string::npos) << out;
-  EXPECT_EQ(run_pvs("info --bsp-liquids see-through " + good, &out), 2) << out;
-  EXPECT_NE(out.find("not supported yet"), std::string::npos) << out;
+  ASSERT_EQ(run_pvs("info --json --bsp-liquids see-through " + good, &out), 0) << out;
+  EXPECT_EQ(out.find("\"see_through_triangles\": 0"), std::string::npos) << out;
   QuakeBsp m = tiny_map();
   m.faces[1].first_edge = 1000;
   std::string bad = write_map(dir, "bad.bsp", encode_bsp(m));

@@ -55,16 +55,21 @@ OracleSample RayOracle::sample(int face, int x, int y, double t) const {
   return {h.tri, h.lambda, is_ambiguous(face, x, y, t)};
 }
 
-OracleSample brute_force_first_hit(const Scene& scene, double tau, Vec3 eye, Vec3 dir,
-                                   double z_near) {
-  constexpr double inf = std::numeric_limits<double>::infinity();
-  struct Candidate {
-    uint32_t tri;
-    double lambda, min_bary;
-  };
-  std::vector<Candidate> on_ray;  // every triangle the ray passes within the barycentric margin
+namespace {
+
+struct Candidate {
+  uint32_t tri;
+  double lambda, min_bary;
+};
+
+// Every triangle the ray passes within the barycentric margin; `which(id)` false: skipped.
+template <class Which>
+std::vector<Candidate> candidates_on_ray(const Scene& scene, double tau, Vec3 eye, Vec3 dir,
+                                         Which which) {
+  std::vector<Candidate> on_ray;
   const bool single_state = scene.positions.size() == 1;
   for (uint32_t id = 0; id < scene.triangle_count(); ++id) {
+    if (!which(id)) continue;
     Vec3 p[3];
     for (int k = 0; k < 3; ++k) {
       const uint32_t vi = scene.triangles[id][k];
@@ -80,6 +85,12 @@ OracleSample brute_force_first_hit(const Scene& scene, double tau, Vec3 eye, Vec
     const double min_bary = std::min(std::min(u, v), 1.0 - u - v);
     if (min_bary >= -kReferenceBarycentric) on_ray.push_back({id, lambda, min_bary});
   }
+  return on_ray;
+}
+
+// The first hit among `on_ray` and its ambiguity (brute_force_first_hit).
+OracleSample first_of(const std::vector<Candidate>& on_ray, double z_near) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
   OracleSample out;
   out.lambda = inf;
   double winner_bary = 0;
@@ -96,6 +107,35 @@ OracleSample brute_force_first_hit(const Scene& scene, double tau, Vec3 eye, Vec
     if (std::fabs(c.lambda - z_near) <= kReferenceNear) out.ambiguous = true;
     // Another hit (or near miss) in front of or just behind the winner.
     if (c.lambda > z_near - kReferenceNear && c.lambda <= gap_limit) out.ambiguous = true;
+  }
+  return out;
+}
+
+}  // namespace
+
+OracleSample brute_force_first_hit(const Scene& scene, double tau, Vec3 eye, Vec3 dir,
+                                   double z_near) {
+  return first_of(candidates_on_ray(scene, tau, eye, dir, [](uint32_t) { return true; }), z_near);
+}
+
+OracleRay brute_force_hits(const Scene& scene, double tau, Vec3 eye, Vec3 dir, double z_near) {
+  OracleRay out;
+  out.opaque =
+      first_of(candidates_on_ray(scene, tau, eye, dir,
+                                 [&](uint32_t id) { return !scene.triangle_see_through(id); }),
+               z_near);
+  if (!scene.has_see_through()) return out;
+  const double far = out.opaque.lambda;
+  for (const Candidate& c : candidates_on_ray(
+           scene, tau, eye, dir, [&](uint32_t id) { return scene.triangle_see_through(id); })) {
+    const bool unstable = c.min_bary <= kReferenceBarycentric ||
+                          std::fabs(c.lambda - z_near) <= kReferenceNear ||
+                          (far < std::numeric_limits<double>::infinity() &&
+                           std::fabs(c.lambda - far) <= kReferenceDepthGap * far);
+    if (unstable)
+      out.see_through_ambiguous.push_back(c.tri);
+    else if (c.lambda > z_near && c.lambda <= far)
+      out.see_through.push_back(c.tri);
   }
   return out;
 }

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "vislib/base/cubemap.h"
 #include "vislib/base/vec.h"
@@ -83,7 +84,26 @@ class RayOracle {
 // kReferenceBarycentric lies in front of (or within the depth gap behind) the winner, or a triangle
 // on the ray lies within kReferenceNear of z_near. O(triangles) per ray: tiny scenes only.
 // `dir` must be finite and non-zero. Thread-safe, deterministic.
+// Every triangle counts as opaque here (Object::see_through is not read); brute_force_hits is
+// the oracle of the see-through rule.
 OracleSample brute_force_first_hit(const Scene& scene, double tau, Vec3 eye, Vec3 dir,
                                    double z_near);
+
+// One ray under the see-through rule (docs/visibility.md "See-through triangles"): the ray
+// passes through see-through triangles, recording each one, until the first opaque hit.
+struct OracleRay {
+  // The first opaque hit, with the ambiguity of brute_force_first_hit over the opaque triangles.
+  OracleSample opaque;
+  // See-through triangles hit at z_near < lambda <= opaque.lambda (a tie counts), ascending ids,
+  // without those in `see_through_ambiguous`.
+  std::vector<uint32_t> see_through;
+  // See-through triangles whose status is not stable: hit or missed within kReferenceBarycentric,
+  // within kReferenceNear of z_near, or within kReferenceDepthGap * lambda of the opaque hit. A
+  // test neither requires nor refuses them.
+  std::vector<uint32_t> see_through_ambiguous;
+};
+// The double-precision brute force of brute_force_first_hit with that rule. Thread-safe,
+// deterministic; O(triangles) per ray.
+OracleRay brute_force_hits(const Scene& scene, double tau, Vec3 eye, Vec3 dir, double z_near);
 
 }  // namespace vislib

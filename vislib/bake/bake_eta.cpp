@@ -7,6 +7,7 @@
 #include <cstring>
 #include <set>
 
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/kernel/region_visibility.h"
 

@@ -17,6 +17,7 @@ struct EmbreeScene::Impl {
   RTCScene scene = nullptr;
   Vec3 origin;
   size_t triangle_count = 0;
+  std::vector<uint8_t> see_through;  // per triangle (empty: none is)
   // Filled by the device error callback (which may run on any thread); raised as an exception by
   // check() on the calling thread, never thrown through Embree's C interface.
   std::atomic<bool> failed{false};
@@ -72,6 +73,34 @@ void exclude_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+// An intersect context for hits_through: the see-through triangles (passed through) and the
+// candidate hits on them (ray index, triangle, hit distance).
+struct ThroughContext {
+  RTCIntersectContext base;
+  const uint8_t* see_through;
+  struct Passed {
+    unsigned ray;
+    uint32_t tri;
+    float t;
+  };
+  std::vector<Passed> passed;
+};
+
+// Embree calls it for every candidate hit no farther than the ray's current tfar, with tfar set
+// to the candidate's distance: a see-through candidate is recorded and rejected, so the traversal
+// goes on to the first opaque hit, and every see-through hit in front of that one is recorded.
+void through_filter(const RTCFilterFunctionNArguments* args) {
+  auto* ctx = reinterpret_cast<ThroughContext*>(args->context);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const uint32_t tri = RTCHitN_primID(args->hit, args->N, i);
+    if (!ctx->see_through[tri]) continue;
+    ctx->passed.push_back(
+        {RTCRayN_id(args->ray, args->N, i), tri, RTCRayN_tfar(args->ray, args->N, i)});
+    args->valid[i] = 0;
+  }
+}
+
 RTCRayHit make_ray(Vec3 org, Vec3 dir, double tnear) {
   RTCRayHit rh;
   rh.ray.org_x = float(org.x);
@@ -106,6 +135,11 @@ EmbreeScene::EmbreeScene(const Scene& scene, double tau, Vec3 origin,
   Impl& im = *impl_;
   im.origin = origin;
   im.triangle_count = scene.triangle_count();
+  if (scene.has_see_through()) {
+    im.see_through.resize(scene.triangle_count());
+    for (size_t t = 0; t < scene.triangle_count(); ++t)
+      im.see_through[t] = scene.triangle_see_through(uint32_t(t)) ? 1 : 0;
+  }
   im.device = rtcNewDevice(device_config.empty() ? nullptr : device_config.c_str());
   if (!im.device)
     throw std::runtime_error("Embree: rtcNewDevice failed (error " +
@@ -212,6 +246,34 @@ void EmbreeScene::first_hits_from(const Vec3* eyes_world, const Vec3* dirs, size
     rays[i] = make_ray(eyes_world[i] - impl_->origin, dirs[i], tnear);
   rtcIntersect1M(impl_->scene, &ctx.base, rays.data(), unsigned(count), sizeof(RTCRayHit));
   for (size_t i = 0; i < count; ++i) out[i] = to_hit(rays[i]);
+  impl_->check();
+}
+
+bool EmbreeScene::has_see_through() const {
+  return !impl_->see_through.empty();
+}
+
+void EmbreeScene::hits_through(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear,
+                               Hit* out, std::vector<uint32_t>& passed) const {
+  if (impl_->see_through.empty()) {  // nothing to pass through
+    first_hits(eye_world, dirs, count, tnear, out);
+    return;
+  }
+  ThroughContext ctx;
+  rtcInitIntersectContext(&ctx.base);
+  ctx.base.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  ctx.base.filter = &through_filter;
+  ctx.see_through = impl_->see_through.data();
+  const Vec3 org = eye_world - impl_->origin;
+  std::vector<RTCRayHit> rays(count);
+  for (size_t i = 0; i < count; ++i) {
+    rays[i] = make_ray(org, dirs[i], tnear);
+    rays[i].ray.id = unsigned(i);
+  }
+  rtcIntersect1M(impl_->scene, &ctx.base, rays.data(), unsigned(count), sizeof(RTCRayHit));
+  for (size_t i = 0; i < count; ++i) out[i] = to_hit(rays[i]);
+  for (const ThroughContext::Passed& p : ctx.passed)
+    if (p.t <= rays[p.ray].ray.tfar) passed.push_back(p.tri);
   impl_->check();
 }
 

@@ -20,6 +20,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "vislib/base/vec.h"
 #include "vislib/scene/scene.h"
@@ -84,6 +85,18 @@ class EmbreeScene {
   // Thread-safe; deterministic.
   void first_hits_from(const Vec3* eyes_world, const Vec3* dirs, size_t count, double tnear,
                        const uint8_t* allowed, Hit* out) const;
+
+  // True when the scene was built with a see-through object (Object::see_through). The queries
+  // above ignore the class: they return the first surface, see-through or not.
+  bool has_see_through() const;
+
+  // The see-through rule (docs/visibility.md "See-through triangles") for `count` rays from
+  // one eye: out[i] is ray i's first opaque hit (see-through triangles are passed through by an
+  // intersect filter), and `passed` gets the id of every see-through triangle a ray hits at
+  // lambda > tnear no farther than its first opaque hit (as Embree decides it in float; a tie
+  // counts), in no particular order and possibly more than once. Thread-safe; deterministic.
+  void hits_through(Vec3 eye_world, const Vec3* dirs, size_t count, double tnear, Hit* out,
+                    std::vector<uint32_t>& passed) const;
 
  private:
   struct Impl;

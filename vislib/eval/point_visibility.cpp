@@ -47,7 +47,27 @@ std::vector<uint32_t> visible_set(const std::vector<uint32_t>& cubemap) {
 
 std::vector<uint32_t> point_visible_set(const EmbreeScene& scene, Vec3 eye, const Mat3& R, int n,
                                         double z_near) {
-  return visible_set(point_cubemap(scene, eye, R, n, z_near));
+  if (!scene.has_see_through()) return visible_set(point_cubemap(scene, eye, R, n, z_near));
+  // The see-through rule: each pixel's first opaque hit and the see-through hits in front of it.
+  const size_t side = size_t(n), rows = size_t(kCubeFaces) * side;
+  FaceAxes axes[kCubeFaces];
+  for (int k = 0; k < kCubeFaces; ++k) axes[k] = face_axes(k, R);
+  std::vector<std::vector<uint32_t>> row_ids(rows);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rows), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Vec3> dirs(side);
+    std::vector<Hit> hits(side);
+    for (size_t row = r.begin(); row != r.end(); ++row) {
+      const int face = int(row / side), y = int(row % side);
+      for (int x = 0; x < n; ++x) dirs[size_t(x)] = pixel_direction(axes[face], x, y, n);
+      std::vector<uint32_t>& ids = row_ids[row];
+      scene.hits_through(eye, dirs.data(), side, z_near, hits.data(), ids);
+      for (const Hit& h : hits)
+        if (h.tri != kNoHit) ids.push_back(h.tri);
+    }
+  });
+  std::vector<uint32_t> all;
+  for (const auto& ids : row_ids) all.insert(all.end(), ids.begin(), ids.end());
+  return visible_set(all);
 }
 
 namespace {

@@ -30,7 +30,9 @@ std::vector<uint32_t> point_cubemap(const EmbreeScene& scene, Vec3 eye, const Ma
 // Sorted unique triangle ids of a cubemap (kNoHit removed).
 std::vector<uint32_t> visible_set(const std::vector<uint32_t>& cubemap);
 
-// visible_set(point_cubemap(...)).
+// visible_set(point_cubemap(...)); with see-through triangles (EmbreeScene::has_see_through), the
+// see-through rule instead: each pixel's first opaque hit and every see-through triangle in front
+// of it (EmbreeScene::hits_through). point_cubemap itself keeps the first surface of any class.
 std::vector<uint32_t> point_visible_set(const EmbreeScene& scene, Vec3 eye, const Mat3& R, int n,
                                         double z_near);
 

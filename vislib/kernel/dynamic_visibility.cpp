@@ -472,6 +472,9 @@ class DynamicKind {
   }
 
   void begin_tile(Scratch& sc) const { sc.depths.clear(); }
+  // No see-through primitives here (segment_visibility refuses them in dynamic scenes).
+  void finish_tile(Scratch&, int, const TileRect&, const FaceAxes&, FoundMarks&,
+                   SegmentStats&) const {}
   size_t held_bytes(const Scratch& sc) const { return sc.depths.bytes(); }
 
   // Bounds of the view depth of every primitive over the run on this face: any hit of it at any s

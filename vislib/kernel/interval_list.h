@@ -94,14 +94,22 @@ const PieceT<D>& front(const PieceT<D>& a, const PieceT<D>& b, double t) {
 
 // Records a tie when `loser` is within rule.eps_z (relative to the front depth) of `winner` at t0,
 // at the middle and at t1 (for linear depths: over the whole of [t0, t1)).
+// True when `loser` lies within eps_z (relative to the front depth) of `winner` at t0, at the
+// middle and at t1: the tie test of H9.
+template <class D>
+bool tied(double eps_z, const PieceT<D>& winner, const PieceT<D>& loser, double t0, double t1) {
+  for (double t : {0.5 * (t0 + t1), t0, t1}) {
+    double w = winner.depth.at(t), l = loser.depth.at(t);
+    if (!(std::fabs(l - w) <= eps_z * std::fabs(w))) return false;
+  }
+  return true;
+}
+
 template <class D>
 void record_tie(const TieRule& rule, const PieceT<D>& winner, const PieceT<D>& loser, double t0,
                 double t1) {
-  for (double t : {0.5 * (t0 + t1), t0, t1}) {
-    double w = winner.depth.at(t), l = loser.depth.at(t);
-    if (!(std::fabs(l - w) <= rule.eps_z * std::fabs(w))) return;
-  }
-  rule.sink->push_back(TieRecord{t0, t1, loser.id, winner.id});
+  if (tied(rule.eps_z, winner, loser, t0, t1))
+    rule.sink->push_back(TieRecord{t0, t1, loser.id, winner.id});
 }
 
 // ---- Division-free decisions for linear depths ----------------------------------------------
@@ -460,6 +468,51 @@ void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieR
 template <class D, class F>
 void for_each_visible(const std::vector<PieceT<D>>& list, const std::vector<TieRecord>& ties, F f) {
   for_each_visible(list, ties, f, [](uint32_t) { return false; });
+}
+
+// See-through primitives (Object::see_through, docs/visibility.md "See-through
+// triangles") are never inserted into a list: they hide nothing. Calls f(t0, t1) for each
+// maximal stretch of [p.t0, p.t1) where the see-through coverage interval `p` is visible over the
+// final `list` of opaque pieces: where no piece covers, where p's depth is at most the piece's (an
+// exact tie counts as visible, whatever the ids), and, when `ties` is true, where the piece is in
+// front but p lies within eps_z of it (detail::tied, the H9 test insert_piece records). The
+// stretches are split at the depth crossings of p with each piece (computed with the pair in id
+// order, as insert_piece does) and merged where they touch, so they are the stretches a caller
+// measures against eps_len.
+template <class D, class F>
+void for_each_see_through_stretch(const std::vector<PieceT<D>>& list, const PieceT<D>& p, bool ties,
+                                  double eps_z, F f) {
+  double run0 = 0, run1 = -1;  // the current run [run0, run1) (empty while run1 < run0)
+  auto visible = [&](double a, double b) {
+    if (!(a < b)) return;
+    if (run1 == a) {
+      run1 = b;
+      return;
+    }
+    if (run0 < run1) f(run0, run1);
+    run0 = a;
+    run1 = b;
+  };
+  double cur = p.t0;
+  double cuts[kMaxCrossings + 2];
+  for (size_t i = 0; i < list.size() && list[i].t0 < p.t1; ++i) {
+    const PieceT<D>& I = list[i];
+    if (!(cur < I.t1)) continue;
+    if (cur < I.t0) visible(cur, I.t0);
+    const double lo = std::max(cur, I.t0), hi = std::min(p.t1, I.t1);
+    const int n = detail::crossings(I, p, lo, hi, cuts + 1);
+    cuts[0] = lo;
+    cuts[n + 1] = hi;
+    for (int k = 0; k <= n; ++k) {
+      const double a = cuts[k], b = cuts[k + 1], m = 0.5 * (a + b);
+      if (!(a < b)) continue;
+      if (p.depth.at(m) <= I.depth.at(m) || (ties && detail::tied(eps_z, I, p, a, b)))
+        visible(a, b);
+    }
+    cur = hi;
+  }
+  if (cur < p.t1) visible(cur, p.t1);
+  if (run0 < run1) f(run0, run1);
 }
 
 // True when the pieces cover [0, 1] without gap.

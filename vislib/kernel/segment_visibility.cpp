@@ -275,6 +275,10 @@ class StaticKind {
     std::vector<Pending> batch = std::vector<Pending>(kBatch);  // triangles set up, not composited
     std::vector<Vec2> hulls = std::vector<Vec2>(kBatch * kMaxFootprintPoints);  // a slot each
     size_t batch_size = 0;
+    // See-through triangles of the tile, set up, kept until its opaque lists are final
+    // (finish_tile); their hulls, a slot each.
+    std::vector<Pending> see_through;
+    std::vector<Vec2> see_through_hulls;
   };
 
   StaticKind(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt,
@@ -303,6 +307,7 @@ class StaticKind {
     // walk reaches get bounds, so nothing is classified up front.
     if (!opt.bvh)
       faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
+    has_see_through_ = scene.has_see_through();
   }
 
   static constexpr bool kHasBvh = true;
@@ -342,26 +347,29 @@ class StaticKind {
   // flushes the batch before it recomputes its bounds, so every culling is as strong as without
   // batches. Measured: 1.02-1.06x on the kernel suite; the search in insert_piece
   // no longer waits for memory, but most of that time moved elsewhere (docs/performance.md).
+  // See-through triangles (Object::see_through) take another path: they are set up here but
+  // composited into nothing; finish_tile tests them against the tile's final opaque lists. Scenes
+  // without them pay one predictable branch per (triangle, tile).
   void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {
-    auto c = scene_.corners(item.id, opt_.state);
-    Vec3 corners[3] = {c[0], c[1], c[2]};
-    Pending& b = sc.batch[sc.batch_size];
-    b.st = prepare_static_triangle(corners, v0_, v1_);
-    if (b.st.n == Vec3{0, 0, 0}) return;  // degenerate: never covers (H5)
-    b.y0 = std::max(rect.y0, box[2]);
-    b.y1 = std::min(rect.y1, box[3]);
-    if (b.y0 > b.y1) return;
-    Vec3 rel[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
-    b.hull_size = compute_footprint_hull(rel, 6, axes, opt_.near,
-                                         &sc.hulls[sc.batch_size * kMaxFootprintPoints], b.margin);
-    if (b.hull_size == 0) return;  // nothing in front of the near plane on this face
-    b.id = item.id;
-    b.zmin = item.zmin;
+    if (has_see_through_ && scene_.triangle_see_through(item.id)) {
+      sc.see_through.emplace_back();
+      sc.see_through_hulls.resize(sc.see_through.size() * kMaxFootprintPoints);
+      if (!set_up(sc.see_through.back(),
+                  &sc.see_through_hulls[sc.see_through_hulls.size() - kMaxFootprintPoints], item,
+                  box, rect, axes))
+        sc.see_through.pop_back();
+      return;
+    }
+    if (!set_up(sc.batch[sc.batch_size], &sc.hulls[sc.batch_size * kMaxFootprintPoints], item, box,
+                rect, axes))
+      return;
     if (++sc.batch_size == kBatch) flush(sc, rect, axes, stats);
   }
 
-  void begin_tile(Scratch&) const {}  // nothing kept beyond the driver's per-pixel state
+  void begin_tile(Scratch& sc) const {  // the driver resets the per-pixel state
+    sc.see_through.clear();
+  }
   size_t held_bytes(const Scratch&) const {
     return 0;
   }
@@ -382,7 +390,86 @@ class StaticKind {
     sc.batch_size = 0;
   }
 
+  // The see-through triangles of the tile against its final opaque lists (the driver calls this
+  // after the last flush): at each pixel of its footprint, the stretches of its coverage interval
+  // that no opaque piece hides (for_each_see_through_stretch) mark it, with a witness at the
+  // middle of the longest. Nothing is inserted, so the lists, and the opaque marks, are those of
+  // the scene without the see-through triangles. Per-pixel culling as for opaque triangles
+  // (`far` includes the tie margin).
+  void finish_tile(Scratch& sc, int face, const TileRect& rect, const FaceAxes& axes,
+                   FoundMarks& found, SegmentStats& stats) const {
+    const bool witnesses = !found.witness_len.empty();
+    for (size_t i = 0; i < sc.see_through.size(); ++i) {
+      const Pending& b = sc.see_through[i];
+      if (!witnesses && part_bounds_.empty() && found.seen[b.id]) continue;  // nothing to add
+      const Vec2* hull = &sc.see_through_hulls[i * kMaxFootprintPoints];
+      const StaticTriangle& st = b.st;
+      for (int y = b.y0; y <= b.y1; ++y) {
+        int x0, x1;
+        if (!footprint_row_span(hull, b.hull_size, b.margin, opt_.resolution, y, x0, x1)) continue;
+        x0 = std::max(x0, rect.x0);
+        x1 = std::min(x1, rect.x1);
+        const double tc = pixel_centers_[size_t(y)];
+        for (int x = x0; x <= x1; ++x) {
+          const size_t k = rect.index(x, y);
+          const Vec3 d = axes.F + axes.S * pixel_centers_[size_t(x)] + axes.T * tc;
+          const double far = sc.far[k];
+          if (opt_.depth_culling &&
+              (double(b.zmin) > far || (far < INFINITY && plane_behind(st, dot(d, st.n), far)))) {
+            ++stats.culled_pairs;
+            continue;
+          }
+          ++stats.pair_tests;
+          double lo, hi;
+          LinearDepth depth;
+          if (!static_coverage(st, d, axes.S, axes.T, opt_.near, lo, hi, depth)) continue;
+          ++stats.covered_pairs;
+          for_each_see_through_stretch(sc.lists[k], Piece{lo, hi, b.id, depth}, keep_ties_,
+                                       opt_.eps_z, [&](double t0, double t1) {
+                                         if (!part_bounds_.empty()) {
+                                           mark_parts(found, part_bounds_, opt_.eps_len, b.id, t0,
+                                                      t1);
+                                           return;
+                                         }
+                                         const double len = t1 - t0;
+                                         if (!(len > opt_.eps_len)) return;
+                                         if (!witnesses) {
+                                           found.seen[b.id] = 1;
+                                           return;
+                                         }
+                                         Witness w;
+                                         w.tri = b.id;
+                                         w.face = face;
+                                         w.x = x;
+                                         w.y = y;
+                                         w.t = 0.5 * (t0 + t1);
+                                         found.mark(b.id, len, w);
+                                       });
+        }
+      }
+    }
+  }
+
  private:
+  // Sets up triangle `item` for compositing in the tile (its hull written to `hull`); false when it
+  // covers nothing there.
+  bool set_up(Pending& b, Vec2* hull, const TileItem& item, const int* box, const TileRect& rect,
+              const FaceAxes& axes) const {
+    auto c = scene_.corners(item.id, opt_.state);
+    Vec3 corners[3] = {c[0], c[1], c[2]};
+    b.st = prepare_static_triangle(corners, v0_, v1_);
+    if (b.st.n == Vec3{0, 0, 0}) return false;  // degenerate: never covers (H5)
+    b.y0 = std::max(rect.y0, box[2]);
+    b.y1 = std::min(rect.y1, box[3]);
+    if (b.y0 > b.y1) return false;
+    Vec3 rel[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
+    b.hull_size = compute_footprint_hull(rel, 6, axes, opt_.near, hull, b.margin);
+    if (b.hull_size == 0) return false;  // nothing in front of the near plane on this face
+    b.id = item.id;
+    b.zmin = item.zmin;
+    return true;
+  }
+
   // The pairs of one batched triangle on row y of the tile.
   void cover_row(Scratch& sc, const Pending& b, const Vec2* hull, int y, const TileRect& rect,
                  const FaceAxes& axes, SegmentStats& stats) const {
@@ -484,6 +571,7 @@ class StaticKind {
   std::vector<PieceList>* pieces_;
   std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
   bool keep_ties_ = false;
+  bool has_see_through_ = false;
   double far_scale_ = 1.0;
   std::vector<double> pixel_centers_;
   decltype(&coverage4_scalar) coverage4_ = nullptr;
@@ -504,9 +592,11 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     if (scene.sphere_count() > 0 || scene.is_dynamic())
       throw std::invalid_argument("a segment can be split only in a static scene without spheres");
   }
-  if (scene.sphere_count() > 0 || scene.is_dynamic())
+  if (scene.sphere_count() > 0 || scene.is_dynamic()) {
+    if (scene.has_see_through()) throw std::invalid_argument(kSeeThroughStaticOnly);
     return dynamic_segment_visibility(scene, v0, v1, opt);  // resolves tile_size 0 itself
-  if (opt.tile_size == 0) {                                 // the kernel's choice
+  }
+  if (opt.tile_size == 0) {  // the kernel's choice
     SegmentOptions o = opt;
     o.tile_size = kStaticTileSize;
     return segment_visibility(scene, v0, v1, o);

@@ -135,11 +135,25 @@ struct SegmentResult {
   SegmentStats stats;
 };
 
+// The error of the kernels for see-through objects (Object::see_through) in a scene with moving
+// vertices or spheres: only static triangles can be see-through.
+constexpr const char* kSeeThroughStaticOnly =
+    "see-through objects are supported only in static scenes without spheres (no moving vertices, "
+    "no spheres)";
+
 // Visibility of the scene's triangles and spheres from the segment v0 -> v1. A static scene
 // without spheres takes the linear path (key state `options.state`); a scene with moving vertices
 // or spheres takes the dynamic kernel (dynamic_visibility.cpp; quadratic events only for what
 // moves; dynamic_visibility.h) in `options.mode`. Thread-safe (reads the scene only); parallel with
 // TBB.
+// See-through triangles (Object::see_through; docs/visibility.md "See-through triangles")
+// hide nothing: one is visible where its coverage interval at a pixel is not behind the final list
+// of the opaque triangles there (a depth tie with an opaque piece, within eps_z under
+// CoplanarRule::Both and exact under First, counts as visible); the lists (`pieces`) hold opaque
+// triangles only, and the opaque marks are those of the scene without the see-through triangles.
+// Its witness is a pixel and t where the ray from v(t) reaches it before any opaque surface (or
+// at a tie); see-through triangles in front do not block it. Scenes with moving vertices or
+// spheres and a see-through object: std::invalid_argument(kSeeThroughStaticOnly).
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
                                  const SegmentOptions& options);
 

@@ -42,6 +42,10 @@
 //   void flush(Scratch&, const TileRect&, const FaceAxes&, SegmentStats&) const;
 //                          composite what cover() held back; called before the driver
 //                          recomputes its culling bounds, and before the tile's results
+//   void finish_tile(Scratch&, int face, const TileRect&, const FaceAxes&, FoundMarks&,
+//                    SegmentStats&) const;  after the last flush, with the tile's lists final:
+//                          mark what is tested against them without being composited
+//                          (see-through triangles)
 //   void finish_pixel(Scratch&, size_t k, int face, int x, int y, FoundMarks&) const;
 //                          report the non-empty list of pixel k = (y - y0) * stride + (x - x0)
 //   static constexpr bool kHasBvh;          true: also
@@ -442,6 +446,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                             }
                           }
                           flush();  // what the kind still holds back
+                          kind.finish_tile(sc, face, rect, axes, found, stats);
                           // Tile results: marks, witnesses, pieces, statistics.
                           size_t bytes = kind.held_bytes(sc);
                           for (int y = rect.y0; y <= rect.y1; ++y)

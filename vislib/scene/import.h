@@ -25,7 +25,7 @@ enum class BspModels {
 enum class BspLiquids {
   opaque,       // ordinary triangles: they occlude
   omit,         // left out of the scene
-  see_through,  // seen but not occluding: not supported yet (load_scene throws InputError)
+  see_through,  // kept, on see-through objects (Object::see_through): seen but not occluding
 };
 
 struct LoadOptions {

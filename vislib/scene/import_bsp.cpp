@@ -1,7 +1,7 @@
 // import_bsp.cpp: compiled Quake maps (.bsp: BSP29, BSP2, 2PSB; quake_bsp.h) as scenes.
 //
 // The faces bsp_face_triangles selects (model 0 by default, every model with BspModels::all;
-// liquid faces kept or omitted) become objects, one per face, in map face order, named
+// liquid faces kept, omitted or see-through) become objects, one per face, in map face order, named
 // "face<F>_<texture>" (F = the map's face index). Each face gets its own block of vertices, its
 // edge loop in stored order converted to y-up (quake_to_scene), and is fan-triangulated
 // (v0, vi, vi+1): face F's triangles are bsp_face_triangles(...)[F]. Sky faces are kept as
@@ -15,11 +15,6 @@ namespace vislib {
 
 Scene load_bsp(const std::string& path, const LoadOptions& options,
                std::vector<std::string>& warnings) {
-  if (options.bsp_liquids == BspLiquids::see_through)
-    throw InputError(path,
-                     "liquid faces as see-through triangles are not supported yet (the kernel has "
-                     "no triangle class that is seen but does not occlude): use --bsp-liquids "
-                     "opaque or omit");
   const QuakeBsp bsp = read_quake_bsp(path);
   const std::vector<BspFaceTriangles> faces = bsp_face_triangles(bsp, options);
   Scene scene;
@@ -33,7 +28,11 @@ Scene load_bsp(const std::string& path, const LoadOptions& options,
   for (uint32_t f = 0; f < bsp.faces.size(); ++f) {
     if (!faces[f].imported) continue;
     const uint32_t object = uint32_t(scene.objects.size());
-    scene.objects.push_back({"face" + std::to_string(f) + "_" + bsp.face_texture(f)});
+    const std::string texture = bsp.face_texture(f);
+    scene.objects.push_back({"face" + std::to_string(f) + "_" + texture});
+    // Liquids (a '*' texture) seen but not occluding, as the compiler's vis treated them.
+    scene.objects.back().see_through =
+        options.bsp_liquids == BspLiquids::see_through && !texture.empty() && texture[0] == '*';
     const uint32_t first = uint32_t(pos.size());
     for (uint32_t v : bsp.face_vertices(f)) {
       const auto& q = bsp.vertices[v];

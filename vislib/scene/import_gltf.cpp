@@ -3,8 +3,10 @@
 // What is imported: the default scene (scene 0 if none is set; all root nodes if the file has no
 // scenes), nodes depth-first with children in order, TRS or matrix transforms composed in double;
 // every node with a mesh becomes one Object (node name, else mesh name, else "node<i>") with its
-// own copy of the vertices (instancing flattened). TRIANGLES, TRIANGLE_STRIP and TRIANGLE_FAN
-// primitives in order (points and lines are skipped with a warning); indexed or not.
+// own copy of the vertices (instancing flattened); it is see-through (Object::see_through) when
+// one of its triangle primitives uses a material with alphaMode BLEND or MASK. TRIANGLES,
+// TRIANGLE_STRIP and TRIANGLE_FAN primitives in order (points and lines are skipped with a
+// warning); indexed or not.
 //
 // Robustness: tinygltf parses the JSON and loads buffers, but every bufferView and accessor range
 // is checked here before a byte is read, so a bad file gives InputError, never a crash. Images
@@ -97,6 +99,21 @@ Mat4 to_matrix(const Trs& x) {
     for (int r = 0; r < 3; ++r) m.m[c * 4 + r] = R[r][c] * x.s[c];
   for (int r = 0; r < 3; ++r) m.m[12 + r] = x.t[r];
   return m;
+}
+
+// True when a triangle primitive of mesh `m` uses a material whose alphaMode is BLEND or MASK:
+// its node's object is see-through (docs/scene-model.md "See-through objects"). One such
+// primitive makes the whole object see-through, the direction that never hides what is behind
+// it.
+bool see_through_mesh(const tinygltf::Model& model, int m) {
+  for (const auto& prim : model.meshes[size_t(m)].primitives) {
+    const bool triangles = prim.mode == 4 || prim.mode == 5 || prim.mode == 6 || prim.mode == -1;
+    if (!triangles || prim.material < 0 || size_t(prim.material) >= model.materials.size())
+      continue;
+    const std::string& mode = model.materials[size_t(prim.material)].alphaMode;
+    if (mode == "BLEND" || mode == "MASK") return true;
+  }
+  return false;
 }
 
 // The inverse transpose of the linear part of `a` applied to `n` (a normal), not normalised.
@@ -594,6 +611,7 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
                                                              : "node" + std::to_string(n);
     uint32_t obj = uint32_t(scene.objects.size());
     scene.objects.push_back({name});
+    scene.objects.back().see_through = see_through_mesh(model, nd.mesh);
     const std::vector<std::vector<Mat4>> joint_m = joint_matrices(ctx, n, poses);
     std::vector<Vec3> morphed;
     for (const Prim& p : mesh_cache[nd.mesh]) {

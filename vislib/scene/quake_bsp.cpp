@@ -550,7 +550,6 @@ bool bsp_texture_sky(const std::string& name) {
 }
 
 std::vector<BspFaceTriangles> bsp_face_triangles(const QuakeBsp& bsp, const LoadOptions& options) {
-  assert(options.bsp_liquids != BspLiquids::see_through);
   std::vector<uint8_t> selected(bsp.faces.size(), 0);
   const size_t models = options.bsp_models == BspModels::all ? bsp.models.size() : 1;
   for (size_t i = 0; i < models; ++i)

@@ -147,7 +147,8 @@ inline bool bsp_texture_liquid(const std::string& name) {
 }
 // True for a sky texture (name starts with "sky", case-insensitive).
 bool bsp_texture_sky(const std::string& name);
-// One entry per map face. `options.bsp_liquids` must not be see_through (not supported yet).
+// One entry per map face. Liquid faces are kept for BspLiquids::opaque and see_through (the
+// importer marks the latter's objects see-through) and left out for omit.
 std::vector<BspFaceTriangles> bsp_face_triangles(const QuakeBsp& bsp, const LoadOptions& options);
 
 // Leaf `leaf`'s visibility row decoded: the leaves (1..visleafs, increasing) it sees. Leaf 0 and

@@ -1,5 +1,7 @@
 #include "vislib/scene/scene.h"
 
+#include <fnmatch.h>
+
 #include <cassert>
 #include <cmath>
 
@@ -11,6 +13,31 @@ bool Scene::is_dynamic() const {
   for (size_t k = 1; k < sphere_centers.size(); ++k)
     if (sphere_centers[k] != sphere_centers[0]) return true;
   return false;
+}
+
+bool Scene::has_see_through() const {
+  for (const Object& o : objects)
+    if (o.see_through) return true;
+  return false;
+}
+
+size_t Scene::see_through_triangle_count() const {
+  if (!has_see_through()) return 0;
+  size_t n = 0;
+  for (uint32_t o : triangle_object) n += objects[o].see_through ? 1 : 0;
+  return n;
+}
+
+size_t mark_see_through(Scene& scene, const std::vector<std::string>& patterns) {
+  size_t marked = 0;
+  for (Object& o : scene.objects)
+    for (const std::string& p : patterns)
+      if (fnmatch(p.c_str(), o.name.c_str(), 0) == 0) {
+        o.see_through = true;
+        ++marked;
+        break;
+      }
+  return marked;
 }
 
 namespace {

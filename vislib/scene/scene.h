@@ -23,8 +23,16 @@
 
 namespace vislib {
 
+// An object's triangles are either opaque (the default) or see-through. A see-through triangle
+// is seen but hides nothing (water, glass, windows, foliage cards): it is visible from an eye
+// along a direction where no opaque surface lies in front of it (a depth tie with an opaque
+// surface counts as visible), and every surface behind it stays visible through it. The class is
+// per object because it is a property of the material, and an object is what every format names
+// (glTF node, OBJ group, BSP texture); docs/scene-model.md "See-through objects". Spheres are
+// always opaque: the kernels refuse a see-through object with spheres.
 struct Object {
-  std::string name;  // glTF node/mesh name, OBJ group/object name, or generated name
+  std::string name;          // glTF node/mesh name, OBJ group/object name, or generated name
+  bool see_through = false;  // its triangles are seen but do not occlude
 };
 
 struct Scene {
@@ -59,6 +67,14 @@ struct Scene {
     const auto& t = triangles[tri];
     return {p[t[0]], p[t[1]], p[t[2]]};
   }
+  // True when triangle `tri` belongs to a see-through object.
+  bool triangle_see_through(uint32_t tri) const {
+    return objects[triangle_object[tri]].see_through;
+  }
+  // True when some object is see-through; an O(objects) scan.
+  bool has_see_through() const;
+  // Number of triangles of see-through objects.
+  size_t see_through_triangle_count() const;
   // Bounding box over all states of vertices and spheres (radius included).
   Box3 bounds() const;
 };
@@ -66,5 +82,12 @@ struct Scene {
 // Appends `other` to `scene` (ids of `other` follow those of `scene`). Both must have the same
 // state count, or one of them a single state (which is then repeated).
 void append_scene(Scene& scene, const Scene& other);
+
+// Marks every object whose name matches one of `patterns` (shell globs as fnmatch(3) reads them,
+// without flags: `*`, `?` and `[...]`; a literal `*` is `[*]`) see-through. Returns the number of
+// objects it marked (already see-through ones included). This is the call an importer or a
+// command-line option makes; an importer that knows its materials may set Object::see_through
+// itself.
+size_t mark_see_through(Scene& scene, const std::vector<std::string>& patterns);
 
 }  // namespace vislib

@@ -39,6 +39,8 @@ SceneInfo scene_info(const Scene& s) {
   info.triangles = s.triangle_count();
   info.vertices = s.vertex_count();
   info.objects = s.objects.size();
+  for (const Object& o : s.objects) info.see_through_objects += o.see_through ? 1 : 0;
+  info.see_through_triangles = s.see_through_triangle_count();
   info.states = s.state_count();
   info.spheres = s.sphere_count();
   info.dynamic = s.is_dynamic();
@@ -80,6 +82,8 @@ std::string to_json(const SceneInfo& info, int indent) {
   j["triangles"] = info.triangles;
   j["vertices"] = info.vertices;
   j["objects"] = info.objects;
+  j["see_through_objects"] = info.see_through_objects;
+  j["see_through_triangles"] = info.see_through_triangles;
   j["states"] = info.states;
   j["spheres"] = info.spheres;
   j["dynamic"] = info.dynamic;

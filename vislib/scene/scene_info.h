@@ -10,6 +10,8 @@ namespace vislib {
 
 struct SceneInfo {
   size_t triangles = 0, vertices = 0, objects = 0, states = 0, spheres = 0;
+  // Object::see_through: objects so marked and their triangles.
+  size_t see_through_objects = 0, see_through_triangles = 0;
   bool dynamic = false;
   Box3
       bbox;  // over all states, spheres with their radius (Scene::bounds); empty for an empty scene
