@@ -47,6 +47,11 @@ json summary(pvs::Reader& r) {
                    {"box", box_json(L.grid_box)},
                    {"grid", {L.nx, L.ny, L.nz}},
                    {"eye_band", {L.eye_lo, L.eye_hi}}};
+  else if (L.kind == pvs::LayoutKind::BspTree)
+    j["layout"] = {{"kind", "bsp-tree"},
+                   {"planes", L.planes.size()},
+                   {"nodes", L.nodes.size()},
+                   {"leaves", L.leaf_cell.size()}};
   else
     j["layout"] = {{"kind", "boxes"}};
   json md = json::parse(info.metadata, nullptr, false);
@@ -98,6 +103,10 @@ void print_summary(const std::string& path, const json& j) {
     std::printf("  %u cells: grid %s over %s, eye band %s above each cell's bottom\n",
                 j["cells"].get<unsigned>(), L["grid"].dump().c_str(), L["box"].dump().c_str(),
                 L["eye_band"].dump().c_str());
+  else if (L["kind"] == "bsp-tree")
+    std::printf("  %u cells: BSP tree of %s nodes, %s planes, %s leaves\n",
+                j["cells"].get<unsigned>(), L["nodes"].dump().c_str(), L["planes"].dump().c_str(),
+                L["leaves"].dump().c_str());
   else
     std::printf("  %u cells: box list\n", j["cells"].get<unsigned>());
   std::printf("  metadata %s\n", j["metadata"].dump().c_str());

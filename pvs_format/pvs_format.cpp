@@ -1,4 +1,5 @@
-// pvs_format.cpp: the PVS file format, version 1 (docs/pvs-format.md). Standard library only.
+// pvs_format.cpp: the PVS file format, versions 1 and 2 (docs/pvs-format.md). Standard library
+// only.
 #include "pvs_format/pvs_format.h"
 
 #include <algorithm>
@@ -36,12 +37,28 @@ bool operator==(const Box& a, const Box& b) {
   return true;
 }
 
+bool operator==(const BspPlane& a, const BspPlane& b) {
+  return a.normal[0] == b.normal[0] && a.normal[1] == b.normal[1] && a.normal[2] == b.normal[2] &&
+         a.dist == b.dist;
+}
+
+bool operator==(const BspNode& a, const BspNode& b) {
+  return a.plane == b.plane && a.children[0] == b.children[0] && a.children[1] == b.children[1];
+}
+
 bool operator==(const CellLayout& a, const CellLayout& b) {
   if (a.kind != b.kind) return false;
   if (a.kind == LayoutKind::Grid)
     return a.grid_box == b.grid_box && a.nx == b.nx && a.ny == b.ny && a.nz == b.nz &&
            a.eye_lo == b.eye_lo && a.eye_hi == b.eye_hi;
+  if (a.kind == LayoutKind::BspTree)
+    return a.boxes == b.boxes && a.planes == b.planes && a.nodes == b.nodes && a.root == b.root &&
+           a.leaf_cell == b.leaf_cell && a.cell_leaf == b.cell_leaf && a.neighbours == b.neighbours;
   return a.boxes == b.boxes;
+}
+
+uint32_t format_version_for(LayoutKind kind) {
+  return kind == LayoutKind::BspTree ? 2 : 1;
 }
 
 // ---- Checksums and hashes --------------------------------------------------------------------
@@ -313,12 +330,12 @@ std::vector<uint32_t> decode_sorted_delta(std::string_view payload, uint32_t uni
 // ---- Layout ---------------------------------------------------------------------------------
 
 uint32_t CellLayout::cell_count() const {
-  if (kind == LayoutKind::Boxes) return uint32_t(boxes.size());
+  if (kind != LayoutKind::Grid) return uint32_t(boxes.size());
   return nx * ny * nz;
 }
 
 Box CellLayout::cell_box(uint32_t cell) const {
-  if (kind == LayoutKind::Boxes) return boxes.at(cell);
+  if (kind != LayoutKind::Grid) return boxes.at(cell);
   uint32_t n[3] = {nx, ny, nz};
   uint32_t i[3] = {cell % nx, (cell / nx) % ny, cell / nx / ny};
   Box b;
@@ -340,7 +357,26 @@ Box CellLayout::view_region(uint32_t cell) const {
   return b;
 }
 
+std::optional<uint32_t> CellLayout::find_leaf(const double p[3]) const {
+  if (kind != LayoutKind::BspTree) return std::nullopt;
+  int32_t at = root;
+  for (size_t steps = 0; at >= 0; ++steps) {
+    if (steps >= nodes.size() || size_t(at) >= nodes.size()) return std::nullopt;
+    const BspNode& node = nodes[size_t(at)];
+    if (node.plane >= planes.size()) return std::nullopt;
+    const BspPlane& pl = planes[node.plane];
+    double d = pl.normal[0] * p[0] + pl.normal[1] * p[1] + pl.normal[2] * p[2] - pl.dist;
+    at = node.children[d > 0 ? 0 : 1];
+  }
+  return uint32_t(-(int64_t(at) + 1));
+}
+
 std::optional<uint32_t> CellLayout::find_cell(const double p[3]) const {
+  if (kind == LayoutKind::BspTree) {
+    std::optional<uint32_t> leaf = find_leaf(p);
+    if (!leaf || *leaf >= leaf_cell.size() || leaf_cell[*leaf] == kNoCell) return std::nullopt;
+    return leaf_cell[*leaf];
+  }
   auto inside = [&](const Box& b) {
     for (int a = 0; a < 3; ++a)
       if (!(p[a] >= b.min[a] && p[a] <= b.max[a])) return false;
@@ -371,6 +407,155 @@ std::optional<uint32_t> CellLayout::find_cell(const double p[3]) const {
   }
   return idx[0] + nx * (idx[1] + ny * idx[2]);
 }
+
+// ---- BSP-tree layouts ---------------------------------------------------------------------------
+
+namespace {
+
+// What is wrong with a BSP-tree layout: the part of the layout section and the index in it (the
+// reader turns these into a file offset, the writer into its message).
+struct BspProblem {
+  enum Part { Plane, Node, Root, LeafCell, CellLeaf, Neighbours } part;
+  uint32_t index;
+  std::string what;
+};
+
+// The one check of the BSP fields (CellLayout's preconditions), shared by writer and reader.
+std::optional<BspProblem> check_bsp(const CellLayout& L) {
+  const uint64_t P = L.planes.size(), N = L.nodes.size(), NL = L.leaf_cell.size(),
+                 C = L.boxes.size();
+  if (N > 0x7FFFFFFFull || NL > 0x80000000ull)
+    return BspProblem{BspProblem::Root, 0, "more nodes or leaves than child references reach"};
+  if (L.cell_leaf.size() != C || L.neighbours.size() != C)
+    return BspProblem{BspProblem::CellLeaf, 0, "cell_leaf, neighbours and boxes differ in size"};
+  for (uint32_t i = 0; i < P; ++i) {
+    const BspPlane& p = L.planes[i];
+    bool finite = std::isfinite(p.dist), nonzero = false;
+    for (double v : p.normal) {
+      finite = finite && std::isfinite(v);
+      nonzero = nonzero || v != 0;
+    }
+    if (!finite || !nonzero)
+      return BspProblem{BspProblem::Plane, i,
+                        "plane " + std::to_string(i) + " is not finite with a nonzero normal"};
+  }
+  // A child reference: "" when in range.
+  auto bad_ref = [&](int32_t ref) -> std::string {
+    if (ref >= 0) {
+      if (uint64_t(ref) >= N)
+        return "node " + std::to_string(ref) + " out of range (" + std::to_string(N) + " nodes)";
+    } else if (uint64_t(-(int64_t(ref) + 1)) >= NL) {
+      return "leaf " + std::to_string(-(int64_t(ref) + 1)) + " out of range (" +
+             std::to_string(NL) + " leaves)";
+    }
+    return "";
+  };
+  for (uint32_t i = 0; i < N; ++i) {
+    const BspNode& n = L.nodes[i];
+    if (n.plane >= P)
+      return BspProblem{BspProblem::Node, i,
+                        "node " + std::to_string(i) + ": plane " + std::to_string(n.plane) +
+                            " out of range (" + std::to_string(P) + " planes)"};
+    for (int32_t ref : n.children)
+      if (std::string e = bad_ref(ref); !e.empty())
+        return BspProblem{BspProblem::Node, i, "node " + std::to_string(i) + ": child " + e};
+  }
+  if (std::string e = bad_ref(L.root); !e.empty())
+    return BspProblem{BspProblem::Root, 0, "root: " + e};
+  // Every node reached exactly once from the root: a tree, so every walk ends in a leaf within
+  // N steps.
+  std::vector<uint8_t> seen(N, 0);
+  std::vector<uint8_t> leaf_reached(NL, 0);
+  std::vector<int32_t> stack = {L.root};
+  if (L.root >= 0) seen[size_t(L.root)] = 1;
+  while (!stack.empty()) {
+    int32_t ref = stack.back();
+    stack.pop_back();
+    if (ref < 0) {
+      leaf_reached[size_t(-(int64_t(ref) + 1))] = 1;
+      continue;
+    }
+    for (int32_t child : L.nodes[size_t(ref)].children) {
+      if (child >= 0) {
+        if (seen[size_t(child)])
+          return BspProblem{BspProblem::Node, uint32_t(ref),
+                            "node " + std::to_string(ref) + ": child node " +
+                                std::to_string(child) +
+                                " is reached twice (a cycle or a shared subtree)"};
+        seen[size_t(child)] = 1;
+      }
+      stack.push_back(child);
+    }
+  }
+  for (uint32_t i = 0; i < N; ++i)
+    if (!seen[i])
+      return BspProblem{BspProblem::Node, i,
+                        "node " + std::to_string(i) + " is not reachable from the root"};
+  for (uint32_t l = 0; l < NL; ++l) {
+    uint32_t c = L.leaf_cell[l];
+    if (c != kNoCell && (c >= C || L.cell_leaf[c] != l))
+      return BspProblem{BspProblem::LeafCell, l,
+                        "leaf " + std::to_string(l) + " names cell " + std::to_string(c) +
+                            ", which is not a cell of that leaf"};
+  }
+  for (uint32_t c = 0; c < C; ++c) {
+    uint32_t l = L.cell_leaf[c];
+    if (l >= NL || L.leaf_cell[l] != c)
+      return BspProblem{BspProblem::CellLeaf, c,
+                        "cell " + std::to_string(c) + " names leaf " + std::to_string(l) +
+                            ", which is not the leaf of that cell"};
+    if (!leaf_reached[l])
+      return BspProblem{BspProblem::CellLeaf, c,
+                        "cell " + std::to_string(c) + ": leaf " + std::to_string(l) +
+                            " is not reached by the tree"};
+  }
+  for (uint32_t c = 0; c < C; ++c) {
+    const std::vector<uint32_t>& nb = L.neighbours[c];
+    for (size_t i = 0; i < nb.size(); ++i) {
+      uint32_t o = nb[i];
+      std::string e;
+      if (o >= C)
+        e = "neighbour " + std::to_string(o) + " out of range";
+      else if (o == c)
+        e = "the cell is its own neighbour";
+      else if (i > 0 && o <= nb[i - 1])
+        e = "neighbours not strictly increasing";
+      else if (!std::binary_search(L.neighbours[o].begin(), L.neighbours[o].end(), c))
+        e = "neighbour " + std::to_string(o) + " does not list this cell back";
+      if (!e.empty())
+        return BspProblem{BspProblem::Neighbours, c, "cell " + std::to_string(c) + ": " + e};
+    }
+  }
+  return std::nullopt;
+}
+
+void put_bsp_layout(std::string& out, const CellLayout& L) {
+  put_u32(out, uint32_t(L.planes.size()));
+  put_u32(out, uint32_t(L.nodes.size()));
+  put_u32(out, uint32_t(L.leaf_cell.size()));
+  put_u32(out, uint32_t(L.root));
+  for (const BspPlane& p : L.planes) {
+    for (double v : p.normal) put_f64(out, v);
+    put_f64(out, p.dist);
+  }
+  for (const BspNode& n : L.nodes) {
+    put_u32(out, n.plane);
+    put_u32(out, uint32_t(n.children[0]));
+    put_u32(out, uint32_t(n.children[1]));
+  }
+  for (uint32_t c : L.leaf_cell) put_u32(out, c);
+  for (size_t c = 0; c < L.boxes.size(); ++c) {
+    put_u32(out, L.cell_leaf[c]);
+    for (double v : L.boxes[c].min) put_f64(out, v);
+    for (double v : L.boxes[c].max) put_f64(out, v);
+  }
+  for (const std::vector<uint32_t>& nb : L.neighbours) {
+    put_u32(out, uint32_t(nb.size()));
+    for (uint32_t o : nb) put_u32(out, o);
+  }
+}
+
+}  // namespace
 
 // ---- Writer ---------------------------------------------------------------------------------
 
@@ -502,6 +687,10 @@ StreamWriter::StreamWriter(FileInfo info, Sink sink) : impl_(std::make_unique<Im
   } else {
     if (L.boxes.size() > 0xFFFFFFFFull) throw std::invalid_argument("write_pvs: too many cells");
     for (const Box& b : L.boxes) check_box(b, "cell box");
+    if (L.kind == LayoutKind::BspTree) {
+      if (std::optional<BspProblem> p = check_bsp(L))
+        throw std::invalid_argument("write_pvs: BSP tree: " + p->what);
+    }
   }
   if (info.metadata.size() > 0xFFFFFFFFull)
     throw std::invalid_argument("write_pvs: metadata too long");
@@ -522,6 +711,8 @@ StreamWriter::StreamWriter(FileInfo info, Sink sink) : impl_(std::make_unique<Im
     put_u32(out, L.nz);
     put_f64(out, L.eye_lo);
     put_f64(out, L.eye_hi);
+  } else if (L.kind == LayoutKind::BspTree) {
+    put_bsp_layout(out, L);
   } else {
     for (const Box& b : L.boxes) put_box(out, b);
   }
@@ -599,7 +790,7 @@ WriteStats StreamWriter::finish() {
   const CellLayout& L = w.info.layout;
   std::string h;
   h.append(kMagic, 8);
-  put_u32(h, kFormatVersion);
+  put_u32(h, format_version_for(L.kind));
   put_u32(h, w.info.partial ? 1u : 0u);
   put_u64(h, w.at);
   put_u64(h, w.info.scene_fingerprint);
@@ -649,6 +840,96 @@ std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells, W
 }
 
 // ---- Reader ---------------------------------------------------------------------------------
+
+namespace {
+
+// Reads a BSP-tree layout (docs/pvs-format.md, "BSP tree") of `n` cells from `l`, up to the
+// metadata, then checks it (check_bsp). Every count is held against the bytes left before
+// anything is allocated for it.
+void read_bsp_layout(Cursor& l, uint32_t n, CellLayout& L) {
+  const uint64_t counts_at = l.offset();
+  const uint32_t P = l.u32(), N = l.u32(), NL = l.u32();
+  const uint64_t root_at = l.offset();
+  L.root = int32_t(l.u32());
+  // `at`: the offset of the count.
+  auto room = [&](uint64_t count, uint64_t each, uint64_t at, const char* what) {
+    if (count * each > l.remaining())
+      throw FormatError(at, std::to_string(count) + " " + what + " of " + std::to_string(each) +
+                                " bytes do not fit in the " + std::to_string(l.remaining()) +
+                                " bytes left of the layout section");
+  };
+  room(P, 32, counts_at, "planes");
+  const uint64_t planes_at = l.offset();
+  L.planes.resize(P);
+  for (BspPlane& p : L.planes) {
+    for (double& v : p.normal) v = l.f64();
+    p.dist = l.f64();
+  }
+  room(N, 12, counts_at + 4, "nodes");
+  const uint64_t nodes_at = l.offset();
+  L.nodes.resize(N);
+  for (BspNode& node : L.nodes) {
+    node.plane = l.u32();
+    node.children[0] = int32_t(l.u32());
+    node.children[1] = int32_t(l.u32());
+  }
+  room(NL, 4, counts_at + 8, "leaves");
+  const uint64_t leaves_at = l.offset();
+  L.leaf_cell.resize(NL);
+  for (uint32_t& c : L.leaf_cell) c = l.u32();
+  room(n, 56, 36,
+       "cells");  // the header's cell_count: 52 bytes of leaf and box, 4 or more of neighbours
+  const uint64_t cells_at = l.offset();
+  L.cell_leaf.resize(n);
+  L.boxes.resize(n);
+  for (uint32_t c = 0; c < n; ++c) {
+    L.cell_leaf[c] = l.u32();
+    uint64_t at = l.offset();
+    Box& b = L.boxes[c];
+    for (double& v : b.min) v = l.f64();
+    for (double& v : b.max) v = l.f64();
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(b.min[a]) || !std::isfinite(b.max[a]) || !(b.min[a] <= b.max[a]))
+        throw FormatError(at, "box is not finite with min <= max");
+  }
+  std::vector<uint64_t> neighbours_at(n);
+  L.neighbours.resize(n);
+  for (uint32_t c = 0; c < n; ++c) {
+    neighbours_at[c] = l.offset();
+    uint32_t k = l.u32();
+    if (uint64_t(k) * 4 > l.remaining())
+      throw FormatError(neighbours_at[c], "cell " + std::to_string(c) + ": " + std::to_string(k) +
+                                              " neighbours do not fit in the layout section");
+    L.neighbours[c].resize(k);
+    for (uint32_t& o : L.neighbours[c]) o = l.u32();
+  }
+  if (std::optional<BspProblem> p = check_bsp(L)) {
+    uint64_t at = counts_at;
+    switch (p->part) {
+      case BspProblem::Plane:
+        at = planes_at + 32 * uint64_t(p->index);
+        break;
+      case BspProblem::Node:
+        at = nodes_at + 12 * uint64_t(p->index);
+        break;
+      case BspProblem::Root:
+        at = root_at;
+        break;
+      case BspProblem::LeafCell:
+        at = leaves_at + 4 * uint64_t(p->index);
+        break;
+      case BspProblem::CellLeaf:
+        at = cells_at + 52 * uint64_t(p->index);
+        break;
+      case BspProblem::Neighbours:
+        at = neighbours_at[p->index];
+        break;
+    }
+    throw FormatError(at, "BSP tree: " + p->what);
+  }
+}
+
+}  // namespace
 
 struct Reader::Source {
   virtual ~Source() = default;
@@ -804,7 +1085,11 @@ void Reader::open(const ReadOptions& options) {
   if (gran > 1) throw FormatError(40, "unknown granularity " + std::to_string(gran));
   info_.granularity = Granularity(gran);
   uint8_t kind = h.u8();
-  if (kind > 1) throw FormatError(41, "unknown cell layout " + std::to_string(kind));
+  if (kind > 2) throw FormatError(41, "unknown cell layout " + std::to_string(kind));
+  if (version < format_version_for(LayoutKind(kind)))
+    throw FormatError(41, "cell layout " + std::to_string(kind) + " needs format version " +
+                              std::to_string(format_version_for(LayoutKind(kind))) +
+                              ", the file is version " + std::to_string(version));
   info_.layout.kind = LayoutKind(kind);
   info_.max_delta_depth = h.u8();
   if (h.u8() != 0) throw FormatError(43, "reserved byte is not zero");
@@ -813,7 +1098,10 @@ void Reader::open(const ReadOptions& options) {
     if (h.u8() != 0) throw FormatError(48 + i, "reserved byte is not zero");
 
   // Layout section.
-  const uint64_t layout_fixed = kind == 0 ? 76 : uint64_t(n) * 48;
+  // (A BSP tree's section is at least its 16 count bytes and 56 bytes per cell.)
+  const uint64_t layout_fixed = kind == 0   ? 76
+                                : kind == 1 ? uint64_t(n) * 48
+                                            : 16 + uint64_t(n) * 56;
   if (uint64_t(layout_size) < layout_fixed + 8)
     throw FormatError(44, "layout section of " + std::to_string(layout_size) +
                               " bytes is too small for " + std::to_string(n) + " cells");
@@ -863,6 +1151,8 @@ void Reader::open(const ReadOptions& options) {
     L.eye_hi = l.f64();
     if (!std::isfinite(L.eye_lo) || !std::isfinite(L.eye_hi) || !(L.eye_lo <= L.eye_hi))
       throw FormatError(at, "eye band is not finite with eye_lo <= eye_hi");
+  } else if (L.kind == LayoutKind::BspTree) {
+    read_bsp_layout(l, n, L);
   } else {
     L.boxes.resize(n);
     for (Box& b : L.boxes) read_box(b);

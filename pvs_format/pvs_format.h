@@ -1,5 +1,5 @@
 // pvs_format.h: writing and reading PVS files (potentially visible sets per view cell), format
-// version 1, specified byte for byte in docs/pvs-format.md.
+// versions 1 and 2, specified byte for byte in docs/pvs-format.md.
 //
 // This library depends on the C++ standard library only (house style, "Which way the arrows
 // point"): an engine embeds it to load a PVS without vislib or its dependencies. It knows nothing
@@ -25,8 +25,10 @@
 
 namespace pvs {
 
-// The version this library writes, and the newest it reads.
-constexpr uint32_t kFormatVersion = 1;
+// The newest version this library reads. It writes version 1 for grid and box-list layouts (so
+// their files stay byte-identical to what version-1 writers wrote) and version 2 for the BSP-tree
+// layout, which version 1 does not have (format_version_for).
+constexpr uint32_t kFormatVersion = 2;
 // The eight magic bytes that open every PVS file ("\x89PVS\r\n\x1a\n", PNG-style: a text-mode
 // transfer or a 7-bit channel damages them visibly).
 constexpr char kMagic[8] = {'\x89', 'P', 'V', 'S', '\r', '\n', '\x1a', '\n'};
@@ -47,7 +49,9 @@ class FormatError : public std::runtime_error {
 };
 
 enum class Granularity : uint8_t { Triangle = 0, Object = 1 };
-enum class LayoutKind : uint8_t { Grid = 0, Boxes = 1 };
+enum class LayoutKind : uint8_t { Grid = 0, Boxes = 1, BspTree = 2 };
+// The version a file with this layout is written as: 1 for Grid and Boxes, 2 for BspTree.
+uint32_t format_version_for(LayoutKind kind);
 
 // How one cell's block is encoded (the first byte of the block).
 enum class Encoding : uint8_t {
@@ -65,16 +69,47 @@ struct Box {
 };
 bool operator==(const Box& a, const Box& b);
 
+// One plane of a BSP-tree layout: the points p with dot(normal, p) - dist = 0 (scene units, y up).
+struct BspPlane {
+  double normal[3] = {0, 0, 0};
+  double dist = 0;
+};
+// A child reference of a BSP node (as in a Quake map): >= 0 the node of that index, < 0 the leaf
+// number -(child + 1).
+constexpr uint32_t kNoCell = 0xFFFFFFFFu;  // BSP leaf without a cell (solid, sky, not baked)
+struct BspNode {
+  uint32_t plane = 0;
+  int32_t children[2] = {0, 0};  // [0] front: d > 0; [1] back: d <= 0 (CellLayout::find_cell)
+};
+bool operator==(const BspPlane& a, const BspPlane& b);
+bool operator==(const BspNode& a, const BspNode& b);
+
 // Where the cells are. Grid: the box split into nx * ny * nz equal cells, cell id
 // x + nx * (y + ny * z); a cell's view region spans its x and z range and the eye band
 // [bottom + eye_lo, bottom + eye_hi] above the cell's bottom face. Boxes: one box per cell, which
 // is both the cell and its view region (vislib's walkable cells: the eye band above a floor).
+// BspTree: a BSP tree (planes, nodes, a root) whose leaves are numbered as in the map it comes
+// from; each cell is one leaf (cell_leaf), each leaf is one cell or none (leaf_cell, kNoCell for
+// solid, sky or leaves not baked); `boxes` holds the bounding box of each cell's volume, and
+// `neighbours` each cell's neighbour cells (leaves sharing a portal: computed by the writer's
+// caller, stored as given: sorted, unique, symmetric, without the cell itself). Preconditions of
+// the BSP fields (checked by the writer, enforced by the reader): plane indices and child
+// references in range, finite planes with a nonzero normal, every node reached exactly once from
+// the root (a tree: no cycle, no shared or unreachable node), cell_leaf and leaf_cell inverse to
+// each other, every cell's leaf reached by the tree.
 struct CellLayout {
   LayoutKind kind = LayoutKind::Grid;
   Box grid_box;
   uint32_t nx = 1, ny = 1, nz = 1;
   double eye_lo = 0, eye_hi = 0;
-  std::vector<Box> boxes;
+  std::vector<Box> boxes;  // Boxes: the cells; BspTree: each cell's bounding box
+  // BspTree only.
+  std::vector<BspPlane> planes;
+  std::vector<BspNode> nodes;
+  int32_t root = -1;                // a child reference (a node, or a leaf for a one-leaf tree)
+  std::vector<uint32_t> leaf_cell;  // per leaf number: its cell or kNoCell
+  std::vector<uint32_t> cell_leaf;  // per cell: its leaf number
+  std::vector<std::vector<uint32_t>> neighbours;  // per cell
 
   uint32_t cell_count() const;  // nx * ny * nz (grid, must fit 32 bits) or boxes.size()
   // The lookup box of cell `cell` (< cell_count()): grid cell (i, j, k) spans
@@ -82,17 +117,25 @@ struct CellLayout {
   // order of operations (the last cell ends exactly at max).
   Box cell_box(uint32_t cell) const;
   // The view region of cell `cell`: for a grid, the cell box with y replaced by the eye band;
-  // for a box list, the box itself.
+  // for a box list, the box itself; for a BSP tree, the bounding box of the cell's volume (the
+  // region itself is the leaf's convex volume, which this box only bounds).
   Box view_region(uint32_t cell) const;
-  // The first cell (in id order) whose lookup box contains p (boundaries inclusive), if any.
-  // Grid: O(1); box list: a linear scan.
+  // Grid and box list: the first cell (in id order) whose lookup box contains p (boundaries
+  // inclusive), if any; grid O(1), box list a linear scan. BSP tree: walks from the root, at each
+  // node computing d = n[0]*p[0] + n[1]*p[1] + n[2]*p[2] - dist in binary64 in that order and going
+  // to the front child when d > 0, to the back child otherwise (a point on a plane goes back, as in
+  // the Quake engine's Mod_PointInLeaf), until a leaf; then that leaf's cell, nullopt for a leaf
+  // without one. O(depth). A NaN coordinate goes back at every node.
   std::optional<uint32_t> find_cell(const double p[3]) const;
+  // BSP tree: the leaf number `p` falls in (the walk of find_cell). nullopt for other layouts, or
+  // if the walk exceeds nodes.size() steps (a cyclic tree the reader would have rejected).
+  std::optional<uint32_t> find_leaf(const double p[3]) const;
 };
 bool operator==(const CellLayout& a, const CellLayout& b);
 
 // Everything of a file except the visible sets.
 struct FileInfo {
-  uint32_t version = kFormatVersion;
+  uint32_t version = 1;  // as read; the writer writes format_version_for(layout.kind)
   bool partial = false;  // some cells are Absent (a shard of a bake)
   uint64_t scene_fingerprint = 0;
   uint32_t universe = 0;  // number of ids at this granularity (scene triangles or objects)
@@ -119,7 +162,8 @@ struct WriteStats {
 // Deterministic: same arguments, same bytes.
 // Preconditions: cells.size() == info.layout.cell_count(); every set sorted, unique, ids <
 // info.universe; some cell absent only if info.partial; layout boxes finite with min <= max;
-// grid nx, ny, nz >= 1; eye_lo <= eye_hi. Violations throw std::invalid_argument.
+// grid nx, ny, nz >= 1; eye_lo <= eye_hi; a BSP tree as CellLayout says. Violations throw
+// std::invalid_argument. A BSP-tree layout is delta-encoded as a box list over its bounding boxes.
 std::string write_pvs(const FileInfo& info, const std::vector<CellSet>& cells,
                       WriteStats* stats = nullptr);
 

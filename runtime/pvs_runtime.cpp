@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <iterator>
 #include <string_view>
 
 namespace pvs_runtime {
@@ -203,7 +204,7 @@ void finish_open(Pvs::Impl& impl_ref, const OpenOptions& options) {
   if (options.expected_fingerprint && *options.expected_fingerprint != info.scene_fingerprint)
     throw FingerprintMismatch(*options.expected_fingerprint, info.scene_fingerprint);
   if (options.verify_all_blocks) impl->reader->verify();
-  if (info.layout.kind == pvs::LayoutKind::Boxes) impl->buckets.build(info.layout.boxes);
+  if (info.layout.kind != pvs::LayoutKind::Grid) impl->buckets.build(info.layout.boxes);
 }
 
 }  // namespace
@@ -223,7 +224,7 @@ std::optional<uint32_t> Pvs::find_cell(const double position[3]) const {
   for (int k = 0; k < 3; ++k)
     if (!std::isfinite(position[k])) return std::nullopt;
   const pvs::CellLayout& layout = info().layout;
-  if (layout.kind == pvs::LayoutKind::Grid) return layout.find_cell(position);
+  if (layout.kind != pvs::LayoutKind::Boxes) return layout.find_cell(position);
   for (uint32_t c : impl_->buckets.candidates(position[0], position[0], position[2], position[2]))
     if (box_contains(layout.boxes[c], position))
       return c;  // candidates are sorted: lowest id first
@@ -258,9 +259,19 @@ std::vector<uint32_t> Pvs::neighbours(uint32_t cell, double margin) const {
     std::sort(out.begin(), out.end());
     return out;
   }
+  // BSP tree: the stored neighbours (leaves sharing a portal), and with a margin > 0 also the
+  // cells whose bounding boxes come within it.
+  const bool bsp = layout.kind == pvs::LayoutKind::BspTree;
+  if (bsp && !(margin > 0)) return layout.neighbours[cell];
   for (uint32_t c : impl_->buckets.candidates(me.min[0] - margin, me.max[0] + margin,
                                               me.min[2] - margin, me.max[2] + margin))
     if (c != cell && boxes_overlap(me, layout.boxes[c], margin)) out.push_back(c);
+  if (bsp) {
+    std::vector<uint32_t> both;
+    std::set_union(out.begin(), out.end(), layout.neighbours[cell].begin(),
+                   layout.neighbours[cell].end(), std::back_inserter(both));
+    return both;
+  }
   return out;
 }
 

@@ -89,15 +89,19 @@ class Pvs {
 
   // The cell whose lookup box contains `position` (x, y, z in scene units, y up; boundaries
   // inclusive, the lowest cell id wins on shared faces), or nullopt if none does (the eye is
-  // outside every cell: an engine typically keeps the last cell). Same answer as
-  // pvs::CellLayout::find_cell. A NaN or infinite coordinate gives nullopt. Grid: O(1); box list:
-  // O(boxes in one bucket) through a 2D bucket grid over x and z built at open.
+  // outside every cell: an engine typically keeps the last cell). BSP tree: the cell of the leaf
+  // the walk down the stored planes reaches, nullopt for a leaf without a cell (solid, sky, not
+  // baked). Same answer as pvs::CellLayout::find_cell. A NaN or infinite coordinate gives
+  // nullopt. Grid: O(1); box list: O(boxes in one bucket) through a 2D bucket grid over x and z
+  // built at open; BSP tree: O(tree depth).
   std::optional<uint32_t> find_cell(const double position[3]) const;
 
   // The cells to prefetch around `cell` (< cell_count()): every other cell whose lookup box comes
   // within `margin` scene units (margin >= 0) of this cell's box on every axis, i.e. the boxes
   // overlap once this one is grown by `margin`. margin = 0: the cells that touch it (for a grid,
-  // the up to 26 around it); margin = +infinity: every other cell. Sorted by id, without `cell`.
+  // the up to 26 around it); margin = +infinity: every other cell. BSP tree: the neighbours the
+  // file stores (leaves sharing a portal), plus for margin > 0 the cells whose bounding boxes
+  // come within `margin` of this cell's. Sorted by id, without `cell`.
   std::vector<uint32_t> neighbours(uint32_t cell, double margin = 0.0) const;
 
   // Number of visible ids of `cell`, from the index (no block is read). 0 for an absent cell.

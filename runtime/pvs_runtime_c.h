@@ -47,7 +47,7 @@ typedef struct pvs_rt_info {
   uint32_t cell_count;
   uint32_t universe;    /* ids are < universe */
   uint32_t granularity; /* 0: triangle ids, 1: object ids */
-  uint32_t layout;      /* 0: grid, 1: box list */
+  uint32_t layout;      /* 0: grid, 1: box list, 2: BSP tree */
   uint32_t partial;     /* 1 if some cells may be absent */
   uint64_t scene_fingerprint;
   uint64_t file_size;
