@@ -87,12 +87,13 @@ PY
 # The near-far frames against pvs view's, each with the same choices: first pinned (centre on
 # the eye, 15,40), then pvs view's own (its default centre: the centre of the cell's view region,
 # moved to a free point when the scene encloses it; its default radii), which it reports and the
-# page is given. Eye lookup, 512 x 512 faces, 90 degrees, 320 x 240. PSNR at least 38 dB.
-nf_compare() {  # NAME CENTRE R1,R2
+# page is given; last the same with the cylinder lookup. Eye lookup, 512 x 512 faces, 90 degrees,
+# 320 x 240. PSNR at least 38 dB.
+nf_compare() {  # NAME CENTRE R1,R2 [LOOKUP]
   set +e
   PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
     --path "0,1.6,0@30,1.6,0" --fov 90 --size 320x240 --near-far "$3" --centre "$2" \
-    --env-size 512 --lookup eye --json "$work/$1.json" --png "$work/$1" --png-frames 0
+    --env-size 512 --lookup "${4:-eye}" --json "$work/$1.json" --png "$work/$1" --png-frames 0
   local rc=$?
   set -e
   [[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh ($1) exited $rc"; exit 1; }
@@ -121,6 +122,10 @@ nf_compare near_far 0,1.6,0 15,40
 read -r centre radii < <(python3 -c 'import json, sys; j = json.load(open(sys.argv[1]))
 print(",".join(repr(v) for v in j["centre"]), "%r,%r" % (j["r1"], j["r2"]))' "$work/near_far_default/cpu.json")
 nf_compare near_far_default "$centre" "$radii"
+"$pvs" view "$work/city.pvs" --scene "$root/data/city.glb" --at 0,1.6,0 --look 30,1.6,0 \
+  --near-far "$radii" --centre "$centre" --env-size 512 --lookup cylinder --frame 320x240 -q \
+  -o "$work/near_far_cylinder/cpu.png"
+nf_compare near_far_cylinder "$centre" "$radii" cylinder
 centre=0,1.6,0
 # CloVR: entering the crossing's cell, the near region grows by the C API's scheduler; 40 frames
 # at the same eye. The near count never shrinks, grows (frame 0 injects the first merged ring's
