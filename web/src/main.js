@@ -6,7 +6,8 @@
 // (vertical, default 60), prefetch=MARGIN (on entering a cell, fetch the blocks of its neighbours
 // within MARGIN scene units; off by default, so that only visited cells are fetched), overlay=0
 // (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
-// frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size).
+// frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size),
+// nearfar=r1,r2 with centre=x,y,z, envsize=N, lookup=eye|cylinder and clovr=1 (docs/web.md).
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
 // scene), and the overlay says so in red.
