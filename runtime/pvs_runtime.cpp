@@ -296,6 +296,20 @@ std::pair<uint64_t, uint32_t> Pvs::block_range(uint32_t cell) const {
   return {e.offset, e.size};
 }
 
+std::vector<uint32_t> Pvs::delta_chain(uint32_t cell) {
+  assert(cell < cell_count());
+  std::vector<uint32_t> chain{cell};
+  for (;;) {
+    const pvs::BlockInfo bi = impl_->reader->block_info(chain.back());
+    if (bi.encoding != pvs::Encoding::Delta) return chain;
+    if (chain.size() > size_t(impl_->reader->info().max_delta_depth))
+      throw pvs::FormatError(impl_->reader->entry(chain.back()).offset,
+                             "cell " + std::to_string(cell) + ": Delta chain longer than " +
+                                 std::to_string(impl_->reader->info().max_delta_depth));
+    chain.push_back(bi.reference);
+  }
+}
+
 void Pvs::prefetch(uint32_t cell) {
   assert(cell < cell_count());
   const pvs::IndexEntry& e = impl_->reader->entry(cell);

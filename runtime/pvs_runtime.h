@@ -120,6 +120,13 @@ class Pvs {
   // block is read).
   std::pair<uint64_t, uint32_t> block_range(uint32_t cell) const;
 
+  // The cells whose blocks visible_ids(cell) reads: `cell` first, then the cell each Delta block
+  // refers to, until a block that is not a Delta (at most info().max_delta_depth references).
+  // Reads those blocks (each once; no ids are decoded): a streaming client calls it for a
+  // neighbour and so fetches the neighbour's whole chain ahead. Throws pvs::FormatError on a
+  // corrupt block or a chain longer than max_delta_depth.
+  std::vector<uint32_t> delta_chain(uint32_t cell);
+
   // Asks the OS to page in the block of `cell` (madvise MADV_WILLNEED on its byte range, from the
   // index; returns immediately, reads nothing). The blocks of its Delta chain are not known
   // without reading the block, so they are paged in when visible_ids() decodes it. Call it for the

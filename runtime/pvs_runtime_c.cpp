@@ -198,6 +198,23 @@ pvs_rt_status pvs_rt_block_range(const pvs_rt* h, uint32_t cell, uint64_t* offse
   return PVS_RT_OK;
 }
 
+pvs_rt_status pvs_rt_delta_chain(pvs_rt* h, uint32_t cell, uint32_t* out, size_t capacity,
+                                 size_t* count) {
+  if (!h || !count || (capacity && !out))
+    return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_delta_chain: null argument");
+  if (pvs_rt_status s = check_cell(h, cell)) return s;
+  return guarded([&] {
+    const std::vector<uint32_t> chain = h->pvs.delta_chain(cell);
+    *count = chain.size();
+    if (chain.size() > capacity)
+      return fail(PVS_RT_BUFFER_TOO_SMALL, "pvs_rt_delta_chain: cell " + std::to_string(cell) +
+                                               "'s chain has " + std::to_string(chain.size()) +
+                                               " cells, capacity " + std::to_string(capacity));
+    std::memcpy(out, chain.data(), chain.size() * sizeof(uint32_t));
+    return PVS_RT_OK;
+  });
+}
+
 pvs_rt_status pvs_rt_prefetch(pvs_rt* h, uint32_t cell) {
   if (!h) return fail(PVS_RT_INVALID_ARGUMENT, "pvs_rt_prefetch: null handle");
   if (pvs_rt_status s = check_cell(h, cell)) return s;

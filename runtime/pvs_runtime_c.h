@@ -113,6 +113,16 @@ PVS_RT_API pvs_rt_status pvs_rt_visible_ids(pvs_rt* handle, uint32_t cell, uint3
 PVS_RT_API pvs_rt_status pvs_rt_block_range(const pvs_rt* handle, uint32_t cell, uint64_t* offset,
                                             uint32_t* size);
 
+/* The cells whose blocks pvs_rt_visible_ids(cell) reads: `cell` first, then the cell each Delta
+ * block refers to (at most pvs_rt_info's max delta depth more). Reads those blocks (on a
+ * pvs_rt_open_ranges handle: asks the callback for each, and for nothing else), decodes no ids:
+ * what a streaming client calls to fetch a neighbour's whole chain ahead, then
+ * pvs_rt_block_range names each block's bytes. Writes at most `capacity` cells to `out`; *count
+ * receives their number (PVS_RT_BUFFER_TOO_SMALL if it exceeds capacity; 1 + the max delta depth
+ * is always enough). PVS_RT_FORMAT on a corrupt block or too long a chain. */
+PVS_RT_API pvs_rt_status pvs_rt_delta_chain(pvs_rt* handle, uint32_t cell, uint32_t* out,
+                                            size_t capacity, size_t* count);
+
 /* Asks the OS to page in the cell's block (returns immediately). */
 PVS_RT_API pvs_rt_status pvs_rt_prefetch(pvs_rt* handle, uint32_t cell);
 

@@ -6,8 +6,10 @@
 #
 # Usage: web-check.sh SCENE PVS --path "x,y,z[@lx,ly,lz];..." --json OUT
 #                     [--png DIR --png-frames 0,4,9] [--size WxH] [--fov DEG] [--bare]
-#                     [--popping K] [--near-far r1,r2 [--centre x,y,z] [--env-size N]]
+#                     [--popping K] [--near-far r1,r2 [--centre x,y,z] [--env-size N]
+#                      [--lookup eye|cylinder] [--clovr]] [--prefetch MARGIN]
 # --popping K: the popping meter every K frames (popping_pixels per measured frame).
+# --clovr: the near region grows by the CloVR scheduler on entering a cell (per frame: clovr).
 # --bare: the frames without the overlays (to compare with pvs inspect --render's frames).
 # Exit: 0 done, 1 the page failed, 2 bad arguments or missing build, 77 chromium cannot start.
 set -euo pipefail
@@ -19,7 +21,12 @@ shift 2
 path_text="" json="" png="" png_frames="" size=640x400 fov=60 extra=
 while [[ $# -gt 0 ]]; do
   if [[ $1 == --bare ]]; then
-    extra="&overlay=0"
+    extra+="&overlay=0"
+    shift
+    continue
+  fi
+  if [[ $1 == --clovr ]]; then
+    extra+="&clovr=1"
     shift
     continue
   fi
@@ -35,6 +42,8 @@ while [[ $# -gt 0 ]]; do
     --near-far) extra+="&nearfar=$2" ;;
     --centre) extra+="&centre=$2" ;;
     --env-size) extra+="&envsize=$2" ;;
+    --lookup) extra+="&lookup=$2" ;;
+    --prefetch) extra+="&prefetch=$2" ;;
     *) echo "web-check: unknown option $1" >&2; usage ;;
   esac
   shift 2

@@ -14,7 +14,9 @@ web_stage() {
   [[ -f $pvs ]] || { echo "web: $pvs: no such file" >&2; return 2; }
   STAGE=$(mktemp -d "${TMPDIR:-/tmp}/vislib-web.XXXXXX")
   ln -s "$root/web" "$STAGE/web"
-  "$exe" export "$scene" -o "$STAGE/scene.glb" -q || return 2
+  # WEB_STATES=K: sample the scene's animation at K states (pvs export --states K), so that the
+  # GLB carries them as morph targets and the page knows the moving (dynamic) triangles.
+  "$exe" export "$scene" ${WEB_STATES:+--states "$WEB_STATES"} -o "$STAGE/scene.glb" -q || return 2
   PVS_NAME=$(basename "$pvs")
   ln -s "$(realpath "$pvs")" "$STAGE/$PVS_NAME"
   SERVER_LOG=$STAGE/server.log

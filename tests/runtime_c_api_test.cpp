@@ -503,3 +503,46 @@ TEST(RuntimeCApi, OpenRangesAsksForHeaderIndexAndTheQueriedCellsBlocksOnly) {
   EXPECT_EQ(pvs_rt_open_ranges(rc.bytes.size() - 1, read_range, &log, 0, 0, &h2), PVS_RT_FORMAT);
   std::filesystem::remove(rc.path);
 }
+
+TEST(RuntimeCApi, DeltaChainNamesAndReadsExactlyTheBlocksVisibleIdsNeeds) {
+  const RangeCase rc = make_range_case();
+  pvs::Reader reader = pvs::Reader::from_memory(rc.bytes);
+  RangeLog log{rc.bytes, {}, false};
+  pvs_rt* h = nullptr;
+  ASSERT_EQ(pvs_rt_open_ranges(rc.bytes.size(), read_range, &log, 0, 0, &h), PVS_RT_OK);
+  size_t longest = 0;
+  for (uint32_t cell = 0; cell < 30; ++cell) {
+    // Oracle: the blocks visible_ids asks for (the callback's log), in order.
+    log.ranges.clear();
+    EXPECT_EQ(ids_of(h, cell), reader.read_cell(cell));
+    const auto read_by_ids = log.ranges;
+    log.ranges.clear();
+    uint32_t chain[16];
+    size_t count = 0;
+    ASSERT_EQ(pvs_rt_delta_chain(h, cell, chain, 16, &count), PVS_RT_OK) << pvs_rt_last_error();
+    ASSERT_GE(count, 1u);
+    EXPECT_EQ(chain[0], cell);
+    std::vector<std::pair<uint64_t, uint64_t>> named;
+    for (size_t k = 0; k < count; ++k) {
+      uint64_t off = 0;
+      uint32_t size = 0;
+      ASSERT_EQ(pvs_rt_block_range(h, chain[k], &off, &size), PVS_RT_OK);
+      named.emplace_back(off, off + size);
+    }
+    EXPECT_EQ(named, read_by_ids) << "cell " << cell;
+    EXPECT_EQ(log.ranges, read_by_ids) << "cell " << cell << ": the chain reads its blocks only";
+    longest = std::max(longest, size_t(count));
+    if (count > 1) {
+      size_t small = 0;
+      EXPECT_EQ(pvs_rt_delta_chain(h, cell, chain, count - 1, &small), PVS_RT_BUFFER_TOO_SMALL);
+      EXPECT_EQ(small, count);
+    }
+  }
+  EXPECT_GT(longest, 1u) << "the case should exercise Delta chains";
+  size_t count = 0;
+  uint32_t one = 0;
+  EXPECT_EQ(pvs_rt_delta_chain(h, 30, &one, 1, &count), PVS_RT_INVALID_ARGUMENT);
+  EXPECT_EQ(pvs_rt_delta_chain(nullptr, 0, &one, 1, &count), PVS_RT_INVALID_ARGUMENT);
+  pvs_rt_close(h);
+  std::filesystem::remove(rc.path);
+}

@@ -25,7 +25,9 @@ function accessorArray(gltf, bin, index, want) {
 }
 
 // Returns {positions: Float32Array(9 * T) (triangle t's corners at 9t..9t+8, de-indexed),
-// triangleObject: Uint32Array(T), objectCount, objectNames}. Throws on anything else than the
+// triangleObject: Uint32Array(T), dynamic: Uint8Array(T) (1: a vertex of the triangle moves in
+// some state, as vislib::moving_triangles; positions are the rest state 0), objectCount,
+// objectNames}. Throws on anything else than the
 // export's layout (node transforms, non-triangle primitives, several scenes).
 export function parseGlb(arrayBuffer) {
   const dv = new DataView(arrayBuffer);
@@ -53,25 +55,34 @@ export function parseGlb(arrayBuffer) {
       if ((prim.mode ?? 4) !== 4) throw new Error(`mesh ${node.mesh}: not TRIANGLES`);
       const pos = accessorArray(gltf, bin, prim.attributes.POSITION, 3);
       const idx = accessorArray(gltf, bin, prim.indices, 1);
-      parts.push({pos, idx});
+      // A vertex moves when a morph target (the export's states 1..K-1) displaces it.
+      const moves = new Uint8Array(pos.length / 3);
+      for (const target of prim.targets || []) {
+        const d = accessorArray(gltf, bin, target.POSITION, 3);
+        for (let v = 0; v < moves.length; ++v)
+          if (d[3 * v] !== 0 || d[3 * v + 1] !== 0 || d[3 * v + 2] !== 0) moves[v] = 1;
+      }
+      parts.push({pos, idx, moves});
       objects.push([object, idx.length / 3]);
       total += idx.length / 3;
     }
   });
   const positions = new Float32Array(9 * total);
   const triangleObject = new Uint32Array(total);
+  const dynamic = new Uint8Array(total);
   let t = 0;
-  parts.forEach(({pos, idx}, k) => {
+  parts.forEach(({pos, idx, moves}, k) => {
     const [object, n] = objects[k];
     for (let i = 0; i < 3 * n; ++i) {
       const v = idx[i];
       positions[3 * (3 * t) + 3 * (i % 3)] = pos[3 * v];
       positions[3 * (3 * t) + 3 * (i % 3) + 1] = pos[3 * v + 1];
       positions[3 * (3 * t) + 3 * (i % 3) + 2] = pos[3 * v + 2];
+      if (moves[v]) dynamic[t] = 1;
       if (i % 3 === 2) triangleObject[t++] = object;
     }
   });
-  return {positions, triangleObject, objectCount: nodes.length, objectNames: names};
+  return {positions, triangleObject, dynamic, objectCount: nodes.length, objectNames: names};
 }
 
 // splitmix64 as vislib/eval/render.cpp has it (BigInt: 64-bit wrapping arithmetic).

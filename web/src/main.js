@@ -6,7 +6,8 @@
 // (vertical, default 60), prefetch=MARGIN (on entering a cell, fetch the blocks of its neighbours
 // within MARGIN scene units; off by default, so that only visited cells are fetched), overlay=0
 // (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
-// frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size).
+// frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size),
+// nearfar=r1,r2 with centre=x,y,z, envsize=N, lookup=eye|cylinder and clovr=1 (docs/web.md).
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
 // scene), and the overlay says so in red.
@@ -28,40 +29,103 @@ const overlay = document.getElementById("overlay");
 const mapCanvas = document.getElementById("map");
 const canvas = document.getElementById("view");
 
-// Near-far (near-far paper §4.1, Eq. 1 with a = r2 - r, runtime/near_far.h morph_vertex): with
-// nearFar on, a vertex at axis distance r from the centre O is kept (r <= r1), sent to
-// U + |OP| d_O (r >= r2: where O's environment map shows it) or, in between, to U + t d with
-// d = normalize(w d_U + (1 - w) d_O), t = w |UP| + (1 - w) |OP|, w = (r2 - r) / (r2 - r1).
+// Vertex displacement by `mode` (the GPU counterparts of runtime/near_far.h, which the worker's
+// partition and scheduler use through the C API):
+//   0: none.
+//   1: near-far Eq. 1 (near-far paper §4.1, morph_vertex, a = r2 - r): a vertex at axis distance
+//      r from the centre O is kept (r <= r1), sent to U + |OP| d_O (r >= r2: where O's
+//      environment map shows it) or, in between, to U + t d with d = normalize(w d_U + (1 - w)
+//      d_O), t = w |UP| + (1 - w) |OP|, w = (r2 - r) / (r2 - r1).
+//   2: Eq. 2 for dynamic far vertices (displace_far): Q = U + P - O.
+//   3: CloVR's injection (Alg. 1, inject_vertex) with R = r2 and R_n = r1: a vertex at r >= R_n
+//      moves to where the ray from U along normalize(w d_U + (1 - w) d_O), w = clamp((R - r) /
+//      (R - R_n), 0, 1), leaves the cylinder of radius r.
 const VERTEX = `
 in vec3 position; in vec3 normal; in vec3 colour;
 uniform mat4 projectionMatrix, viewMatrix;
 uniform vec3 eye, centre;
 uniform float r1, r2;
-uniform bool nearFar;
+uniform int mode;
 out vec3 vWorld; out vec3 vNormal; out vec3 vColour;
 vec3 morph(vec3 p) {
   float r = length(p.xz - centre.xz);
-  if (!nearFar || r <= r1) return p;
+  if (r <= r1) return p;
   vec3 up = p - eye, op = p - centre;
   if (r >= r2) return eye + length(op) * normalize(op);
   float w = (r2 - r) / (r2 - r1);
   vec3 d = normalize(w * normalize(up) + (1.0 - w) * normalize(op));
   return eye + (w * length(up) + (1.0 - w) * length(op)) * d;
 }
+vec3 inject(vec3 p) {
+  float r = length(p.xz - centre.xz);
+  if (r < r1) return p;
+  float w = clamp((r2 - r) / (r2 - r1), 0.0, 1.0);
+  vec3 d = normalize(w * normalize(p - eye) + (1.0 - w) * normalize(p - centre));
+  vec2 u = eye.xz - centre.xz;
+  float a = dot(d.xz, d.xz), b = 2.0 * dot(u, d.xz), c = dot(u, u) - r * r;
+  if (!(a > 0.0)) return p;
+  return eye + d * ((-b + sqrt(max(0.0, b * b - 4.0 * a * c))) / (2.0 * a));
+}
 void main() {
-  vWorld = morph(position); vNormal = normal; vColour = colour;
+  vWorld = mode == 1 ? morph(position) : mode == 2 ? eye + position - centre
+         : mode == 3 ? inject(position) : position;
+  vNormal = normal; vColour = colour;
   gl_Position = projectionMatrix * viewMatrix * vec4(vWorld, 1.0);
 }`;
+// Shading; with rangeTest (dynamic far fragments, near-far Eq. 3, passes_range_test) a fragment
+// at displaced position q survives iff |q - U| <= r_O (1 + kRangeRelativeTolerance), r_O the
+// range the cube map from O stores for direction q - U (0: no surface there, infinitely far).
 const FRAGMENT = `precision highp float;
+precision highp int;
 uniform vec3 eye;
+uniform bool rangeTest;
+uniform samplerCube rangeMap;
+uniform int mode;
 in vec3 vWorld; in vec3 vNormal; in vec3 vColour;
 out vec4 outColour;
 void main() {
   vec3 v = vWorld - eye;
-  float nl = length(vNormal), vl = length(v);
-  float lambert = nl > 0.0 && vl > 0.0 ? abs(dot(vNormal, v)) / (nl * vl) : 0.0;
+  // A morphed triangle is shaded as the CPU shades it: by its displaced corners' plane.
+  vec3 n = mode == 1 || mode == 3 ? cross(dFdx(vWorld), dFdy(vWorld)) : vNormal;
+  float nl = length(n), vl = length(v);
+  if (rangeTest) {
+    float rO = texture(rangeMap, v).r;
+    if (rO > 0.0 && vl > rO * (1.0 + 1.0e-6)) discard;
+  }
+  float lambert = nl > 0.0 && vl > 0.0 ? abs(dot(n, v)) / (nl * vl) : 0.0;
   float shade = 0.1 + 0.9 * min(lambert, 1.0);
   outColour = vec4(vColour * shade, 1.0);
+}`;
+// The environment map's range channel: the distance from O (the cube camera) to the surface.
+const RANGE_FRAGMENT = `precision highp float;
+uniform vec3 eye;
+in vec3 vWorld; in vec3 vNormal; in vec3 vColour;
+out vec4 outColour;
+void main() { outColour = vec4(length(vWorld - eye), 0.0, 0.0, 1.0); }`;
+// The far region: a full-screen pass behind everything that samples the cube map (nearest
+// texel, as the CPU's cube_pixel) along the eye ray (lookup=eye, the paper) or where the eye ray
+// leaves the cylinder of radius r2 about O's axis (lookup=cylinder), as pvs view --lookup.
+const BACKGROUND_VERTEX = `
+in vec3 position;
+out vec2 vNdc;
+void main() { vNdc = position.xy; gl_Position = vec4(position.xy, 1.0, 1.0); }`;
+const BACKGROUND_FRAGMENT = `precision highp float;
+uniform mat4 inverseProjectionView;
+uniform vec3 eye, centre;
+uniform float r2;
+uniform bool cylinder;
+uniform samplerCube envMap;
+in vec2 vNdc;
+out vec4 outColour;
+void main() {
+  vec4 far = inverseProjectionView * vec4(vNdc, 1.0, 1.0);
+  vec3 d = normalize(far.xyz / far.w - eye), look = d;
+  if (cylinder) {
+    vec2 u = eye.xz - centre.xz;
+    float a = dot(d.xz, d.xz), b = 2.0 * dot(u, d.xz), c = dot(u, u) - r2 * r2;
+    if (a > 0.0) look = eye + d * ((-b + sqrt(max(0.0, b * b - 4.0 * a * c))) / (2.0 * a)) - centre;
+  }
+  outColour = vec4(texture(envMap, look).rgb, 1.0);
 }`;
 
 // The popping meter's id pass (WebGL2 has no primitive id): the full scene, de-indexed, so the
@@ -177,7 +241,8 @@ class Viewer {
       vertexShader: VERTEX, fragmentShader: FRAGMENT, side: THREE.DoubleSide,
       glslVersion: THREE.GLSL3,
       uniforms: {eye: {value: new THREE.Vector3()}, centre: {value: new THREE.Vector3()},
-                 r1: {value: 0}, r2: {value: 1}, nearFar: {value: false}},
+                 r1: {value: 0}, r2: {value: 1}, mode: {value: 0},
+                 rangeTest: {value: false}, rangeMap: {value: null}},
     });
     this.mesh = new THREE.Mesh(this.geometry, this.material);
     this.mesh.frustumCulled = false;
@@ -193,21 +258,25 @@ class Viewer {
     this.camera.position.set(...at);
     if (params.get("look")) this.camera.lookAt(...vec3(params.get("look")));
     else this.camera.lookAt(at[0] + 1, at[1], at[2]);
-    if (this.nearFar) this.initNearFar();
+    if (this.nearFar) await this.initNearFar();
     this.initPopping();
     this.setDrawList(null);
     this.drawMapBase();
     return this;
   }
 
-  setDrawList(ids) {
+  // The draw list of a cell (null: the whole scene). With near-far on, `partition` is the
+  // worker's (pvs_rt_partition_near_far): its geometry ids are drawn, its environment ids go to
+  // the cube map; with CloVR on, the scheduler's frames replace it (setClovr).
+  setDrawList(ids, partition) {
     this.far = 0;
+    this.farDynamic = 0;
     this.mask = null;
     if (ids) {
       this.mask = new Uint8Array(this.total);
       for (const t of ids) this.mask[t] = 1;
     }
-    if (ids && this.nearFar) ids = this.partitionNearFar(ids);
+    if (ids && this.nearFar) ids = this.applyPartition(partition);
     if (ids) {
       this.geometry.setIndex(indexOf(ids));
       this.drawn = ids.length;
@@ -217,49 +286,128 @@ class Viewer {
     }
   }
 
-  // Near-far: the environment cube map (colour) is rendered from the centre O of the cell's view
-  // region on entering the cell, from the cell's far triangles (every vertex at axis distance
-  // >= r2); the main pass draws the others (near and intermediate, morphed) over it.
-  initNearFar() {
+  // Near-far: the environment cube map is rendered from the centre O on entering the cell, colour
+  // and range (distance from O, float), from the static triangles with a vertex beyond r2; the
+  // main pass draws the near and intermediate triangles (morphed, Eq. 1) over the far region, and
+  // the dynamic far ones displaced by Eq. 2 under the range test (Eq. 3). `centre=x,y,z` pins O;
+  // otherwise it is the centre of the cell's lookup box. `lookup=eye|cylinder` as pvs view's.
+  // `clovr=1`: the near region grows by CloVR's scheduler (pvs_rt_clovr_*) on entering a cell.
+  async initNearFar() {
     const [r1, r2] = this.nearFar;
     if (!(r1 >= 0 && r2 > r1)) throw new Error(`nearfar=${this.nearFar}: need 0 <= r1 < r2`);
-    this.envTarget = new THREE.WebGLCubeRenderTarget(this.envSize);
+    this.lookupMode = params.get("lookup") || "eye";
+    if (!["eye", "cylinder"].includes(this.lookupMode))
+      throw new Error(`lookup=${this.lookupMode}: eye or cylinder`);
+    this.clovr = params.get("clovr") === "1";
+    const nearest = {minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+                     generateMipmaps: false};
+    this.envTarget = new THREE.WebGLCubeRenderTarget(this.envSize, nearest);
+    this.rangeTarget = new THREE.WebGLCubeRenderTarget(
+      this.envSize, {...nearest, type: THREE.FloatType, format: THREE.RGBAFormat});
     this.cubeCamera = new THREE.CubeCamera(0.05, this.camera.far, this.envTarget);
+    this.rangeCamera = new THREE.CubeCamera(0.05, this.camera.far, this.rangeTarget);
     this.envGeometry = new THREE.BufferGeometry();
-    for (const name of ["position", "normal", "colour"])
+    this.dynGeometry = new THREE.BufferGeometry();
+    for (const name of ["position", "normal", "colour"]) {
       this.envGeometry.setAttribute(name, this.geometry.getAttribute(name));
+      this.dynGeometry.setAttribute(name, this.geometry.getAttribute(name));
+    }
     this.envMaterial = this.material.clone();
-    this.envMaterial.uniforms.nearFar.value = false;
+    this.envMaterial.uniforms.mode.value = 0;
+    this.rangeMaterial = new THREE.RawShaderMaterial({
+      vertexShader: VERTEX, fragmentShader: RANGE_FRAGMENT, side: THREE.DoubleSide,
+      glslVersion: THREE.GLSL3, uniforms: this.envMaterial.uniforms,
+    });
     this.envMesh = new THREE.Mesh(this.envGeometry, this.envMaterial);
     this.envMesh.frustumCulled = false;
     this.envWorld = new THREE.Scene();
     this.envWorld.add(this.envMesh);
     this.material.uniforms.r1.value = r1;
     this.material.uniforms.r2.value = r2;
+    this.dynMaterial = this.material.clone();
+    this.dynMaterial.uniforms.mode.value = 2;
+    this.dynMaterial.uniforms.rangeTest.value = true;
+    this.dynMaterial.uniforms.rangeMap.value = this.rangeTarget.texture;
+    this.dynMaterial.uniforms.eye = this.material.uniforms.eye;  // shared
+    this.dynMesh = new THREE.Mesh(this.dynGeometry, this.dynMaterial);
+    this.dynMesh.frustumCulled = false;
+    this.dynMesh.visible = false;
+    this.world.add(this.dynMesh);
+    this.background = new THREE.RawShaderMaterial({
+      vertexShader: BACKGROUND_VERTEX, fragmentShader: BACKGROUND_FRAGMENT, depthWrite: false,
+      glslVersion: THREE.GLSL3,
+      uniforms: {inverseProjectionView: {value: new THREE.Matrix4()}, eye: this.material.uniforms.eye,
+                 centre: {value: new THREE.Vector3()}, r2: {value: r2},
+                 cylinder: {value: this.lookupMode === "cylinder"}, envMap: {value: this.envTarget.texture}},
+    });
+    const quad = new THREE.BufferGeometry();
+    quad.setAttribute("position", new THREE.BufferAttribute(
+      new Float32Array([-1, -1, 0, 3, -1, 0, -1, 3, 0]), 3));
+    this.backgroundMesh = new THREE.Mesh(quad, this.background);
+    this.backgroundMesh.frustumCulled = false;
+    this.backgroundMesh.renderOrder = -1;
+    this.backgroundMesh.visible = false;
+    this.world.add(this.backgroundMesh);
+    const centre = params.get("centre") ? vec3(params.get("centre")) : null;
+    await this.client.setGeometry(this.scene, {r1, r2, centre, clovr: this.clovr});
   }
 
-  partitionNearFar(ids) {
-    const [, r2] = this.nearFar;
-    const b = this.pvs.boxes, c = this.cell, p = this.scene.positions;
-    const o = params.get("centre") ? vec3(params.get("centre"))
-      : [(b[6 * c] + b[6 * c + 3]) / 2, (b[6 * c + 1] + b[6 * c + 4]) / 2, (b[6 * c + 2] + b[6 * c + 5]) / 2];
-    const near = [], far = [];
-    for (const t of ids) {
-      let allFar = true;
-      for (let k = 0; k < 3 && allFar; ++k)
-        allFar = Math.hypot(p[9 * t + 3 * k] - o[0], p[9 * t + 3 * k + 2] - o[2]) >= r2;
-      (allFar ? far : near).push(t);
-    }
-    this.material.uniforms.centre.value.set(...o);
-    this.material.uniforms.nearFar.value = true;
-    this.envGeometry.setIndex(indexOf(far));
+  // Renders the cube maps (colour and range) from O of the triangles `ids`.
+  renderEnvironment(ids, o) {
+    this.envGeometry.setIndex(indexOf(ids));
     this.envMaterial.uniforms.eye.value.set(...o);
     this.cubeCamera.position.set(...o);
+    this.rangeCamera.position.set(...o);
+    const clear = new THREE.Color();
+    this.renderer.getClearColor(clear);
     this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
+    this.envMesh.material = this.envMaterial;
     this.cubeCamera.update(this.renderer, this.envWorld);
-    this.world.background = this.envTarget.texture;
-    this.far = far.length;
-    return near;
+    this.renderer.setClearColor(new THREE.Color(0, 0, 0), 0);  // range 0: nothing there
+    this.envMesh.material = this.rangeMaterial;
+    this.rangeCamera.update(this.renderer, this.envWorld);
+    this.envMesh.material = this.envMaterial;
+    this.renderer.setClearColor(clear, 1);
+    this.backgroundMesh.visible = true;
+  }
+
+  applyPartition(part) {
+    const o = part.centre;
+    this.centre = o;
+    this.material.uniforms.centre.value.set(...o);
+    this.dynMaterial.uniforms.centre.value.set(...o);
+    this.background.uniforms.centre.value.set(...o);
+    this.material.uniforms.mode.value = 1;
+    if (this.clovr) return [];  // the scheduler's first frame (setClovr) sets the sets
+    this.renderEnvironment(part.environment, o);
+    this.dynGeometry.setIndex(indexOf(part.farDynamic));
+    this.dynMesh.visible = part.farDynamic.length > 0;
+    this.far = part.farStatic;
+    this.farDynamic = part.farDynamic.length;
+    this.envCount = part.environment.length;
+    return part.geometry;
+  }
+
+  // A CloVR frame (pvs_worker.js clovrNext): R and R_n drive the injection (mode 3); when the near
+  // set changed, the draw list and the environment map (from the same O) are rebuilt.
+  setClovr(f) {
+    this.clovrFrame = f;
+    const u = this.material.uniforms;
+    u.mode.value = 3;
+    u.r1.value = f.near_radius;
+    u.r2.value = f.radius;
+    this.dynMesh.visible = false;
+    if (f.near) {
+      this.geometry.setIndex(indexOf(f.near));
+      this.drawn = f.near.length;
+      this.renderEnvironment(f.environment, this.centre);
+      this.far = f.environment.length;
+      this.envCount = f.environment.length;
+    }
+    // Alg. 1 needs the eye strictly inside R_n; until R_n reaches it the near set is drawn as is.
+    const p = this.camera.position;
+    const inside = Math.hypot(p.x - this.centre[0], p.z - this.centre[2]) < f.near_radius;
+    u.mode.value = inside ? 3 : 0;
   }
 
   initPopping() {
@@ -325,11 +473,19 @@ class Viewer {
     this.found = r.cell;
     if (r.cell >= 0 && r.cell !== this.cell) {
       this.cell = r.cell;
-      this.setDrawList(r.ids);
+      this.setDrawList(r.ids, r.partition);
     }
+    if (r.clovr) this.setClovr(r.clovr);
     this.bytes = r.bytes;
     this.requests = r.requests;
+    this.lookupRequests = r.lookupRequests;
+    this.chainBlocks = r.chainBlocks;
     this.material.uniforms.eye.value.copy(p);
+    if (this.background) {
+      this.camera.updateMatrixWorld();
+      this.background.uniforms.inverseProjectionView.value
+        .multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).invert();
+    }
     this.renderer.render(this.world, this.camera);
     const measure = this.measureNext ||
       (this.poppingEvery > 0 && this.frameCount % this.poppingEvery === 0);
@@ -342,9 +498,16 @@ class Viewer {
     this.showOverlay(ms);
     this.drawMap();
     return {cell: this.found, drawn_cell: this.cell, triangles_drawn: this.drawn,
-            triangles_far: this.far, popping_pixels: measure ? this.popping : null,
+            triangles_far: this.far, triangles_far_dynamic: this.farDynamic ?? 0,
+            clovr: this.clovrFrame ? {frame: this.clovrFrame.frame, ring: this.clovrFrame.ring,
+                                      ring_count: this.clovrFrame.ring_count, radius: this.clovrFrame.radius,
+                                      near_radius: this.clovrFrame.near_radius, done: this.clovrFrame.done,
+                                      near_count: this.clovrFrame.near_count,
+                                      environment_count: this.clovrFrame.environment_count} : null,
+            popping_pixels: measure ? this.popping : null,
             triangles_total: this.total, ms, bytes_fetched: this.bytes,
-            range_requests: this.requests, eye: [p.x, p.y, p.z]};
+            range_requests: this.requests, frame_range_requests: this.lookupRequests,
+            prefetched_chain_blocks: this.chainBlocks, eye: [p.x, p.y, p.z]};
   }
 
   // Replay: frame i of the path.
@@ -373,10 +536,11 @@ class Viewer {
       ? `<span class="outside">outside every cell: ${this.cell >= 0 ? `keeping cell ${this.cell}'s set` : "drawing the whole scene"}</span>`
       : `cell ${this.found} of ${this.pvs.info.cell_count}`;
     overlay.innerHTML =
-      `${cellText}\ntriangles drawn ${this.drawn}${this.nearFar ? ` near + ${this.far} far (environment map)` : ""} / ${this.total}` +
+      `${cellText}\ntriangles drawn ${this.drawn}${this.nearFar ? ` near + ${this.far} far (environment map)${this.farDynamic ? ` + ${this.farDynamic} dynamic far` : ""}` : ""} / ${this.total}` +
       ` (${(100 * (this.drawn + this.far) / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
       `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
       `\nscene ${this.sceneBytes} bytes` +
+      (this.clovrFrame ? `\nCloVR ring ${this.clovrFrame.ring} of ${this.clovrFrame.ring_count}, R ${this.clovrFrame.radius.toFixed(1)}${this.clovrFrame.done ? " (complete)" : ""}` : "") +
       (this.popping === null ? "" : `\npopping pixels ${this.popping} (last measured; P measures)`);
   }
 

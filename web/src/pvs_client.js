@@ -20,6 +20,11 @@ export class PvsClient {
   }
   // Opens the PVS at `url` (header, layout and index by range request).
   open(url) { return this.call({op: "open", url}); }
+  // The scene's triangles for the near-far partition and CloVR (pvs_worker.js, op geometry).
+  setGeometry(scene, nearFar) {
+    return this.call({op: "geometry", positions: scene.positions, triangleObject: scene.triangleObject,
+                      objectCount: scene.objectCount, dynamic: scene.dynamic, nearFar});
+  }
   // The cell containing `position` (-1: none) and, when it is not `have`, its visible ids; on a
   // cell change with `prefetch` >= 0, the worker then fetches the neighbours' blocks.
   lookup(position, have, prefetch = -1) {

@@ -9,8 +9,16 @@
 //                                    cell is not `have`), bytes, requests}
 // With `prefetch` = a margin (scene units) on a cell change, after the reply the worker fetches
 // the blocks of the cells the runtime names as neighbours within that margin
-// (pvs_rt_neighbours, pvs_rt_block_range), so that crossing into one costs no request; their
-// Delta chains are fetched when a cell is entered (they are known only from the block).
+// (pvs_rt_neighbours, then pvs_rt_delta_chain: the neighbour's block and the blocks of its Delta
+// chain, read through readRange and kept), so that crossing into one costs no request.
+//   {op: "geometry", positions, triangleObject, objectCount, dynamic, nearFar: {r1, r2, centre,
+//    clovr}}                     -> {} (the scene's triangles, for the near-far partition and the
+//                                    CloVR scheduler of the C API, runtime/near_far_c.h)
+// With near-far on, a lookup that enters a cell also returns the cell's partition
+// (pvs_rt_partition_near_far: `geometry` drawn per frame, `farDynamic` displaced by Eq. 2 under
+// the range test, `environment` rendered into the cube map from O); with CloVR on, every lookup
+// advances the scheduler one frame (pvs_rt_clovr_next_frame) and returns `clovr` (the frame) and,
+// when the near set changed, its `near` and `environment` ids.
 // Each range fetched is kept (a cell's block is fetched once); `bytes` counts every byte the
 // server sent for this file, so the page can show what streaming cost.
 /* global createPvsRuntime, importScripts */
@@ -21,6 +29,7 @@ let handle = 0;
 let url = null;
 let bytesFetched = 0;
 let requests = 0;
+let chainBlocks = 0;  // blocks of neighbours' Delta chains prefetched beyond their own blocks
 const ranges = new Map();  // "offset:size" -> Uint8Array
 const idCache = new Map();  // cell -> Uint32Array
 
@@ -111,20 +120,122 @@ function visibleIds(cell) {
 }
 
 function prefetchNeighbours(cell, margin) {
-  const cap = 4096;
-  const out = rt._malloc(4 * cap + 32);
-  const countP = out + 4 * cap, offP = countP + 8, sizeP = countP + 16;
+  const cap = 4096, chainCap = 256;
+  const out = rt._malloc(4 * cap + 4 * chainCap + 16);
+  const chain = out + 4 * cap, countP = chain + 4 * chainCap;
   if (rt._pvs_rt_neighbours(handle, cell, margin, out, cap, countP) === 0) {
     const n = new Uint32Array(rt.HEAPU8.buffer, countP, 1)[0];
     const cells = new Uint32Array(rt.HEAPU8.buffer, out, n).slice();
+    // Each chain's blocks are read by the runtime through readRange, which keeps them.
     for (const c of cells) {
-      if (idCache.has(c) || rt._pvs_rt_block_range(handle, c, offP, sizeP) !== 0) continue;
-      const off = Number(new BigUint64Array(rt.HEAPU8.buffer, offP, 1)[0]);
-      const size = new Uint32Array(rt.HEAPU8.buffer, sizeP, 1)[0];
-      readRange(off, size);
+      if (idCache.has(c) || rt._pvs_rt_delta_chain(handle, c, chain, chainCap, countP) !== 0)
+        continue;
+      chainBlocks += new Uint32Array(rt.HEAPU8.buffer, countP, 1)[0] - 1;
     }
   }
   rt._free(out);
+}
+
+// ---- Near-far and CloVR through the C API (runtime/near_far_c.h) -----------------------------
+
+let geometry = 0;  // pvs_rt_geometry* (its arrays live as long as the worker)
+let nearFar = null;  // {r1, r2, centre (null: the cell box's centre), clovr}
+let triangleCount = 0;
+let clovr = 0;  // pvs_rt_clovr*
+let clovrFrame = 0;  // pvs_rt_clovr_frame*
+let clovrStarted = false;  // a growth was started (a cell entered)
+
+function copyIn(array) {
+  const p = rt._malloc(Math.max(4, array.byteLength));
+  rt.HEAPU8.set(new Uint8Array(array.buffer, array.byteOffset, array.byteLength), p);
+  return p;
+}
+
+function check(status, what) {
+  if (status !== 0) throw new Error(`${what}: ${lastError()}`);
+}
+
+function setGeometry(m) {
+  triangleCount = m.triangleObject.length;
+  const indices = new Uint32Array(3 * triangleCount);
+  for (let i = 0; i < indices.length; ++i) indices[i] = i;  // the page's de-indexed triangles
+  // pvs_rt_geometry in wasm32: 7 words (pointers and size_t are 32-bit).
+  const words = [copyIn(m.positions), 3 * triangleCount, copyIn(indices), triangleCount,
+                 copyIn(m.triangleObject), m.objectCount, copyIn(m.dynamic)];
+  geometry = rt._malloc(28);  // (a view is made after the last allocation: memory may grow)
+  new Uint32Array(rt.HEAPU8.buffer, geometry, 7).set(words);
+  nearFar = m.nearFar;
+  if (nearFar && nearFar.clovr) {
+    const params = rt._malloc(40);  // pvs_rt_clovr_params: 3 doubles, uint32 (+4), double
+    rt._pvs_rt_clovr_default_params(nearFar.r2, params);
+    const out = rt._malloc(4);
+    check(rt._pvs_rt_clovr_create(geometry, params, out), "pvs_rt_clovr_create");
+    clovr = new Uint32Array(rt.HEAPU8.buffer, out, 1)[0];
+    rt._free(out);
+    rt._free(params);
+    clovrFrame = rt._malloc(56);
+  }
+}
+
+function cellCentre(cell) {
+  if (nearFar.centre) return nearFar.centre;
+  const p = rt._malloc(48);
+  rt._pvs_rt_cell_box(handle, cell, p, p + 24);
+  const b = new Float64Array(rt.HEAPU8.buffer, p, 6).slice();
+  rt._free(p);
+  return [(b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2];
+}
+
+function idList(p, n) {
+  return new Uint32Array(rt.HEAPU32.buffer, p, n).slice();
+}
+
+// pvs_rt_partition_near_far of a cell's set about its centre.
+function partition(ids, centre) {
+  const n = ids.length, lists = 6;
+  const idsP = copyIn(ids);
+  const buf = rt._malloc(4 * Math.max(1, n) * lists);
+  const out = rt._malloc(52);  // pvs_rt_near_far: 6 pointers, capacity, 6 counts
+  const o = new Uint32Array(rt.HEAPU8.buffer, out, 13);
+  for (let k = 0; k < lists; ++k) o[k] = buf + 4 * Math.max(1, n) * k;
+  o[6] = n;
+  const c = rt._malloc(24);
+  new Float64Array(rt.HEAPU8.buffer, c, 3).set(centre);
+  check(rt._pvs_rt_partition_near_far(geometry, idsP, n, c, nearFar.r1, nearFar.r2, out),
+        "pvs_rt_partition_near_far");
+  const w = new Uint32Array(rt.HEAPU8.buffer, out, 13).slice();
+  // w[0..5]: near, intermediate, far static, far dynamic, environment map, geometry; counts w[7..12]
+  const farDynamic = idList(w[3], w[10]);
+  const dyn = new Set(farDynamic);
+  const geometryIds = idList(w[5], w[12]).filter((t) => !dyn.has(t));
+  const result = {centre, geometry: geometryIds, farDynamic, environment: idList(w[4], w[11]),
+                  near: w[7], intermediate: w[8], farStatic: w[9]};
+  for (const p of [idsP, buf, out, c]) rt._free(p);
+  return result;
+}
+
+function clovrIds(fn, capacity) {
+  const out = rt._malloc(4 * Math.max(1, capacity) + 4);
+  const countP = out + 4 * Math.max(1, capacity);
+  check(fn(clovr, out, capacity, countP), "pvs_rt_clovr ids");
+  const ids = idList(out, new Uint32Array(rt.HEAPU8.buffer, countP, 1)[0]);
+  rt._free(out);
+  return ids;
+}
+
+// One frame of the CloVR scheduler: the frame's description, and the sets when they changed.
+function clovrNext(total) {
+  check(rt._pvs_rt_clovr_next_frame(clovr, clovrFrame), "pvs_rt_clovr_next_frame");
+  const u = new Uint32Array(rt.HEAPU8.buffer, clovrFrame, 14);
+  const d = new Float64Array(rt.HEAPU8.buffer, clovrFrame, 5);
+  const f = {frame: u[0], ring: u[1], ring_count: u[2], ring_radius: d[2], radius: d[3],
+             near_radius: d[4], near_changed: u[10], done: u[11], near_count: u[12],
+             environment_count: u[13]};
+  if (f.near_changed || f.frame === 0) {
+    f.near = clovrIds(rt._pvs_rt_clovr_near_ids, total);
+    f.environment = clovrIds(rt._pvs_rt_clovr_environment_ids, total);
+  }
+  return f;
 }
 
 function lookup(position) {
@@ -143,12 +254,33 @@ self.onmessage = async (ev) => {
     if (m.op === "open") {
       const r = await open(m.url);
       self.postMessage({id: m.id, ok: true, ...r});
+    } else if (m.op === "geometry") {
+      setGeometry(m);
+      self.postMessage({id: m.id, ok: true});
     } else if (m.op === "lookup") {
+      const before = requests;
       const cell = lookup(m.position);
       const reply = {id: m.id, ok: true, cell};
-      if (cell >= 0 && m.have !== cell) reply.ids = visibleIds(cell);
+      if (cell >= 0 && m.have !== cell) {
+        reply.ids = visibleIds(cell);
+        if (nearFar) {
+          reply.partition = partition(reply.ids, cellCentre(cell));
+          if (clovr) {
+            const c = rt._malloc(24);
+            new Float64Array(rt.HEAPU8.buffer, c, 3).set(reply.partition.centre);
+            const idsP = copyIn(reply.ids);
+            check(rt._pvs_rt_clovr_start(clovr, idsP, reply.ids.length, c), "pvs_rt_clovr_start");
+            clovrStarted = true;
+            rt._free(idsP);
+            rt._free(c);
+          }
+        }
+      }
+      if (clovrStarted) reply.clovr = clovrNext(triangleCount);
       reply.bytes = bytesFetched;
       reply.requests = requests;
+      reply.lookupRequests = requests - before;  // what this frame waited for
+      reply.chainBlocks = chainBlocks;
       self.postMessage(reply);
       if (cell >= 0 && m.have !== cell && m.prefetch >= 0) prefetchNeighbours(cell, m.prefetch);
     }
