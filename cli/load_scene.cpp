@@ -43,10 +43,6 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states, const Impo
     if (vislib::mark_see_through(scene, {p}) == 0)
       throw CLI::ValidationError("--see-through",
                                  "pattern '" + p + "' matches no object of " + path);
-  for (const std::string& p : see_through)
-    if (vislib::mark_see_through(scene, {p}) == 0)
-      throw CLI::ValidationError("--see-through",
-                                 "pattern '" + p + "' matches no object of " + path);
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "loaded %s: %zu triangles, %zu objects, %zu spheres, %zu key states in %.2f s",
