@@ -314,6 +314,33 @@ TEST(QuakeBsp, LeafVolumesAreTheBoundsClippedByThePathPlanes) {
   EXPECT_EQ(pieces[1].volume.halfspaces.size(), 7u);  // the box's six and the node's plane
 }
 
+// The view region keeps kBspLeafInset from every plane: the tiny map's leaves are 64 x 96 x 16
+// boxes, so their regions are 62 x 94 x 14; a slab 1/16 unit thick is too thin for the full inset
+// and takes the largest halving that leaves a volume (1/64: 1/32 would leave exactly none).
+TEST(QuakeBsp, ViewRegionIsTheLeafInsetOrTheLargestHalvingThatLeavesAVolume) {
+  QuakeBsp m = parse_quake_bsp("map.bsp", encode_bsp(tiny_map()));
+  const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(m);
+  const BspViewRegion r = bsp_leaf_view_region(pieces[0].volume);
+  EXPECT_EQ(r.inset, kBspLeafInset);
+  EXPECT_NEAR(r.volume.volume(), 62.0 * 94 * 14, 1e-6);
+  const Box3 b = r.volume.bounds();
+  EXPECT_NEAR(b.min.z, 17, 1e-9);
+  EXPECT_NEAR(b.max.z, 31, 1e-9);
+
+  std::vector<HalfSpace> slab = {{{1, 0, 0}, 10}, {{-1, 0, 0}, 0},     {{0, 1, 0}, 10},
+                                 {{0, -1, 0}, 0}, {{0, 0, 1}, 0.0625}, {{0, 0, -1}, 0}};
+  ConvexPolytope thin = inset_polytope(ConvexPolytope{slab, {}}, 0);
+  ASSERT_FALSE(thin.empty());
+  const BspViewRegion t = bsp_leaf_view_region(thin);
+  EXPECT_EQ(t.inset, 1.0 / 64);
+  EXPECT_NEAR(t.volume.volume(), (10 - 2.0 / 64) * (10 - 2.0 / 64) * (0.0625 - 2.0 / 64), 1e-9);
+  std::vector<HalfSpace> sheet = slab;
+  sheet[4].offset = 1.0 / 64;  // thinner than twice the smallest inset: the volume itself
+  const BspViewRegion z = bsp_leaf_view_region(inset_polytope(ConvexPolytope{sheet, {}}, 0));
+  EXPECT_EQ(z.inset, 0);
+  EXPECT_FALSE(z.volume.empty());
+}
+
 TEST(QuakeBsp, BadFilesNameTheLumpAndTheByte) {
   const std::string good = encode_bsp(tiny_map());
   auto expect = [](const std::string& msg, const std::string& part) {

@@ -68,6 +68,29 @@ Box3 ConvexPolytope::bounds() const {
   return b;
 }
 
+ConvexPolytope inset_polytope(const ConvexPolytope& p, double distance) {
+  // Large enough to reach across the polytope from any of its planes: from its corners, or (no
+  // faces yet) from the planes' distances to the origin, which bound a box-clipped polytope's.
+  double size = 1;
+  if (!p.empty()) {
+    const Box3 b = p.bounds();
+    size += 4 * (length(b.max - b.min) + length(b.min) + length(b.max));
+  } else {
+    for (const HalfSpace& h : p.halfspaces) size += 4 * std::fabs(h.offset) / length(h.normal);
+  }
+  std::vector<HalfSpace> hs = p.halfspaces;
+  for (HalfSpace& h : hs) h.offset -= distance * length(h.normal);
+  return make_polytope(hs, size);
+}
+
+BspViewRegion bsp_leaf_view_region(const ConvexPolytope& leaf_volume) {
+  for (double d = kBspLeafInset; d >= kBspLeafMinInset; d /= 2) {
+    ConvexPolytope v = inset_polytope(leaf_volume, d);
+    if (!v.empty()) return {std::move(v), d};
+  }
+  return {leaf_volume, 0};
+}
+
 std::vector<BspLeafPiece> bsp_leaf_pieces(const QuakeBsp& bsp) {
   const BspModel& world = bsp.models[0];
   const Vec3 lo{world.mins[0], world.mins[1], world.mins[2]};

@@ -47,4 +47,26 @@ struct BspLeafPiece {
 // ends. Deterministic. O(pieces * depth^2) polygon clips.
 std::vector<BspLeafPiece> bsp_leaf_pieces(const QuakeBsp& bsp);
 
+// `p` with every half-space moved inward by `distance` (Quake units, >= 0): dot(n, x) <= offset -
+// distance * |n|. Empty when nothing of positive volume is left. `p.faces` may be empty (the
+// half-spaces alone, bounded: a box's six among them), so this also builds a polytope's faces.
+ConvexPolytope inset_polytope(const ConvexPolytope& p, double distance);
+
+// How far inside its leaf's volume a cell's view region lies (Quake units): eyes exactly on a
+// leaf's boundary would sit on the faces that lie there, and a point of a boundary plane belongs
+// to one side only (bsp_point_leaf), so the region keeps this distance from every plane.
+constexpr double kBspLeafInset = 1.0;
+// The smallest inset tried for a leaf too thin for kBspLeafInset (Quake units).
+constexpr double kBspLeafMinInset = 1.0 / 64;
+
+// The view region of a leaf whose volume is `leaf_volume` (not empty): the volume inset by
+// kBspLeafInset; a leaf too thin for that (nothing left) is inset by the largest of
+// kBspLeafInset / 2^k, k = 1, 2, ..., down to kBspLeafMinInset, that leaves a volume, and by 0
+// (the volume itself) when none does. `inset` is the distance used.
+struct BspViewRegion {
+  ConvexPolytope volume;
+  double inset = 0;
+};
+BspViewRegion bsp_leaf_view_region(const ConvexPolytope& leaf_volume);
+
 }  // namespace vislib
