@@ -35,8 +35,7 @@ struct ExportOptions {
   int states = 1;
   std::optional<double> time;
   ImportArgs import;
-  double scale = 1;
-  std::string rotate, translate;
+  TransformArgs transform;
 };
 
 void append_f(std::string& s, const char* fmt, double a, double b, double c) {
@@ -53,26 +52,12 @@ void run_export(const ExportOptions& o) {
     throw CLI::ValidationError("--id-map", "goes with an .obj export (a .glb keeps the id order)");
   check_output_file(o.out, "--output");  // before any work
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
-  vislib::Similarity sim;
-  sim.scale = o.scale;
-  if (!o.rotate.empty()) {
-    auto r = parse_doubles(o.rotate, "--rotate", 4);
-    if (!(r[1] != 0 || r[2] != 0 || r[3] != 0))
-      throw CLI::ValidationError("--rotate", "the axis must not be zero");
-    sim.rotation = vislib::axis_angle_rotation({r[1], r[2], r[3]}, r[0]);
-  }
-  if (!o.translate.empty()) sim.translation = parse_vec3(o.translate, "--translate");
+  const vislib::Similarity sim = parse_transform(o.transform);
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
   vislib::transform_scene(scene, sim);
-  if (!o.rotate.empty() && show_progress()) {
-    std::string m;
-    for (double x : sim.rotation.m) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%s%.17g", m.empty() ? "" : ",", x);
-      m += buf;
-    }
-    std::fprintf(stderr, "pvs: rotation (row-major, for --orientation): %s\n", m.c_str());
-  }
+  if (!o.transform.rotate.empty() && show_progress())
+    std::fprintf(stderr, "pvs: rotation (row-major, for --orientation): %s\n",
+                 matrix_text(sim.rotation).c_str());
   if (glb) {
     for (size_t t = 1; t < scene.triangle_count(); ++t)
       if (scene.triangle_object[t] < scene.triangle_object[t - 1])
@@ -154,11 +139,7 @@ const Registration reg("export", [](CLI::App& app) {
       "--id-map", o->id_map,
       "Also write FILE.json: runs of consecutive triangle ids of one object and their vertex "
       "blocks (PVS ids to draw calls; docs/runtime.md)");
-  cmd->add_option("--scale", o->scale, "Scale the scene by S (after --rotate, before --translate)")
-      ->check(positive());
-  cmd->add_option("--rotate", o->rotate,
-                  "Rotate the scene by DEG degrees about the axis AX,AY,AZ (through the origin)");
-  cmd->add_option("--translate", o->translate, "Move the scene by X,Y,Z (after --scale)");
+  add_transform_options(cmd, o->transform, "the scene");
   cmd->callback([o] { run_export(*o); });
 });
 

@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
 #include "vislib/bake/view_cells.h"
@@ -69,8 +71,11 @@ Totals run_segments(const Scene& a, const std::vector<Segment>& segs, int n, con
     tot.grazing += rep.count(InvarianceClass::Grazing);
     tot.ties += rep.count(InvarianceClass::DepthTie);
     tot.defects += rep.count(InvarianceClass::Defect);
-    std::printf("%s segment %zu: %zu visible, %zu moved, %zu differ\n", name, i, rep.visible_a,
-                rep.visible_b, rep.diffs.size());
+    std::printf(
+        "%s segment %zu (%.17g,%.17g,%.17g -> %.17g,%.17g,%.17g): %zu visible, %zu moved, %zu "
+        "differ\n",
+        name, i, segs[i].v0.x, segs[i].v0.y, segs[i].v0.z, segs[i].v1.x, segs[i].v1.y, segs[i].v1.z,
+        rep.visible_a, rep.visible_b, rep.diffs.size());
     for (const InvarianceEvidence& e : rep.diffs) {
       if (e.cls == InvarianceClass::Grazing) tot.max_ulps = std::max(tot.max_ulps, e.ulps_needed);
       std::printf(
@@ -176,6 +181,69 @@ TEST(Invariance, ClassifierReportsATriangleThatMovedAsADefect) {
       EXPECT_TRUE(e.in_original);
     }
   EXPECT_TRUE(found) << "triangle " << victim << " should differ";
+}
+
+std::string vec_text(Vec3 v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g", v.x, v.y, v.z);
+  return buf;
+}
+
+std::vector<uint32_t> visible_of(const std::string& json_path) {
+  std::ifstream in(json_path);
+  return nlohmann::json::parse(in)["visible"].get<std::vector<uint32_t>>();
+}
+
+// `pvs segment --rotate --scale --translate` moves scene, segment, cube and near together: the same
+// set as `pvs export` with the same options and `pvs segment` on the export with the segment, the
+// printed rotation and the near distance moved by hand.
+TEST(InvarianceCli, SegmentTransformMatchesTheExportedMovedScene) {
+  const std::string dir = vislib_test::temp_dir("invariance_cli");
+  const std::string city = dir + "/c.glb", moved = dir + "/moved.obj";
+  std::string out, err;
+  ASSERT_EQ(vislib_test::run_pvs("generate city --blocks 1,1 -o " + city, &out), 0) << out;
+  const std::string tr = " --rotate 37,0.3,1,0.5 --scale 0.0254 --translate 1e5,1e5,1e5";
+  ASSERT_EQ(vislib_test::run_pvs_split("export " + city + tr + " -o " + moved, &out, &err), 0)
+      << err;
+  const Similarity sim = far_transform();
+  EXPECT_NE(
+      err.find("rotation (row-major, for --orientation): " +
+               std::string(vec_text({sim.rotation.m[0], sim.rotation.m[1], sim.rotation.m[2]}))),
+      std::string::npos)
+      << err;
+  const Scene a = load_scene(city);
+  const auto segs = random_cell_segments(a, WalkableOptions{}, 1, 3);
+  ASSERT_EQ(segs.size(), 1u);
+  const std::string seg =
+      " --res 32 --from " + vec_text(segs[0].v0) + " --to " + vec_text(segs[0].v1);
+  ASSERT_EQ(vislib_test::run_pvs("segment " + city + seg + tr + " --json " + dir + "/t.json", &out),
+            0)
+      << out;
+  std::string orient;
+  for (double x : sim.rotation.m) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.17g", orient.empty() ? "" : ",", x);
+    orient += buf;
+  }
+  orient +=
+      (orient.empty() ? "" : ",") + vec_text({x, 0, 0}).substr(0, vec_text({x, 0, 0}).find(','));
+  char near[64];
+  std::snprintf(near, sizeof near, "%.17g", kDefaultNear * sim.scale);
+  ASSERT_EQ(vislib_test::run_pvs("segment " + moved + " --res 32 --from " +
+                                     vec_text(apply(sim, segs[0].v0)) + " --to " +
+                                     vec_text(apply(sim, segs[0].v1)) + " --orientation " + orient +
+                                     " --near " + near + " --json " + dir + "/m.json",
+                                 &out),
+            0)
+      << out;
+  const auto t = visible_of(dir + "/t.json"), m = visible_of(dir + "/m.json");
+  EXPECT_FALSE(t.empty());
+  EXPECT_EQ(t, m);
+  // A zero axis is refused, naming the option, before any output.
+  EXPECT_EQ(vislib_test::run_pvs(
+                "segment " + city + seg + " --rotate 10,0,0,0 --json " + dir + "/bad.json", &out),
+            2);
+  EXPECT_NE(out.find("--rotate"), std::string::npos) << out;
 }
 
 // The check on a real map: sauer_pandora, 4 random walkable cells' diagonals, N = 128.
