@@ -225,8 +225,6 @@ TEST(InvarianceCli, SegmentTransformMatchesTheExportedMovedScene) {
     std::snprintf(buf, sizeof buf, "%s%.17g", orient.empty() ? "" : ",", x);
     orient += buf;
   }
-  orient +=
-      (orient.empty() ? "" : ",") + vec_text({x, 0, 0}).substr(0, vec_text({x, 0, 0}).find(','));
   char near[64];
   std::snprintf(near, sizeof near, "%.17g", kDefaultNear * sim.scale);
   ASSERT_EQ(vislib_test::run_pvs("segment " + moved + " --res 32 --from " +
