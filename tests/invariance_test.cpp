@@ -148,7 +148,7 @@ TEST(Invariance, GeneratedCityDiffersOnlyByGrazingRaysAndTies) {
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 }
 
-// The classifier is not blind: a triangle of the moved copy pushed 1 m away (not a similarity of
+// The classifier is not blind: a triangle of the moved copy pushed 1 km down (not a similarity of
 // the original) is reported as a defect, with the ray that shows it.
 TEST(Invariance, ClassifierReportsATriangleThatMovedAsADefect) {
   CityOptions co;
@@ -166,7 +166,7 @@ TEST(Invariance, ClassifierReportsATriangleThatMovedAsADefect) {
   const Similarity sim = far_transform();
   Scene b = a;
   transform_scene(b, sim);
-  // Detach the victim's corners from the shared vertices and move them 1 m (scaled) behind the eye.
+  // Detach the victim's corners from the shared vertices and move them 1 km (scaled) down.
   for (int k = 0; k < 3; ++k) {
     Vec3 p = b.positions[0][b.triangles[victim][k]];
     b.positions[0].push_back(p + Vec3{0, -1000 * sim.scale, 0});
