@@ -1,6 +1,8 @@
 // invariance.cpp: invariance.h.
 #include "tests/support/invariance.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -200,7 +202,9 @@ InvarianceReport classify_invariance(const Scene& a, const Scene& b, const Simil
   std::vector<uint32_t> only;
   std::set_symmetric_difference(ra.visible.begin(), ra.visible.end(), rb.visible.begin(),
                                 rb.visible.end(), std::back_inserter(only));
-  for (uint32_t id : only) {
+  rep.diffs.resize(only.size());
+  tbb::parallel_for(size_t(0), only.size(), [&](size_t k) {  // ids are independent: deterministic
+    const uint32_t id = only[k];
     const bool in_a = std::binary_search(ra.visible.begin(), ra.visible.end(), id);
     const SegmentResult& r = in_a ? ra : rb;
     std::vector<EvidenceRay> rays;
@@ -244,8 +248,8 @@ InvarianceReport classify_invariance(const Scene& a, const Scene& b, const Simil
       if (ev.cls == InvarianceClass::Defect) break;
     }
     if (!have) ev.why = "no evidence ray (no piece and no witness)";
-    rep.diffs.push_back(ev);
-  }
+    rep.diffs[k] = ev;
+  });
   return rep;
 }
 
