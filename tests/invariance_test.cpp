@@ -244,22 +244,31 @@ TEST(InvarianceCli, SegmentTransformMatchesTheExportedMovedScene) {
   EXPECT_NE(out.find("--rotate"), std::string::npos) << out;
 }
 
-// The check on a real map: sauer_pandora, 4 random walkable cells' diagonals, N = 128.
-TEST(Invariance, PandoraDiffersOnlyByGrazingRaysAndTies) {
-  VISLIB_REQUIRE_SHARED(shared);
+// The check on the real maps: 4 random walkable cells' diagonals, N = 128.
+void check_shared_map(const std::string& path, const char* name) {
   const auto start = std::chrono::steady_clock::now();
-  const Scene a = load_scene(shared + "/scenes/sauer_pandora/pandora.obj");
+  const Scene a = load_scene(path);
   WalkableOptions wo;
   wo.cell_size = 16;  // Sauerbraten units (a player is about 15 tall)
   wo.eye = {10, 14};
   const auto segs = random_cell_segments(a, wo, 4, 38);
   ASSERT_EQ(segs.size(), 4u);
-  const Totals t = run_segments(a, segs, 128, "sauer_pandora");
+  const Totals t = run_segments(a, segs, 128, name);
   EXPECT_GT(t.visible, 0u);
   EXPECT_EQ(t.defects, 0u);
   EXPECT_LE(t.max_ulps, kInvarianceUlps);
   std::printf("time budget 60 s: took %.1f s\n",
               std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
+TEST(Invariance, PandoraDiffersOnlyByGrazingRaysAndTies) {
+  VISLIB_REQUIRE_SHARED(shared);
+  check_shared_map(shared + "/scenes/sauer_pandora/pandora.obj", "sauer_pandora");
+}
+
+TEST(Invariance, Fdm6DiffersOnlyByGrazingRaysAndTies) {
+  VISLIB_REQUIRE_SHARED(shared);
+  check_shared_map(shared + "/scenes/sauer_fdm6/fdm6.obj", "sauer_fdm6");
 }
 
 }  // namespace
