@@ -54,7 +54,7 @@ void run_export(const ExportOptions& o) {
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   const vislib::Similarity sim = parse_transform(o.transform);
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
-  vislib::transform_scene(scene, sim);
+  transform_scene_for_cli(scene, sim);
   if (!o.transform.rotate.empty() && show_progress())
     std::fprintf(stderr, "pvs: rotation (row-major, for --orientation): %s\n",
                  matrix_text(sim.rotation).c_str());

@@ -62,7 +62,7 @@ void add_segment(CLI::App& app) {
       vislib::Scene scene = load(*a, load_s);
       if (transform->any()) {  // the whole computation moved: scene, segment, cube, near
         const vislib::Similarity sim = parse_transform(*transform);
-        vislib::transform_scene(scene, sim);
+        transform_scene_for_cli(scene, sim);
         v0 = vislib::apply(sim, v0);
         v1 = vislib::apply(sim, v1);
         so.orientation = vislib::multiply(sim.rotation, so.orientation);

@@ -32,6 +32,9 @@ struct TransformArgs {
 void add_transform_options(CLI::App* cmd, TransformArgs& args, const std::string& what);
 // The similarity of `args` (CLI::ValidationError naming the option when malformed).
 vislib::Similarity parse_transform(const TransformArgs& args);
+// transform_scene, then CLI::ValidationError (naming --scale) when a coordinate is no longer
+// finite.
+void transform_scene_for_cli(vislib::Scene& scene, const vislib::Similarity& sim);
 // The matrix as r00,...,r22 (%.17g), as --orientation reads it.
 std::string matrix_text(const vislib::Mat3& m);
 

@@ -242,6 +242,18 @@ TEST(InvarianceCli, SegmentTransformMatchesTheExportedMovedScene) {
                 "segment " + city + seg + " --rotate 10,0,0,0 --json " + dir + "/bad.json", &out),
             2);
   EXPECT_NE(out.find("--rotate"), std::string::npos) << out;
+  // So are a non-finite angle and a transform that leaves the range of double.
+  EXPECT_EQ(vislib_test::run_pvs(
+                "segment " + city + seg + " --rotate nan,0,1,0 --json " + dir + "/bad.json", &out),
+            2);
+  EXPECT_NE(out.find("--rotate"), std::string::npos) << out;
+  EXPECT_EQ(
+      vislib_test::run_pvs(
+          "export " + city + " --scale 1e308 --translate 1e308,0,0 -o " + dir + "/bad.obj", &out),
+      2);
+  EXPECT_NE(out.find("--scale"), std::string::npos) << out;
+  EXPECT_FALSE(std::ifstream(dir + "/bad.json").good());
+  EXPECT_FALSE(std::ifstream(dir + "/bad.obj").good());
 }
 
 // The check on the real maps: 4 random walkable cells' diagonals, N = 128.
