@@ -8,6 +8,11 @@
 // animation time TAU (Scene::position_at; default 0 = state 0).
 // --id-map FILE.json: the runs of consecutive triangle ids of one object with their vertex blocks
 // (vislib/scene/id_map.h), so an engine maps PVS ids to its draw calls.
+// --scale S, --rotate DEG,AX,AY,AZ, --translate X,Y,Z: the scene moved by the similarity
+// x' = S * (R x) + T first (R: DEG degrees about the axis, right-handed; scene_transform.h), to
+// check that visible sets do not depend on placement, orientation and units
+// (docs/visibility-math.md §6); with --rotate the rotation's matrix is printed for
+// `pvs segment --orientation`.
 // Spheres, if any, go to OUT.spheres in the sphere text format (docs/sphere-format.md): all key
 // states without --time, the single state at TAU with --time.
 #include <cstdio>
@@ -19,6 +24,7 @@
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/id_map.h"
+#include "vislib/scene/scene_transform.h"
 #include "vislib/scene/write_gltf.h"
 
 namespace pvs_cli {
@@ -29,6 +35,7 @@ struct ExportOptions {
   int states = 1;
   std::optional<double> time;
   ImportArgs import;
+  TransformArgs transform;
 };
 
 void append_f(std::string& s, const char* fmt, double a, double b, double c) {
@@ -45,7 +52,12 @@ void run_export(const ExportOptions& o) {
     throw CLI::ValidationError("--id-map", "goes with an .obj export (a .glb keeps the id order)");
   check_output_file(o.out, "--output");  // before any work
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
+  const vislib::Similarity sim = parse_transform(o.transform);
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
+  transform_scene_for_cli(scene, sim);
+  if (!o.transform.rotate.empty() && show_progress())
+    std::fprintf(stderr, "pvs: rotation (row-major, for --orientation): %s\n",
+                 matrix_text(sim.rotation).c_str());
   if (glb) {
     for (size_t t = 1; t < scene.triangle_count(); ++t)
       if (scene.triangle_object[t] < scene.triangle_object[t - 1])
@@ -127,6 +139,7 @@ const Registration reg("export", [](CLI::App& app) {
       "--id-map", o->id_map,
       "Also write FILE.json: runs of consecutive triangle ids of one object and their vertex "
       "blocks (PVS ids to draw calls; docs/runtime.md)");
+  add_transform_options(cmd, o->transform, "the scene");
   cmd->callback([o] { run_export(*o); });
 });
 

@@ -28,6 +28,7 @@ void add_segment(CLI::App& app) {
   auto orientation = std::make_shared<std::string>();
   auto seed = std::make_shared<uint64_t>(0);
   auto witness = std::make_shared<bool>(false);
+  auto transform = std::make_shared<TransformArgs>();
   CLI::App* cmd = app.add_subcommand(
       "segment",
       "Triangles visible from a view segment: continuous from-segment visibility over a cubemap "
@@ -40,6 +41,8 @@ void add_segment(CLI::App& app) {
   cmd->add_option("--seed", *seed, "Random cube orientation from this seed (0 = world-aligned)")
       ->excludes(o_opt);
   cmd->add_flag("--witness", *witness, "Add one witness (face, x, y, t) per visible triangle");
+  add_transform_options(cmd, *transform,
+                        "the scene, --from, --to and the cube orientation (and --near by S)");
   cmd->callback([=] {
     check_output_file(a->json_out, "--json", true);  // before any work
     run_with_threads(a->threads, [&] {
@@ -57,6 +60,14 @@ void add_segment(CLI::App& app) {
       vislib::Vec3 v0 = parse_vec3(*from, "--from"), v1 = parse_vec3(*to, "--to");
       double load_s;
       vislib::Scene scene = load(*a, load_s);
+      if (transform->any()) {  // the whole computation moved: scene, segment, cube, near
+        const vislib::Similarity sim = parse_transform(*transform);
+        transform_scene_for_cli(scene, sim);
+        v0 = vislib::apply(sim, v0);
+        v1 = vislib::apply(sim, v1);
+        so.orientation = vislib::multiply(sim.rotation, so.orientation);
+        so.near *= sim.scale;
+      }
       vislib::TriangleBvh tree;
       const double bvh_s = maybe_build_bvh(*a, false, scene, tree, so);
       vislib::SegmentResult r = vislib::with_memory_stage(

@@ -1,6 +1,7 @@
 #include "cli/load_scene.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "cli/commands.h"
@@ -8,6 +9,50 @@
 #include "vislib/scene/scene_info.h"
 
 namespace pvs_cli {
+
+void add_transform_options(CLI::App* cmd, TransformArgs& args, const std::string& what) {
+  cmd->add_option("--scale", args.scale, "Scale " + what + " by S (after --rotate)")
+      ->check(positive());
+  cmd->add_option("--rotate", args.rotate,
+                  "Rotate " + what + " by DEG degrees about the axis AX,AY,AZ through the origin");
+  cmd->add_option("--translate", args.translate,
+                  "Move " + what + " by X,Y,Z (after --rotate and --scale)");
+}
+
+vislib::Similarity parse_transform(const TransformArgs& args) {
+  vislib::Similarity sim;
+  sim.scale = args.scale;
+  if (!args.rotate.empty()) {
+    auto r = parse_doubles(args.rotate, "--rotate", 4);
+    for (double x : r)
+      if (!std::isfinite(x)) throw CLI::ValidationError("--rotate", "the numbers must be finite");
+    if (!(r[1] != 0 || r[2] != 0 || r[3] != 0))
+      throw CLI::ValidationError("--rotate", "the axis must not be zero");
+    sim.rotation = vislib::axis_angle_rotation({r[1], r[2], r[3]}, r[0]);
+  }
+  if (!args.translate.empty()) sim.translation = parse_vec3(args.translate, "--translate");
+  if (!vislib::is_finite(sim.translation))
+    throw CLI::ValidationError("--translate", "the numbers must be finite");
+  return sim;
+}
+
+void transform_scene_for_cli(vislib::Scene& scene, const vislib::Similarity& sim) {
+  vislib::transform_scene(scene, sim);
+  const vislib::Box3 b = scene.bounds();
+  if (!b.empty() && !(vislib::is_finite(b.min) && vislib::is_finite(b.max)))
+    throw CLI::ValidationError("--scale",
+                               "the transform moves the scene beyond the range of double");
+}
+
+std::string matrix_text(const vislib::Mat3& m) {
+  std::string out;
+  for (double x : m.m) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%s%.17g", out.empty() ? "" : ",", x);
+    out += buf;
+  }
+  return out;
+}
 
 void add_import_options(CLI::App* cmd, ImportArgs& args) {
   cmd->add_option("--bsp-models", args.bsp_models,

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "vislib/scene/import.h"
+#include "vislib/scene/scene_transform.h"
 
 namespace pvs_cli {
 
@@ -18,6 +19,24 @@ struct ImportArgs {
 };
 // Adds --bsp-models, --bsp-liquids and --see-through to `cmd`.
 void add_import_options(CLI::App* cmd, ImportArgs& args);
+
+// --scale S, --rotate DEG,AX,AY,AZ, --translate X,Y,Z: the similarity x' = S * (R x) + T (R: DEG
+// degrees about the axis through the origin, right-handed), to move a scene to another place,
+// orientation and unit (docs/visibility-math.md §6 "Invariance under transformation").
+struct TransformArgs {
+  double scale = 1;
+  std::string rotate, translate;
+  bool any() const { return scale != 1 || !rotate.empty() || !translate.empty(); }
+};
+// Adds --scale, --rotate and --translate to `cmd`; `what` ends their help ("the scene", ...).
+void add_transform_options(CLI::App* cmd, TransformArgs& args, const std::string& what);
+// The similarity of `args` (CLI::ValidationError naming the option when malformed).
+vislib::Similarity parse_transform(const TransformArgs& args);
+// transform_scene, then CLI::ValidationError (naming --scale) when a coordinate is no longer
+// finite.
+void transform_scene_for_cli(vislib::Scene& scene, const vislib::Similarity& sim);
+// The matrix as r00,...,r22 (%.17g), as --orientation reads it.
+std::string matrix_text(const vislib::Mat3& m);
 
 // Loads `path` with `states` key states (throws CLI::ValidationError naming --states if < 1;
 // InputError from the importer passes through). Importer warnings go to stderr. Objects whose
