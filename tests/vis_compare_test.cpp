@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -280,6 +281,22 @@ TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
   EXPECT_EQ(ours, 0u);
   EXPECT_EQ(their, 0u);  // lqdm1's vis draws every triangle a ray from a leaf hits
   EXPECT_DOUBLE_EQ(mean_tightness(r), 1.0);
+  // The command on the same sets, written as a PVS file.
+  const std::string dir = temp_dir("vis_compare_lqdm1");
+  const std::string pvs = write_sets(m, sets, dir + "/lqdm1_own.pvs", "{\"resolution\": 24}");
+  std::string out;
+  ASSERT_EQ(
+      run_pvs("vis-compare " + path + " " + pvs + " --samples 1 --json " + dir + "/c.json", &out),
+      0)
+      << out;
+  const auto j = nlohmann::json::parse(read_file(dir + "/c.json"));
+  EXPECT_EQ(j["leaves"], 321);
+  EXPECT_EQ(j["totals"]["ours"], j["totals"]["theirs"]);
+  EXPECT_EQ(j["totals"]["median_tightness"], 1.0);
+  EXPECT_EQ(j["totals"]["extras_confirmed"], 0);
+  EXPECT_EQ(j["totals"]["extras_unconfirmed"], 0);
+  EXPECT_EQ(j["totals"]["our_misses"], 0);
+  EXPECT_EQ(j["totals"]["their_misses"], 0);
 
   // One cell, changed: a hidden triangle added, its most-seen triangle removed.
   const uint32_t cell = 0;
@@ -328,4 +345,47 @@ TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
       "[ budget ] lqdm1 vis-compare, 321 leaves x 1 eye at N = 24 (%llu rays) and one "
       "leaf changed: %.2f s (budget 20 s)\n",
       (unsigned long long)rays, seconds);
+}
+
+// e1m2 and e2m3 against their own sets (opt-in: VISLIB_LONG_TESTS=1): no extras, and every
+// sampled miss of theirs is one of ours (the same sets); prints the misses and where they are.
+TEST(VisCompareLibreQuake, LongOwnSetsOfE1m2AndE2m3) {
+  const char* env = std::getenv("VISLIB_LONG_TESTS");
+  if (!env || std::string(env) != "1") GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1";
+  auto shared = shared_dir();
+  if (!shared) GTEST_SKIP() << "../shared is absent";
+  for (const char* name : {"e1m2.bsp", "e2m3.bsp"}) {
+    const std::string path = *shared + "/scenes/librequake/" + name;
+    if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+    const auto t0 = std::chrono::steady_clock::now();
+    MapCase m = open_map(path);
+    VisCompareOptions o;
+    o.samples = 4;
+    o.resolution = 32;
+    VisCompareResult r = vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, their_sets(m), o);
+    uint64_t rays = 0, misses = 0, never = 0, ambiguous = 0, no_hit = 0;
+    std::map<uint32_t, size_t> missed_faces;
+    for (const VisCompareLeaf& l : r.leaves) {
+      EXPECT_TRUE(l.confirmed.empty() && l.unconfirmed.empty() && l.lacks.empty());
+      EXPECT_EQ(l.our_misses, l.their_misses);
+      rays += l.rays, misses += l.their_misses, never += l.their_never_drawn;
+      ambiguous += l.ambiguous, no_hit += l.no_hit;
+      for (uint32_t t : l.their_missed)
+        for (uint32_t f = 0; f < m.faces.size(); ++f)
+          if (t >= m.faces[f].first_triangle &&
+              t < m.faces[f].first_triangle + m.faces[f].triangle_count)
+            ++missed_faces[f];
+    }
+    std::string faces;
+    for (const auto& [f, leaves] : missed_faces)
+      faces += " " + std::to_string(f) + " (" + m.bsp.face_texture(f) + ", " +
+               std::to_string(leaves) + " leaves)";
+    std::printf(
+        "%s: %zu leaves, %llu rays, %llu no hit, %llu ambiguous, %llu their misses, %llu "
+        "on never-drawn faces; faces missed:%s; %.1f s\n",
+        name, r.leaves.size(), (unsigned long long)rays, (unsigned long long)no_hit,
+        (unsigned long long)ambiguous, (unsigned long long)misses, (unsigned long long)never,
+        faces.c_str(),
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
 }
