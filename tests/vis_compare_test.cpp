@@ -8,6 +8,7 @@
 #include "vislib/eval/vis_compare.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <chrono>
@@ -38,20 +39,24 @@ namespace {
 // (floor, lower halves of the walls), leaf 2 above (ceiling, upper halves). Every face is a quad
 // (two triangles); faces 0 floor, 1 ceiling, 2..5 lower walls, 6..9 upper walls. Leaf 1 sees both
 // leaves; leaf 2 "sees" only itself, so the engine draws nothing of the lower half from above.
-QuakeBsp room_map() {
+// With `water`, face 10 ("*water", triangles 20, 21) lies on the node plane, marked in both
+// leaves.
+QuakeBsp room_map(bool water = false) {
   QuakeBsp m;
   m.entities = "{\n\"classname\" \"worldspawn\"\n}\n";
-  m.texture_names = {"wall"};
-  m.texinfo.resize(1);
+  m.texture_names = {"wall", "*water"};
+  m.texinfo.resize(2);
+  m.texinfo[1].miptex = 1;
   m.edges.push_back({0, 0});  // edge 0 is never used
   m.surfedges.push_back(0);
   auto vertex = [&](float x, float y, float z) {
     m.vertices.push_back({x, y, z});
     return uint32_t(m.vertices.size() - 1);
   };
-  auto face = [&](std::array<std::array<float, 3>, 4> q, uint32_t plane) {
+  auto face = [&](std::array<std::array<float, 3>, 4> q, uint32_t plane, uint32_t texinfo = 0) {
     BspFace f;
     f.plane = plane;
+    f.texinfo = texinfo;
     f.first_edge = uint32_t(m.surfedges.size());
     f.edge_count = 4;
     uint32_t v[4];
@@ -73,6 +78,7 @@ QuakeBsp room_map() {
     face({{{0, 0, z0}, {0, 0, z1}, {64, 0, z1}, {64, 0, z0}}}, 5);
     face({{{0, 64, z0}, {64, 64, z0}, {64, 64, z1}, {0, 64, z1}}}, 6);
   }
+  if (water) face({{{0, 0, 32}, {64, 0, 32}, {64, 64, 32}, {0, 64, 32}}}, 0, 1);
   BspNode n;
   n.plane = 0;
   n.children = {-3, -2};  // front (z > 32): leaf 2, back: leaf 1
@@ -93,6 +99,11 @@ QuakeBsp room_map() {
   above.first_marksurface = 5;
   above.marksurface_count = 5;
   m.marksurfaces = {0, 2, 3, 4, 5, 1, 6, 7, 8, 9};
+  if (water) {
+    m.marksurfaces = {0, 2, 3, 4, 5, 10, 1, 6, 7, 8, 9, 10};
+    below.marksurface_count = above.marksurface_count = 6;
+    above.first_marksurface = 6;
+  }
   m.leaves = {solid, below, above};
   m.visibility = {0x03, 0x02};
   BspModel world;
@@ -112,12 +123,12 @@ struct MapCase {
   std::vector<uint32_t> cell_leaf;
 };
 
-MapCase open_map(const std::string& path) {
+MapCase open_map(const std::string& path, const LoadOptions& options = {}) {
   MapCase c;
   c.path = path;
   c.bsp = read_quake_bsp(path);
-  c.scene = load_scene(path);
-  c.faces = bsp_face_triangles(c.bsp, LoadOptions{});
+  c.scene = load_scene(path, options);
+  c.faces = bsp_face_triangles(c.bsp, options);
   c.cell_leaf = bsp_cell_leaves(c.bsp);
   return c;
 }
@@ -141,10 +152,10 @@ std::string write_sets(const MapCase& m, const std::vector<std::vector<uint32_t>
   return path;
 }
 
-MapCase room(const std::string& dir) {
+MapCase room(const std::string& dir, bool water = false, const LoadOptions& options = {}) {
   const std::string path = dir + "/room.bsp";
-  std::ofstream(path, std::ios::binary) << encode_bsp(room_map());
-  return open_map(path);
+  std::ofstream(path, std::ios::binary) << encode_bsp(room_map(water));
+  return open_map(path, options);
 }
 
 VisCompareOptions fast(int samples) {
@@ -183,6 +194,14 @@ TEST(VisCompare, TheMapsOwnSetsHaveTightnessOneNoExtrasAndNoMisses) {
     EXPECT_TRUE(t < 12 && t != 2 && t != 3) << t << ": not a lower face (0, 2..5)";
   EXPECT_DOUBLE_EQ(median_tightness(r), 1.0);
   EXPECT_EQ(r.degenerate_triangles, 0u);
+  // The same on one thread, byte for byte.
+  tbb::task_arena one(1);
+  std::string single;
+  one.execute([&] {
+    single =
+        vis_compare_json(vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, their_sets(m), fast(2)));
+  });
+  EXPECT_EQ(single, vis_compare_json(r));
 }
 
 TEST(VisCompare, AVisibleExtraIsConfirmedByAWitnessThatTheReferenceRecasts) {
@@ -220,6 +239,32 @@ TEST(VisCompare, ARemovedVisibleTriangleIsLackedAndMissedBySampling) {
   EXPECT_GT(low.our_misses, 0u);
   EXPECT_EQ(low.our_missed, (std::vector<uint32_t>{0, 1}));
   EXPECT_EQ(low.their_misses, 0u);
+}
+
+TEST(VisCompare, SeeThroughWaterHidesNothingFromWitnessesAndSampling) {
+  LoadOptions see_through, opaque;
+  see_through.bsp_liquids = BspLiquids::see_through;
+  for (const LoadOptions& o : {see_through, opaque}) {
+    const bool through = o.bsp_liquids == BspLiquids::see_through;
+    MapCase m = room(temp_dir("vis_compare_water"), true, o);
+    ASSERT_EQ(m.scene.triangle_count(), 22u);
+    ASSERT_EQ(m.scene.triangle_see_through(20), through);
+    auto sets = their_sets(m);
+    insert_sorted(sets[1], 0);  // the floor, below the water, from the upper leaf
+    VisCompareResult r = vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, sets, fast(1));
+    // Through see-through water the floor is seen (confirmed); under opaque water it is hidden.
+    EXPECT_EQ(r.leaves[1].confirmed.size(), through ? 1u : 0u);
+    EXPECT_EQ(r.leaves[1].unconfirmed.size(), through ? 0u : 1u);
+    // From below, the lower leaf's sets hold everything: no misses either way. From above, the
+    // lower half is seen only through see-through water (their misses, ours too but the floor).
+    EXPECT_EQ(r.leaves[0].our_misses + r.leaves[0].their_misses, 0u);
+    EXPECT_EQ(r.leaves[1].their_misses > 0, through);
+    if (through) {
+      EXPECT_LT(r.leaves[1].our_misses, r.leaves[1].their_misses);
+      EXPECT_TRUE(
+          std::binary_search(r.leaves[1].their_missed.begin(), r.leaves[1].their_missed.end(), 0u));
+    }
+  }
 }
 
 TEST(VisCompare, CliPrintsTheTableAndJsonAndRefusesAPvsOfAnotherScene) {
@@ -342,7 +387,8 @@ TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::printf(
-      "[ budget ] lqdm1 vis-compare, 321 leaves x 1 eye at N = 24 (%llu rays) and one "
+      "[ budget ] lqdm1 vis-compare, 321 leaves x 1 eye at N = 24 (%llu rays, library and "
+      "command) and one "
       "leaf changed: %.2f s (budget 20 s)\n",
       (unsigned long long)rays, seconds);
 }
