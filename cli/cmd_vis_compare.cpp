@@ -147,9 +147,13 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
               (unsigned long)num("common"), t["tightness"].get<double>());
   std::printf("  tightness per leaf     mean %.4f, median %.4f\n",
               t["mean_tightness"].get<double>(), t["median_tightness"].get<double>());
-  std::printf("  extras                 %lu: confirmed %lu, unconfirmed (ours wrong?) %lu\n",
-              (unsigned long)(num("extras_confirmed") + num("extras_unconfirmed")),
-              (unsigned long)num("extras_confirmed"), (unsigned long)num("extras_unconfirmed"));
+  std::printf(
+      "  extras                 %lu: confirmed %lu, unconfirmed (ours wrong?) %lu, coincident "
+      "with a face of theirs %lu\n",
+      (unsigned long)(num("extras_confirmed") + num("extras_unconfirmed") +
+                      num("extras_coincident")),
+      (unsigned long)num("extras_confirmed"), (unsigned long)num("extras_unconfirmed"),
+      (unsigned long)num("extras_coincident"));
   std::printf("  ours lacks             %lu\n", (unsigned long)num("ours_lacks"));
   std::printf(
       "  sampling               %d eyes a leaf, N = %d, %lu rays (%lu no hit, %lu "

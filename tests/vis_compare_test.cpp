@@ -40,8 +40,9 @@ namespace {
 // (two triangles); faces 0 floor, 1 ceiling, 2..5 lower walls, 6..9 upper walls. Leaf 1 sees both
 // leaves; leaf 2 "sees" only itself, so the engine draws nothing of the lower half from above.
 // With `water`, face 10 ("*water", triangles 20, 21) lies on the node plane, marked in both
-// leaves.
-QuakeBsp room_map(bool water = false) {
+// leaves. With `twin`, face 10 (triangles 20, 21) is a copy of the ceiling turned the other way,
+// marked in the lower leaf only (so the upper leaf does not draw it).
+QuakeBsp room_map(bool water = false, bool twin = false) {
   QuakeBsp m;
   m.entities = "{\n\"classname\" \"worldspawn\"\n}\n";
   m.texture_names = {"wall", "*water"};
@@ -79,6 +80,7 @@ QuakeBsp room_map(bool water = false) {
     face({{{0, 64, z0}, {64, 64, z0}, {64, 64, z1}, {0, 64, z1}}}, 6);
   }
   if (water) face({{{0, 0, 32}, {64, 0, 32}, {64, 64, 32}, {0, 64, 32}}}, 0, 1);
+  if (twin) face({{{0, 0, 64}, {64, 0, 64}, {64, 64, 64}, {0, 64, 64}}}, 2);
   BspNode n;
   n.plane = 0;
   n.children = {-3, -2};  // front (z > 32): leaf 2, back: leaf 1
@@ -102,6 +104,11 @@ QuakeBsp room_map(bool water = false) {
   if (water) {
     m.marksurfaces = {0, 2, 3, 4, 5, 10, 1, 6, 7, 8, 9, 10};
     below.marksurface_count = above.marksurface_count = 6;
+    above.first_marksurface = 6;
+  }
+  if (twin) {
+    m.marksurfaces = {0, 2, 3, 4, 5, 10, 1, 6, 7, 8, 9};
+    below.marksurface_count = 6;
     above.first_marksurface = 6;
   }
   m.leaves = {solid, below, above};
@@ -152,9 +159,10 @@ std::string write_sets(const MapCase& m, const std::vector<std::vector<uint32_t>
   return path;
 }
 
-MapCase room(const std::string& dir, bool water = false, const LoadOptions& options = {}) {
+MapCase room(const std::string& dir, bool water = false, const LoadOptions& options = {},
+             bool twin = false) {
   const std::string path = dir + "/room.bsp";
-  std::ofstream(path, std::ios::binary) << encode_bsp(room_map(water));
+  std::ofstream(path, std::ios::binary) << encode_bsp(room_map(water, twin));
   return open_map(path, options);
 }
 
@@ -224,6 +232,22 @@ TEST(VisCompare, AVisibleExtraIsConfirmedByAWitnessThatTheReferenceRecasts) {
   // across the quad's diagonal, at the same depth).
   const OracleSample hit = brute_force_first_hit(m.scene, 0, w.eye, w.dir, kDefaultNear);
   EXPECT_TRUE(hit.tri == 0u || hit.tri == 1u) << hit.tri;
+}
+
+TEST(VisCompare, AnExtraSeenOnlyWithACoincidentFaceOfTheirsIsCoincidentNotConfirmed) {
+  MapCase m = room(temp_dir("vis_compare_twin"), false, {}, true);
+  auto sets = their_sets(m);
+  ASSERT_FALSE(std::binary_search(sets[1].begin(), sets[1].end(), 20u));
+  insert_sorted(sets[1], 20);  // the ceiling's twin, from the upper leaf
+  insert_sorted(sets[1], 21);
+  VisCompareResult r = vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, sets, fast(1));
+  const VisCompareLeaf& up = r.leaves[1];
+  EXPECT_TRUE(up.confirmed.empty());
+  EXPECT_TRUE(up.unconfirmed.empty());
+  EXPECT_EQ(up.coincident, (std::vector<uint32_t>{20, 21}));
+  // Sampling from below sees the ceiling or its twin; either is drawn: no miss of theirs there.
+  EXPECT_EQ(r.leaves[0].their_misses, 0u);
+  EXPECT_EQ(r.leaves[0].our_misses, 0u);
 }
 
 TEST(VisCompare, ARemovedVisibleTriangleIsLackedAndMissedBySampling) {

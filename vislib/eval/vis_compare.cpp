@@ -104,8 +104,10 @@ bool set_at_depth(const Context& ctx, const std::vector<RayCrossing>& cr, double
 }
 
 // The witness search for extra `tri` of a cell whose eyes (scene coordinates) are `eyes`.
-bool find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& eyes, Rng& rng,
-                  VisWitness& out) {
+enum class Search { witness, coincident, none };
+Search find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& eyes,
+                    const std::vector<uint8_t>& in_theirs, Rng& rng, VisWitness& out) {
+  bool coincident = false;
   const auto& t = ctx.scene.triangles[tri];
   const Vec3 a = ctx.scene.positions[0][t[0]], b = ctx.scene.positions[0][t[1]],
              c = ctx.scene.positions[0][t[2]];
@@ -139,13 +141,20 @@ bool find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& eye
         candidate = h.tri != kNoHit && (h.tri == tri || ctx.tri_plane[h.tri] == ctx.tri_plane[tri]);
       }
       if (!candidate) continue;
-      if (seen_depth(ctx, ray_crossings(ctx.scene, 0, eye, dir), tri) > 0) {
-        out = {tri, eye, dir};
-        return true;
+      const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, eye, dir);
+      const double lambda = seen_depth(ctx, cr, tri);
+      if (lambda < 0) continue;
+      // Seen, but where a triangle of theirs lies at the same depth (a coincident face they
+      // draw), the ray shows no miss of theirs: search on.
+      if (set_at_depth(ctx, cr, lambda, in_theirs)) {
+        coincident = true;
+        continue;
       }
+      out = {tri, eye, dir};
+      return Search::witness;
     }
   }
-  return false;
+  return coincident ? Search::coincident : Search::none;
 }
 
 // One hit `x` of the ray (eye, dir), missing from ours and/or theirs: the pre-filter (the next
@@ -346,8 +355,12 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
     for (uint32_t t : ours[c]) {
       if (in_theirs[t] || ctx.degenerate[t] || ctx.never_drawn[t]) continue;
       VisWitness w;
-      if (!eyes.empty() && find_witness(ctx, t, eyes, witness_rng, w))
+      const Search found =
+          eyes.empty() ? Search::none : find_witness(ctx, t, eyes, in_theirs, witness_rng, w);
+      if (found == Search::witness)
         row.confirmed.push_back(w);
+      else if (found == Search::coincident)
+        row.coincident.push_back(t);
       else
         row.unconfirmed.push_back(t);
     }
@@ -385,7 +398,8 @@ double mean_tightness(const VisCompareResult& r) {
 std::string vis_compare_json(const VisCompareResult& r) {
   using nlohmann::json;
   json rows = json::array();
-  size_t ours = 0, theirs = 0, common = 0, confirmed = 0, unconfirmed = 0, lacks = 0, never = 0;
+  size_t ours = 0, theirs = 0, common = 0, confirmed = 0, unconfirmed = 0, coincident = 0,
+         lacks = 0, never = 0;
   uint64_t rays = 0, our_misses = 0, their_misses = 0, their_never = 0, ambiguous = 0, no_hit = 0;
   json our_miss_leaves = json::array(), their_miss_leaves = json::array();
   for (const VisCompareLeaf& l : r.leaves) {
@@ -406,6 +420,7 @@ std::string vis_compare_json(const VisCompareResult& r) {
                     {"never_drawn", l.never_drawn},
                     {"extras_confirmed", w},
                     {"extras_unconfirmed", l.unconfirmed},
+                    {"extras_coincident", l.coincident},
                     {"ours_lacks", l.lacks},
                     {"sampled_rays", l.rays},
                     {"no_hit", l.no_hit},
@@ -416,7 +431,8 @@ std::string vis_compare_json(const VisCompareResult& r) {
                     {"our_missed", l.our_missed},
                     {"their_missed", l.their_missed}});
     ours += l.ours, theirs += l.theirs, common += l.common, never += l.never_drawn;
-    confirmed += l.confirmed.size(), unconfirmed += l.unconfirmed.size(), lacks += l.lacks.size();
+    confirmed += l.confirmed.size(), unconfirmed += l.unconfirmed.size();
+    coincident += l.coincident.size(), lacks += l.lacks.size();
     rays += l.rays, our_misses += l.our_misses, their_misses += l.their_misses;
     their_never += l.their_never_drawn, ambiguous += l.ambiguous, no_hit += l.no_hit;
     if (l.our_misses) our_miss_leaves.push_back(l.leaf);
@@ -435,6 +451,7 @@ std::string vis_compare_json(const VisCompareResult& r) {
               {"median_tightness", median_tightness(r)},
               {"extras_confirmed", confirmed},
               {"extras_unconfirmed", unconfirmed},
+              {"extras_coincident", coincident},
               {"ours_lacks", lacks},
               {"never_drawn", never},
               {"sampled_rays", rays},

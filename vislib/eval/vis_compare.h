@@ -8,7 +8,10 @@
 // never draws them) are counted apart as "never drawn". The rest of ours \ theirs are the extras:
 // each is searched for a witness, an eye in A's view region (bsp_leaf_view_region) and a ray whose
 // double-precision re-cast (ray_reference.h) sees the triangle: "confirmed" (their vis misses a
-// visible triangle), else "unconfirmed" (no witness found: ours possibly wrong).
+// visible triangle). An extra whose every seeing ray also crosses a triangle of theirs at the same
+// depth (within eps_z: the coincident twin of a sky or liquid boundary, which they draw) is
+// "coincident": no error of either side. The rest are "unconfirmed" (no witness found: ours
+// possibly wrong).
 //
 // The seeing rule (both the witness and the sampling): along a ray, triangle T is seen when the
 // ray crosses T at lambda > z_near, farther than kReferenceBarycentric inside its edges, and no
@@ -61,8 +64,10 @@ struct VisCompareLeaf {
   size_t never_drawn = 0;                   // ours on faces in no marksurfaces
   std::vector<VisWitness> confirmed;        // extras with a witness, increasing id
   std::vector<uint32_t> unconfirmed;        // extras without one, increasing
-  std::vector<uint32_t> lacks;              // theirs \ ours, increasing
-  double inset = 0;                         // of the view region (Quake units)
+  std::vector<uint32_t> coincident;  // extras seen only where theirs has a face at the same depth
+                                     // (a coincident twin they draw), increasing
+  std::vector<uint32_t> lacks;       // theirs \ ours, increasing
+  double inset = 0;                  // of the view region (Quake units)
   // Sampling.
   uint64_t rays = 0, no_hit = 0, ambiguous = 0;
   uint64_t our_misses = 0, their_misses = 0;  // rays (pixels)
