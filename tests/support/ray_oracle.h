@@ -6,8 +6,8 @@
 //  - RayOracle: Embree (float) with an on-demand ambiguity test (§8 "Embree" bullet, extended by a
 //    depth-gap and a near-plane test). Tests compare the cheap first_hit() with their own answer
 //    and call is_ambiguous() only on a mismatch.
-//  - brute_force_first_hit: double-precision Moller-Trumbore over every triangle with the margins
-//    of the §8 "Reference" bullet, for tiny scenes.
+//  - brute_force_first_hit (vislib/eval/ray_reference.h): double-precision Moller-Trumbore over
+//    every triangle with the margins of the §8 "Reference" bullet.
 // An ambiguous sample is one where the answer may legitimately differ between exact arithmetic,
 // float and double; an oracle must skip it, never fail it.
 #pragma once
@@ -18,6 +18,7 @@
 #include "vislib/base/cubemap.h"
 #include "vislib/base/vec.h"
 #include "vislib/eval/embree_scene.h"
+#include "vislib/eval/ray_reference.h"
 #include "vislib/scene/scene.h"
 
 namespace vislib {
@@ -29,17 +30,6 @@ constexpr double kOracleTimeJitter = 1e-6;  // jitter of the segment parameter t
 constexpr double kOracleDepthGap = 1e-6;    // next surface within this gap, relative to lambda
 constexpr double kOracleNearBand =
     1e-6;  // a surface within this band of z_near, relative to z_near
-
-// Tolerances of brute_force_first_hit (docs/visibility-math.md §8 "Reference").
-constexpr double kReferenceBarycentric = 1e-9;  // smallest barycentric (unitless)
-constexpr double kReferenceDepthGap = 1e-7;     // gap to the next hit, relative to lambda
-constexpr double kReferenceNear = 1e-9;         // |lambda - z_near|, absolute (depth units)
-
-struct OracleSample {
-  uint32_t tri = kNoHit;  // first-hit triangle id, or kNoHit
-  double lambda = 0;      // its depth (inf when kNoHit)
-  bool ambiguous = false;
-};
 
 // The Embree oracle for one segment, orientation, resolution and near distance. Holds a reference
 // to `scene`, which must outlive it (build the scene with origin v0 for best float precision).
@@ -75,35 +65,5 @@ class RayOracle {
   int n_;
   double z_near_;
 };
-
-// The exact-as-double first hit of the ray eye + lambda*dir (lambda > z_near) over every triangle
-// of `scene` at animation time `tau` (Moller-Trumbore, vertices re-centred at `eye` in double).
-// Ties in lambda go to the lower id. `ambiguous` is set when the winner's smallest barycentric is
-// <= kReferenceBarycentric, the next hit of another triangle is within kReferenceDepthGap*lambda,
-// the winner's lambda is within kReferenceNear of z_near, a triangle missed by at most
-// kReferenceBarycentric lies in front of (or within the depth gap behind) the winner, or a triangle
-// on the ray lies within kReferenceNear of z_near. O(triangles) per ray: tiny scenes only.
-// `dir` must be finite and non-zero. Thread-safe, deterministic.
-// Every triangle counts as opaque here (Object::see_through is not read); brute_force_hits is
-// the oracle of the see-through rule.
-OracleSample brute_force_first_hit(const Scene& scene, double tau, Vec3 eye, Vec3 dir,
-                                   double z_near);
-
-// One ray under the see-through rule (docs/visibility.md "See-through triangles"): the ray
-// passes through see-through triangles, recording each one, until the first opaque hit.
-struct OracleRay {
-  // The first opaque hit, with the ambiguity of brute_force_first_hit over the opaque triangles.
-  OracleSample opaque;
-  // See-through triangles hit at z_near < lambda <= opaque.lambda (a tie counts), ascending ids,
-  // without those in `see_through_ambiguous`.
-  std::vector<uint32_t> see_through;
-  // See-through triangles whose status is not stable: hit or missed within kReferenceBarycentric,
-  // within kReferenceNear of z_near, or within kReferenceDepthGap * lambda of the opaque hit. A
-  // test neither requires nor refuses them.
-  std::vector<uint32_t> see_through_ambiguous;
-};
-// The double-precision brute force of brute_force_first_hit with that rule. Thread-safe,
-// deterministic; O(triangles) per ray.
-OracleRay brute_force_hits(const Scene& scene, double tau, Vec3 eye, Vec3 dir, double z_near);
 
 }  // namespace vislib
