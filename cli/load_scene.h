@@ -19,6 +19,9 @@ struct ImportArgs {
 // Adds --bsp-models, --bsp-liquids and --see-through to `cmd`.
 void add_import_options(CLI::App* cmd, ImportArgs& args);
 
+// The importer options of `import` with `states` key states (not checked here).
+vislib::LoadOptions load_options_of(const ImportArgs& import, int states = 1);
+
 // Loads `path` with `states` key states (throws CLI::ValidationError naming --states if < 1;
 // InputError from the importer passes through). Importer warnings go to stderr. Objects whose
 // names match one of `import.see_through` (vislib::mark_see_through) become see-through; a
