@@ -958,6 +958,13 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
                     &out),
             0)
       << out;
+  // Shards merge into the whole bake's bytes.
+  const std::string common = "bake -q " + map + " --cells bsp-leaves --res 16 --face-spacing 32 ";
+  ASSERT_EQ(run_pvs(common + "--shard 0/2 -o " + dir + "/s0.pvs", &out), 0) << out;
+  ASSERT_EQ(run_pvs(common + "--shard 1/2 -o " + dir + "/s1.pvs", &out), 0) << out;
+  ASSERT_EQ(run_pvs("merge -q " + dir + "/s1.pvs " + dir + "/s0.pvs -o " + dir + "/m.pvs", &out), 0)
+      << out;
+  EXPECT_EQ(read_file(dir + "/m.pvs"), read_file(dir + "/tiny.pvs"));
   // Leaf 2 (water, above z = 16): Quake (32, 48, 24) is scene (32, 24, -48).
   ASSERT_EQ(run_pvs("inspect --json " + dir + "/tiny.pvs --at 32,24,-48", &out), 0) << out;
   EXPECT_NE(out.find("\"leaf\": 2"), std::string::npos) << out;
