@@ -74,6 +74,7 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
                                 const BakeSettings& settings, double* seconds = nullptr,
                                 const std::function<void(double)>& progress = {});
 // The same for cells that may carry their own segments (ViewCells::segments): what bake() stores.
+// BSP leaf cells (bsp_cells.h) must use this one; the layout overload asserts a box layout.
 std::vector<uint32_t> bake_cell(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                 const BakeSettings& settings, double* seconds = nullptr,
                                 const std::function<void(double)>& progress = {});

@@ -3,6 +3,7 @@
 #include "vislib/bake/cell_visibility.h"
 
 #include <algorithm>
+#include <cassert>
 #include <iterator>
 
 #include "vislib/base/random.h"
@@ -90,6 +91,7 @@ std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, ui
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
+  assert(layout.kind != pvs::LayoutKind::BspTree);  // BSP leaf cells: pass their ViewCells
   return groups_visibility(scene, rectangle_groups(layout, cell), cell, options, progress);
 }
 

@@ -45,7 +45,8 @@ std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell);
 // of each of cell_rectangles(cells.layout, cell), one group per rectangle.
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell);
 
-// Visible triangles of cell `cell` of `layout`: region_visibility (options.runs orientations,
+// Visible triangles of cell `cell` of `layout` (a grid or box list: BSP leaf cells carry their
+// segments, use the ViewCells overload below): region_visibility (options.runs orientations,
 // options.segment settings) on the bottom and the top rectangle of the view region, united.
 // Depends only on the scene, the view region, `options` and `cell` (not on the thread count).
 // Thread-safe; parallel inside (TBB). `progress(fraction)`, if given, is called after each
