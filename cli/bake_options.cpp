@@ -4,12 +4,15 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
 #include "cli/commands.h"
 #include "cli/options.h"
 #include "cli/threads.h"
+#include "vislib/base/error.h"
+#include "vislib/scene/quake_bsp.h"
 
 namespace pvs_cli {
 namespace {
@@ -94,7 +97,60 @@ CLI::ValidationError placement_error(vislib::PlacementProblem problem) {
 
 }  // namespace
 
+namespace {
+
+bool ends_with_bsp(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& ch : ext) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+  return ext == ".bsp";
+}
+
+// --leaves A-B (or A): the cell leaves of the map numbered A to B.
+std::vector<uint32_t> parse_leaves(const std::string& text, const std::vector<uint32_t>& all) {
+  unsigned lo = 0, hi = 0;
+  char extra;
+  int n = std::sscanf(text.c_str(), "%u-%u%c", &lo, &hi, &extra);
+  if (n == 1) hi = lo;
+  if ((n != 1 && n != 2) || lo > hi)
+    throw CLI::ValidationError("--leaves",
+                               "expected A-B (leaf numbers, A <= B), got '" + text + "'");
+  std::vector<uint32_t> out;
+  for (uint32_t l : all)
+    if (l >= lo && l <= hi) out.push_back(l);
+  if (out.empty())
+    throw CLI::ValidationError("--leaves", "no empty or liquid leaf of model 0 in " + text);
+  return out;
+}
+
+}  // namespace
+
+void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
+  if (a.cells != "bsp-leaves") {
+    for (const char* o : {"--face-spacing", "--leaves"})
+      if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
+    return;
+  }
+  for (const char* o : {"--walkable", "--box", "--grid", "--cell-size", "--eye-height"})
+    if (cmd.count(o))
+      throw CLI::ValidationError(o,
+                                 "cannot be combined with --cells bsp-leaves (the cells are "
+                                 "the map's BSP leaves)");
+  if (!ends_with_bsp(a.scene))
+    throw vislib::InputError(a.scene,
+                             "--cells bsp-leaves needs a Quake map (.bsp): the cells are its BSP "
+                             "leaves");
+}
+
 vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
+  if (a.cells == "bsp-leaves") {
+    const vislib::QuakeBsp bsp = vislib::read_quake_bsp(a.scene);
+    vislib::BspCellOptions o;
+    o.face_spacing = a.face_spacing;
+    if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
+    o.scene = load_options_of(a.import);
+    return vislib::bsp_leaf_cells(bsp, o);
+  }
   vislib::CellPlacement p = placement_of(a);
   try {
     // --grid is parsed only where the library would use it, so that a conflicting combination is
@@ -150,9 +206,21 @@ vislib::BakeSettings settings_of(const BakeArgs& a) {
 }
 
 void add_bake_options(CLI::App* cmd, BakeArgs& a) {
-  cmd->add_option("SCENE", a.scene, "Scene file (.glb .gltf .obj .ply .off .stl)")->required();
+  cmd->add_option("SCENE", a.scene, "Scene file (.glb .gltf .obj .ply .off .stl .bsp)")->required();
   cmd->add_option("-o,--output", a.output, "Output PVS file (a shard file with --shard)")
       ->required();
+  cmd->add_option("--cells", a.cells,
+                  "'bsp-leaves': one cell per empty or liquid leaf of a Quake map's BSP tree "
+                  "(docs/quake.md); default: a grid over --box or --walkable cells")
+      ->check(CLI::IsMember({"bsp-leaves"}));
+  cmd->add_option("--face-spacing", a.face_spacing,
+                  "bsp-leaves: sweep each face of a leaf's view region with parallel segments at "
+                  "most this far apart (Quake units; 0 = the faces' edges only)")
+      ->check(in_range(0.0, 1e6))
+      ->capture_default_str();
+  cmd->add_option("--leaves", a.leaves,
+                  "bsp-leaves: bake only the leaves numbered A to B (A-B), for a partial "
+                  "measurement");
   cmd->add_option("--box", a.box,
                   "Grid box x0,y0,z0,x1,y1,z1 (with --walkable: only place cells in it)");
   cmd->add_option("--grid", a.grid, "Grid cells nx,ny,nz over --box");

@@ -9,6 +9,7 @@
 
 #include "cli/load_scene.h"
 #include "vislib/bake/bake.h"
+#include "vislib/bake/bsp_cells.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/scene/scene.h"
 
@@ -29,8 +30,11 @@ struct BakeArgs {
   int states = 1;
   ImportArgs import;
   std::string preset = "default";
-  std::string bvh = "on";           // --bvh on|off
-  std::string long_segments = "1";  // --long-segments: 1..8 or auto
+  std::string bvh = "on";                         // --bvh on|off
+  std::string long_segments = "1";                // --long-segments: 1..8 or auto
+  std::string cells;                              // --cells: "" (grid or walkable) or bsp-leaves
+  double face_spacing = vislib::kBspFaceSpacing;  // --face-spacing (bsp-leaves), Quake units
+  std::string leaves;                             // --leaves A-B (bsp-leaves)
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).
@@ -42,7 +46,14 @@ vislib::Shard parse_shard(const std::string& text);
 // The preset fills the options not given and says so on stderr (not -q).
 void apply_preset(BakeArgs& a, const CLI::App& cmd);
 
-// The view cells of the options over `scene` (vislib::place_view_cells); a refused placement is
+// --cells bsp-leaves: refuses (CLI::ValidationError, exit 2) the options that place cells
+// otherwise (--walkable, --box, --grid, --cell-size, --eye-height) and, before the scene is
+// loaded, a scene that is not a .bsp (InputError naming it). Without --cells: refuses
+// --face-spacing and --leaves.
+void check_cells_options(const BakeArgs& a, const CLI::App& cmd);
+
+// The view cells of the options over `scene` (vislib::place_view_cells, or with --cells
+// bsp-leaves vislib::bsp_leaf_cells of the map read again from a.scene); a refused placement is
 // reported as the option that caused it.
 vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene);
 

@@ -31,6 +31,11 @@ bool file_exists(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0;
 }
 
+const char* kind_name(const vislib::ViewCells& cells) {
+  if (cells.layout.kind == pvs::LayoutKind::BspTree) return "bsp-leaves";
+  return cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable";
+}
+
 // After the bake: the checkpoint's damage, the summary, the --json report.
 void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const vislib::BakeReport& r,
                  const std::string& checkpoint) {
@@ -82,6 +87,7 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
 
 void run_bake(BakeArgs& a, const CLI::App& cmd) {
   const vislib::Shard shard = parse_shard(a.shard);
+  check_cells_options(a, cmd);
   apply_preset(a, cmd);
   vislib::BakeRunInfo info;
   info.scene = a.scene;
@@ -89,7 +95,7 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
   info.preset = a.preset;
   info.resolution = a.resolution;
   info.runs = a.runs;
-  if (a.grid.empty()) info.cell_size = a.cell_size;
+  if (a.grid.empty() && a.cells.empty()) info.cell_size = a.cell_size;
   info.shard = shard;
   // Every output is checked before any work.
   check_output_file(a.output, "--output");
@@ -124,11 +130,12 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     throw Exit{2};
   }
   if (a.dry_run) {
-    std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell\n", n,
-                cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
-                (n + shard.count - 1 - shard.index) / shard.count, shard.index, shard.count,
-                vislib::cell_boundary_segments(vislib::to_box3(cells.layout.view_region(0))).size(),
-                a.runs);
+    size_t segments = 0;  // mean over the cells, rounded down
+    for (uint32_t c = 0; c < n; ++c)
+      for (const auto& g : vislib::cell_segment_groups(cells, c)) segments += g.size();
+    std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s\n", n,
+                kind_name(cells), (n + shard.count - 1 - shard.index) / shard.count, shard.index,
+                shard.count, segments / n, a.runs, cells.segments.empty() ? "" : " (mean)");
     return;
   }
   if (a.resume && !file_exists(checkpoint) && show_progress())
@@ -136,8 +143,7 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
                  checkpoint.c_str());
   if (show_progress())
     std::fprintf(stderr, "pvs bake: %u cells (%s), %zu triangles, shard %u/%u\n", n,
-                 cells.layout.kind == pvs::LayoutKind::Grid ? "grid" : "walkable",
-                 scene.triangle_count(), shard.index, shard.count);
+                 kind_name(cells), scene.triangle_count(), shard.index, shard.count);
   const vislib::BakeSettings settings = settings_of(a);
   if (settings.long_segments == 0 && show_progress() &&
       vislib::long_segments_apply(scene, settings))
@@ -156,7 +162,8 @@ void add_bake(CLI::App& app) {
       "bake",
       "Bake a PVS file: the triangles (or objects) visible from every view cell, from-segment runs "
       "on the perimeter of the bottom and top rectangles of each cell's eye band. Cells: a grid "
-      "over --box, or --walkable cells over the floors of the scene.");
+      "over --box, --walkable cells over the floors of the scene, or a Quake map's BSP leaves "
+      "(--cells bsp-leaves, segments sweeping each leaf's faces).");
   add_bake_options(cmd, *a);
   cmd->callback([a, cmd] { run_with_threads(a->threads, [&] { run_bake(*a, *cmd); }); });
 }

@@ -125,9 +125,15 @@ void run_inspect(const InspectArgs& a) {
               {"bytes", b.size}};
     if (b.encoding == pvs::Encoding::Delta) j["reference"] = b.reference;
     json segs = json::array();
-    for (const auto& s :
-         vislib::cell_boundary_segments(vislib::to_box3(info.layout.view_region(c))))
-      segs.push_back({{"from", {s.from.x, s.from.y, s.from.z}}, {"to", {s.to.x, s.to.y, s.to.z}}});
+    if (info.layout.kind == pvs::LayoutKind::BspTree) {
+      // A BSP leaf cell: its segments sweep the leaf's region (the file's metadata says how).
+      j["leaf"] = info.layout.cell_leaf[c];
+    } else {
+      for (const auto& s :
+           vislib::cell_boundary_segments(vislib::to_box3(info.layout.view_region(c))))
+        segs.push_back(
+            {{"from", {s.from.x, s.from.y, s.from.z}}, {"to", {s.to.x, s.to.y, s.to.z}}});
+    }
     j["boundary_segments"] = segs;
     std::vector<uint32_t> ids;
     if (b.encoding != pvs::Encoding::Absent) ids = r.read_cell(c);

@@ -173,7 +173,11 @@ void print_cell(const json& j, const std::vector<uint32_t>& ids, uint32_t cell_c
               box_text(info.layout.view_region(c)).c_str());
   std::printf("  block: %s, %u bytes", vislib::block_encoding_name(b).c_str(), b.size);
   if (b.encoding == pvs::Encoding::Delta) std::printf(" (against cell %u)", b.reference);
-  std::printf("\n  boundary segments (%zu):\n", segs.size());
+  if (j.contains("leaf"))
+    std::printf("\n  BSP leaf %u (segments sweeping its faces: see the metadata)\n",
+                j["leaf"].get<uint32_t>());
+  else
+    std::printf("\n  boundary segments (%zu):\n", segs.size());
   for (const auto& s : segs)
     std::printf("    %s -> %s\n", s["from"].dump().c_str(), s["to"].dump().c_str());
   if (b.encoding == pvs::Encoding::Absent) {

@@ -70,9 +70,7 @@ void add_import_options(CLI::App* cmd, ImportArgs& args) {
       ->delimiter(',');
 }
 
-vislib::Scene load_scene_for_cli(const std::string& path, int states, const ImportArgs& import) {
-  if (states < 1)
-    throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
+vislib::LoadOptions load_options_of(const ImportArgs& import, int states) {
   vislib::LoadOptions options;
   options.states = states;
   options.bsp_models =
@@ -80,6 +78,13 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states, const Impo
   options.bsp_liquids = import.bsp_liquids == "omit"          ? vislib::BspLiquids::omit
                         : import.bsp_liquids == "see-through" ? vislib::BspLiquids::see_through
                                                               : vislib::BspLiquids::opaque;
+  return options;
+}
+
+vislib::Scene load_scene_for_cli(const std::string& path, int states, const ImportArgs& import) {
+  if (states < 1)
+    throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
+  const vislib::LoadOptions options = load_options_of(import, states);
   std::vector<std::string> warnings;
   const auto t0 = std::chrono::steady_clock::now();
   vislib::Scene scene = vislib::load_scene(path, options, &warnings);

@@ -37,6 +37,8 @@ vislib::Similarity parse_transform(const TransformArgs& args);
 void transform_scene_for_cli(vislib::Scene& scene, const vislib::Similarity& sim);
 // The matrix as r00,...,r22 (%.17g), as --orientation reads it.
 std::string matrix_text(const vislib::Mat3& m);
+// The importer options of `import` with `states` key states (not checked here).
+vislib::LoadOptions load_options_of(const ImportArgs& import, int states = 1);
 
 // Loads `path` with `states` key states (throws CLI::ValidationError naming --states if < 1;
 // InputError from the importer passes through). Importer warnings go to stderr. Objects whose

@@ -50,7 +50,9 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
       {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
       {"coplanar", s.coplanar == CoplanarRule::First ? "first" : "both"},
       {"eps_z", s.eps_z},
-      {"boundary", "perimeter of the eye band's bottom and top rectangles"}};
+      {"boundary", cells.segments.empty()
+                       ? "perimeter of the eye band's bottom and top rectangles"
+                       : "segments sweeping the boundary faces of each cell's view region"}};
   if (uses_long_segments(scene, settings)) m["long_segments"] = settings.long_segments;
   info.metadata = m.dump();
   return info;
@@ -83,23 +85,39 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
   return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
+std::vector<uint32_t> bake_cell(const Scene& scene, const ViewCells& cells, uint32_t cell,
+                                const BakeSettings& settings, double* seconds,
+                                const std::function<void(double)>& progress) {
+  CellVisibility v = cell_visibility(scene, cells, cell, settings.region, progress);
+  if (seconds) *seconds = v.seconds;
+  return ids_of(scene, settings.granularity, v.triangles, v.spheres);
+}
+
 namespace {
 
-// The from-segment runs of one cell: K per perimeter segment of each of its rectangles.
-uint64_t cell_runs(const pvs::CellLayout& layout, uint32_t cell, int runs) {
+// The from-segment runs of one cell: K per segment of each of its groups.
+uint64_t cell_runs(const ViewCells& cells, uint32_t cell, int runs) {
   uint64_t segments = 0;
-  for (const Box3& rect : cell_rectangles(layout, cell))
-    segments += perimeter_segments(rect).size();
+  for (const std::vector<Segment>& g : cell_segment_groups(cells, cell)) segments += g.size();
   return segments * uint64_t(runs);
 }
 
-// Run 0's segment of every perimeter edge of every cell of the layout, in cell order.
-std::vector<SegmentEnds> all_edges(const pvs::CellLayout& layout) {
+// Run 0's segment of every segment of every cell, in cell order.
+std::vector<SegmentEnds> all_edges(const ViewCells& cells) {
   std::vector<SegmentEnds> all;
-  for (uint32_t c = 0; c < layout.cell_count(); ++c)
-    for (const Box3& rect : cell_rectangles(layout, c))
-      for (const Segment& s : perimeter_segments(rect)) all.emplace_back(s.from, s.to);
+  for (uint32_t c = 0; c < cells.layout.cell_count(); ++c)
+    for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
+      for (const Segment& s : g) all.emplace_back(s.from, s.to);
   return all;
+}
+
+// Every cell's segments, its groups in order (expected_cell_work).
+std::vector<std::vector<Segment>> all_cell_segments(const ViewCells& cells) {
+  std::vector<std::vector<Segment>> out(cells.layout.cell_count());
+  for (uint32_t c = 0; c < cells.layout.cell_count(); ++c)
+    for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
+      out[c].insert(out[c].end(), g.begin(), g.end());
+  return out;
 }
 
 // Wall and CPU clocks of the calling thread, and of the whole process.
@@ -153,12 +171,16 @@ BakeSettings resolved_settings(const Scene& scene, const ViewCells& cells,
   // --long-segments auto: L from a pilot over every cell of the layout (not only this shard's),
   // so that every shard and every resumed run chooses the same L (long_segments.h).
   BakeSettings settings = requested;
+  if (!cells.segments.empty()) {  // a cell's own segments are not shared with another's
+    settings.share_segments = false;
+    settings.long_segments = 1;
+  }
   if (settings.long_segments == 0) {
     settings.long_segments = 1;
     if (long_segments_apply(scene, settings)) {
       SegmentOptions run0 = settings.region.segment;
       run0.bvh = bvh;
-      report.long_segment_choice = choose_long_segments(scene, all_edges(cells.layout), run0);
+      report.long_segment_choice = choose_long_segments(scene, all_edges(cells), run0);
       settings.long_segments = report.long_segment_choice.parts;
     }
   }
@@ -186,20 +208,20 @@ std::unique_ptr<Checkpoint> open_checkpoint(
 }
 
 // Announces to `shared_runs` the runs of the cells this bake computes (settings.share_segments).
-void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const pvs::FileInfo& info,
-                      Shard shard,
+void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const ViewCells& cells,
+                      const pvs::FileInfo& info, Shard shard,
                       const std::vector<std::optional<std::vector<uint32_t>>>& recovered,
                       SegmentRunCache& shared_runs, BakeReport& report) {
   const uint32_t n = info.layout.cell_count();
   if (uses_long_segments(scene, settings)) {
     // The plan covers every cell of the layout, so that it does not depend on the shard or on
     // the cells recovered from a checkpoint.
-    shared_runs.plan_chains(all_edges(info.layout), settings.long_segments);
+    shared_runs.plan_chains(all_edges(cells), settings.long_segments);
   }
   for (uint32_t c = 0; c < n; ++c) {
     if (!in_shard(c, shard) || recovered[c]) continue;
-    for (const Box3& rect : cell_rectangles(info.layout, c))
-      for (const Segment& s : perimeter_segments(rect)) shared_runs.expect(s.from, s.to);
+    for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
+      for (const Segment& s : g) shared_runs.expect(s.from, s.to);
   }
   // The pilot's runs of the chosen L are runs of this bake: not computed again.
   for (LongSegmentChoice::Run& run : report.long_segment_choice.runs)
@@ -213,8 +235,8 @@ void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const pv
 // delta references, whatever the cell count. The bytes are those of pvs::write_pvs.
 // Writes files.output, baking the cells of `shard` not in `recovered` with `run_settings`
 // (`runs` orientations each); adds the runs of the baked cells to `runs_done`.
-void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
-                  const BakeSettings& run_settings, int runs,
+void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInfo& info,
+                  Shard shard, const BakeSettings& run_settings, int runs,
                   std::vector<std::optional<std::vector<uint32_t>>>& recovered,
                   Checkpoint* checkpoint, const BakeFiles& files, const BakeProgressFn& progress,
                   std::atomic<uint64_t>& runs_done, BakeReport& report) {
@@ -234,7 +256,7 @@ void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
   std::vector<uint8_t> to_bake(n, 0);
   for (uint32_t c = 0; c < n; ++c) to_bake[c] = in_shard(c, shard) && !recovered[c];
   const std::vector<double> work =
-      expected_cell_work(info.layout, to_bake, runs, run_settings.share_segments);
+      expected_cell_work(all_cell_segments(cells), to_bake, runs, run_settings.share_segments);
   double work_total = 0, work_finished = 0, work_running = 0;
   for (double w : work) work_total += w;
   auto state = [&] {
@@ -294,7 +316,7 @@ void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
                   try {
                     ids = with_memory_stage(
                         "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
-                          return bake_cell(scene, info.layout, c, run_settings, &seconds, in_cell);
+                          return bake_cell(scene, cells, c, run_settings, &seconds, in_cell);
                         });
                   } catch (...) {
                     --g_cell_depth;
@@ -309,7 +331,7 @@ void stream_cells(const Scene& scene, const pvs::FileInfo& info, Shard shard,
                     add_to(&t_cells, wall_now() - w0);
                     add_to(&t_cells_cpu, cpu);
                   }
-                  runs_done += cell_runs(info.layout, c, runs);
+                  runs_done += cell_runs(cells, c, runs);
                   const double k0 = wall_now();
                   if (checkpoint) checkpoint->append(c, ids);
                   add_to(&t_checkpoint, wall_now() - k0);
@@ -383,13 +405,13 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   BakeSettings run_settings = settings;
   if (settings.share_segments) {
     run_settings.region.shared_runs = &shared_runs;
-    plan_shared_runs(scene, settings, info, shard, recovered, shared_runs, report);
+    plan_shared_runs(scene, settings, cells, info, shard, recovered, shared_runs, report);
   }
   run_settings.region.segment.bvh = bvh;
   std::atomic<uint64_t> runs_done{0};
 
-  stream_cells(scene, info, shard, run_settings, settings.region.runs, recovered, checkpoint.get(),
-               files, progress, runs_done, report);
+  stream_cells(scene, cells, info, shard, run_settings, settings.region.runs, recovered,
+               checkpoint.get(), files, progress, runs_done, report);
   report.times.shared_wait = shared_runs.wait_seconds();
   report.segment_runs_shared = shared_runs.runs_shared();
   report.segment_runs_computed = runs_done.load() - report.segment_runs_shared;

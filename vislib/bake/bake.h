@@ -73,6 +73,11 @@ uint64_t bake_key(const pvs::FileInfo& info, Shard shard);
 std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
                                 const BakeSettings& settings, double* seconds = nullptr,
                                 const std::function<void(double)>& progress = {});
+// The same for cells that may carry their own segments (ViewCells::segments): what bake() stores.
+// BSP leaf cells (bsp_cells.h) must use this one; the layout overload asserts a box layout.
+std::vector<uint32_t> bake_cell(const Scene& scene, const ViewCells& cells, uint32_t cell,
+                                const BakeSettings& settings, double* seconds = nullptr,
+                                const std::function<void(double)>& progress = {});
 
 struct BakeProgress {
   uint32_t done = 0;     // cells of the shard finished, resumed ones included
@@ -151,6 +156,8 @@ struct BakeReport {
 // blocks to a temporary file in cell order as cells finish (index and header patched at the end;
 // pvs::StreamWriter), renamed over `files.output` once complete; then deletes the checkpoint.
 // Runs on the calling thread's TBB arena: its max_concurrency() is the thread count.
+// Cells with their own segments (ViewCells::segments, BSP leaves) run without shared edges and
+// long segments (their segments are not shared between cells), whatever `settings` say.
 // Memory: the cells in flight (4 per thread at most) and the delta references of StreamWriter,
 // plus O(cells) bytes of index and timings; not the sets of all cells (on resume, the recovered
 // cells are held until written). Throws InputError for a checkpoint of another bake or a bake

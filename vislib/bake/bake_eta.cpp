@@ -29,18 +29,29 @@ std::vector<double> expected_cell_work(const pvs::CellLayout& layout,
                                        const std::vector<uint8_t>& bake, int runs,
                                        bool share_segments) {
   const uint32_t n = layout.cell_count();
-  assert(bake.size() == n && runs >= 1);
+  assert(bake.size() == n);
   std::vector<std::vector<Segment>> segments(n);
-  double total = 0;
-  size_t count = 0;
   for (uint32_t c = 0; c < n; ++c) {
     if (!bake[c]) continue;
     for (const Box3& rect : cell_rectangles(layout, c))
-      for (const Segment& s : perimeter_segments(rect)) {
-        segments[c].push_back(s);
-        total += length(s.to - s.from);
-        ++count;
-      }
+      for (const Segment& s : perimeter_segments(rect)) segments[c].push_back(s);
+  }
+  return expected_cell_work(segments, bake, runs, share_segments);
+}
+
+std::vector<double> expected_cell_work(const std::vector<std::vector<Segment>>& segments,
+                                       const std::vector<uint8_t>& bake, int runs,
+                                       bool share_segments) {
+  const size_t n = segments.size();
+  assert(bake.size() == n && runs >= 1);
+  double total = 0;
+  size_t count = 0;
+  for (size_t c = 0; c < n; ++c) {
+    if (!bake[c]) continue;
+    for (const Segment& s : segments[c]) {
+      total += length(s.to - s.from);
+      ++count;
+    }
   }
   std::vector<double> work(n, 0.0);
   if (count == 0) return work;
@@ -48,12 +59,14 @@ std::vector<double> expected_cell_work(const pvs::CellLayout& layout,
   const double fixed = kRunFixedEdges * mean;
   const double unit = mean + fixed;
   std::set<std::array<uint64_t, 6>> computed;  // run 0 of these segments is counted already
-  for (uint32_t c = 0; c < n; ++c)
+  for (size_t c = 0; c < n; ++c) {
+    if (!bake[c]) continue;
     for (const Segment& s : segments[c]) {
       const double run = (length(s.to - s.from) + fixed) / unit;
       const bool first = !share_segments || computed.insert(key_of(s)).second;
       work[c] += run * double(runs - 1 + (first ? 1 : 0));
     }
+  }
   return work;
 }
 

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/kernel/region_visibility.h"
 
 namespace vislib {
 
@@ -35,6 +36,12 @@ constexpr double kRunFixedEdges = 1.0;
 // apart: each edge of a chain counts for the first cell that uses it. bake.size() must equal
 // layout.cell_count(). Deterministic; O(cells log cells).
 std::vector<double> expected_cell_work(const pvs::CellLayout& layout,
+                                       const std::vector<uint8_t>& bake, int runs,
+                                       bool share_segments);
+
+// The same for cells given by their segments (segments[c]: every segment cell c runs, such as
+// cell_segment_groups gives; the mean is over these). bake.size() must equal segments.size().
+std::vector<double> expected_cell_work(const std::vector<std::vector<Segment>>& segments,
                                        const std::vector<uint8_t>& bake, int runs,
                                        bool share_segments);
 

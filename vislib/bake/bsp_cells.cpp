@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -107,6 +109,62 @@ bool share_face(const std::vector<PlanarFace>& a, const std::vector<PlanarFace>&
       if (area >= kBspPortalMinArea) return true;
     }
   return false;
+}
+
+// Segment end points closer than this (Quake units) are one point: an edge of two faces of one
+// polytope is computed once per face and agrees to about 1e-12 units; shorter segments are dropped.
+constexpr double kBspSameEndpoint = 1e-6;
+
+bool same_segment(const Segment& s, Vec3 a, Vec3 b) {
+  auto near = [](Vec3 p, Vec3 q) { return length(p - q) <= kBspSameEndpoint; };
+  return (near(s.from, a) && near(s.to, b)) || (near(s.from, b) && near(s.to, a));
+}
+
+// The chords of convex polygon `poly` (normal `n`) parallel to its longest edge, at equal steps of
+// at most `spacing` across it, strictly between its extreme vertices.
+void face_chords(const std::vector<Vec3>& poly, Vec3 n, double spacing, std::vector<Segment>& out) {
+  const size_t m = poly.size();
+  size_t longest = 0;
+  for (size_t i = 1; i < m; ++i)
+    if (length(poly[(i + 1) % m] - poly[i]) > length(poly[(longest + 1) % m] - poly[longest]))
+      longest = i;
+  Vec3 d = poly[(longest + 1) % m] - poly[longest];
+  if (length(d) <= kBspSameEndpoint) return;
+  d = d * (1.0 / length(d));
+  Vec3 w = cross(n, d);
+  w = w * (1.0 / length(w));
+  double lo = dot(w, poly[0]), hi = lo;
+  for (const Vec3& p : poly) {
+    lo = std::min(lo, dot(w, p));
+    hi = std::max(hi, dot(w, p));
+  }
+  const double width = hi - lo;
+  if (!(width > spacing)) return;
+  const int steps = int(std::ceil(width / spacing));
+  for (int k = 1; k < steps; ++k) {
+    const double h = lo + width * double(k) / double(steps);
+    bool any = false;
+    Vec3 a{}, b{};
+    double ta = 0, tb = 0;
+    for (size_t i = 0; i < m; ++i) {
+      const Vec3& u = poly[i];
+      const Vec3& v = poly[(i + 1) % m];
+      const double hu = dot(w, u), hv = dot(w, v);
+      if (hu == hv || h < std::min(hu, hv) || h > std::max(hu, hv)) continue;
+      const Vec3 p = u + (v - u) * ((h - hu) / (hv - hu));
+      const double t = dot(d, p);
+      if (!any || t < ta) {
+        a = p;
+        ta = t;
+      }
+      if (!any || t > tb) {
+        b = p;
+        tb = t;
+      }
+      any = true;
+    }
+    if (any && length(b - a) > kBspSameEndpoint) out.push_back({a, b});
+  }
 }
 
 bool boxes_touch(const Box3& a, const Box3& b) {
@@ -215,6 +273,75 @@ pvs::CellLayout bsp_leaf_layout(const QuakeBsp& bsp, const std::vector<uint32_t>
         L.neighbours[b].push_back(uint32_t(a));
       }
   return L;  // neighbours sorted: a's list gets b in increasing order, and earlier a's first
+}
+
+std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double spacing) {
+  assert(spacing >= 0);
+  std::vector<Segment> quake;
+  for (const std::vector<Vec3>& f : region.faces)
+    for (size_t i = 0; i < f.size(); ++i) {
+      const Vec3 a = f[i], b = f[(i + 1) % f.size()];
+      if (length(b - a) <= kBspSameEndpoint) continue;
+      bool seen = false;
+      for (const Segment& s : quake) seen = seen || same_segment(s, a, b);
+      if (!seen) quake.push_back({a, b});
+    }
+  if (spacing > 0)
+    for (const std::vector<Vec3>& f : region.faces) {
+      if (f.size() < 3) continue;
+      const PlanarFace pf = planar(f);
+      if (!std::isfinite(pf.normal.x)) continue;
+      face_chords(f, pf.normal, spacing, quake);
+    }
+  std::vector<Segment> out;
+  out.reserve(quake.size());
+  for (const Segment& s : quake) out.push_back({quake_to_scene(s.from), quake_to_scene(s.to)});
+  return out;
+}
+
+ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
+  assert(options.face_spacing >= 0);
+  const std::vector<uint32_t> all = bsp_cell_leaves(bsp);
+  std::vector<uint32_t> leaves = options.leaves.empty() ? all : options.leaves;
+  for (size_t i = 0; i < leaves.size(); ++i)
+    if (!std::binary_search(all.begin(), all.end(), leaves[i]) ||
+        (i > 0 && leaves[i] <= leaves[i - 1]))
+      throw std::invalid_argument("leaf " + std::to_string(leaves[i]) +
+                                  " is not an empty or liquid leaf of model 0 in increasing order");
+  ViewCells cells;
+  cells.layout = bsp_leaf_layout(bsp, leaves);
+  cells.segments.resize(leaves.size());
+  uint32_t thin = 0, uninset = 0;
+  for (const BspLeafPiece& piece : bsp_leaf_pieces(bsp)) {
+    const uint32_t c = cells.layout.leaf_cell[piece.leaf];
+    if (c == pvs::kNoCell || piece.volume.empty()) continue;
+    const BspViewRegion region = bsp_leaf_view_region(piece.volume);
+    if (region.inset < kBspLeafInset) ++thin;
+    if (region.inset == 0) ++uninset;
+    std::vector<Segment> s = bsp_region_segments(region.volume, options.face_spacing);
+    cells.segments[c].insert(cells.segments[c].end(), s.begin(), s.end());
+  }
+  const char* liquids = options.scene.bsp_liquids == BspLiquids::omit          ? "omit"
+                        : options.scene.bsp_liquids == BspLiquids::see_through ? "see-through"
+                                                                               : "opaque";
+  nlohmann::json d = {
+      {"kind", "bsp-leaves"},
+      {"leaves", leaves.size()},
+      {"leaf_subset", !options.leaves.empty()},
+      {"face_spacing", options.face_spacing},
+      {"face_spacing_units", "quake"},
+      {"region",
+       "leaf volume inset by inset units (halved down to min_inset for thin leaves, else 0); "
+       "its edges and chords of each face parallel to its longest edge at most face_spacing "
+       "apart"},
+      {"inset", kBspLeafInset},
+      {"min_inset", kBspLeafMinInset},
+      {"leaves_inset_less", thin},
+      {"leaves_not_inset", uninset},
+      {"bsp_models", options.scene.bsp_models == BspModels::all ? "all" : "world"},
+      {"bsp_liquids", liquids}};
+  cells.description = d.dump();
+  return cells;
 }
 
 }  // namespace vislib

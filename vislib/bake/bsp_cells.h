@@ -14,7 +14,11 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/view_cells.h"
+#include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/import.h"
 #include "vislib/scene/quake_bsp.h"
+#include "vislib/scene/quake_bsp_volumes.h"
 
 namespace vislib {
 
@@ -31,5 +35,37 @@ std::vector<uint32_t> bsp_cell_leaves(const QuakeBsp& bsp);
 // leaf). Boxes: the scene-space bounding box of the leaf's volume (bsp_leaf_pieces). Neighbours as
 // the file comment says. Deterministic. Throws std::invalid_argument on a bad cell_leaves.
 pvs::CellLayout bsp_leaf_layout(const QuakeBsp& bsp, const std::vector<uint32_t>& cell_leaves);
+
+// The default spacing of the segments that sweep each boundary face of a leaf's view region
+// (Quake units, about 40 cm): what a point inside a leaf sees is seen from the region's boundary
+// (the region holds no geometry), and the face is sampled by parallel segments at most this far
+// apart (docs/quake.md measures what the spacing buys).
+constexpr double kBspFaceSpacing = 16.0;
+
+// The segments a convex region's visibility is computed on (Quake coordinates in, scene
+// coordinates out, quake_to_scene): first every edge of every face of `region`, in face order and
+// each once (an edge shared by two faces is kept where it first appears); then, when `spacing` >
+// 0, for each face in order, the chords of the face parallel to its longest edge (the first such
+// edge in vertex order) at equal steps of at most `spacing` Quake units across it, strictly
+// between its extreme vertices. spacing 0: the edges only. Degenerate edges and faces (shorter or
+// narrower than 1e-6 units) give no segment. Deterministic.
+std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double spacing);
+
+struct BspCellOptions {
+  double face_spacing = kBspFaceSpacing;  // bsp_region_segments' spacing, >= 0 (0: edges only)
+  // The leaves to bake, a subset of bsp_cell_leaves (increasing); empty: all of them.
+  std::vector<uint32_t> leaves;
+  // The import options the scene was loaded with (bsp_models, bsp_liquids), recorded in the
+  // description so that a reader knows what the triangle ids index.
+  LoadOptions scene;
+};
+
+// The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
+// bsp_region_segments(bsp_leaf_view_region(volume of its leaf), face_spacing), and a description
+// (JSON) recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
+// kBspLeafMinInset, the count of leaves inset less than kBspLeafInset) and the scene options.
+// Throws std::invalid_argument for leaves that are not an increasing subset of bsp_cell_leaves.
+// Deterministic.
+ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options);
 
 }  // namespace vislib

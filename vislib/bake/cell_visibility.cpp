@@ -3,9 +3,9 @@
 #include "vislib/bake/cell_visibility.h"
 
 #include <algorithm>
+#include <cassert>
 #include <iterator>
 
-#include "vislib/bake/view_cells.h"
 #include "vislib/base/random.h"
 
 namespace vislib {
@@ -40,24 +40,27 @@ std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell) 
   return bottom_and_top(to_box3(layout.view_region(cell)));
 }
 
-CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
-                               const RegionOptions& options,
-                               const std::function<void(double)>& progress) {
-  Box3 region = to_box3(layout.view_region(cell));
+namespace {
+
+// The union of segments_visibility over `groups`, group g seeded Rng::derive(cell_seed, g).
+CellVisibility groups_visibility(const Scene& scene,
+                                 const std::vector<std::vector<Segment>>& groups, uint32_t cell,
+                                 const RegionOptions& options,
+                                 const std::function<void(double)>& progress) {
   CellVisibility out;
-  out.segments = cell_boundary_segments(region);
-  const std::vector<Box3> rect = cell_rectangles(layout, cell);
-  const int rects = int(rect.size());
+  for (const std::vector<Segment>& g : groups)
+    out.segments.insert(out.segments.end(), g.begin(), g.end());
+  const int count = int(groups.size());
   const uint64_t seed = cell_seed(options.seed, cell);
-  for (int r = 0; r < rects; ++r) {
+  for (int r = 0; r < count; ++r) {
     RegionOptions o = options;
     o.seed = Rng::derive(seed, uint64_t(r));
     std::function<void(size_t, size_t)> run_done;
     if (progress)
       run_done = [&](size_t done, size_t total) {
-        progress((double(r) + double(done) / double(std::max<size_t>(1, total))) / double(rects));
+        progress((double(r) + double(done) / double(std::max<size_t>(1, total))) / double(count));
       };
-    RegionResult rr = region_visibility(scene, rect[r], o, run_done);
+    RegionResult rr = segments_visibility(scene, groups[r], o, run_done);
     std::vector<uint32_t> merged;
     merged.reserve(out.triangles.size() + rr.visible.size());
     std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(), rr.visible.end(),
@@ -70,6 +73,32 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
     out.seconds += rr.seconds;
   }
   return out;
+}
+
+std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout, uint32_t cell) {
+  std::vector<std::vector<Segment>> groups;
+  for (const Box3& rect : cell_rectangles(layout, cell)) groups.push_back(perimeter_segments(rect));
+  return groups;
+}
+
+}  // namespace
+
+std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell) {
+  if (!cells.segments.empty()) return {cells.segments.at(cell)};
+  return rectangle_groups(cells.layout, cell);
+}
+
+CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress) {
+  assert(layout.kind != pvs::LayoutKind::BspTree);  // BSP leaf cells: pass their ViewCells
+  return groups_visibility(scene, rectangle_groups(layout, cell), cell, options, progress);
+}
+
+CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint32_t cell,
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress) {
+  return groups_visibility(scene, cell_segment_groups(cells, cell), cell, options, progress);
 }
 
 }  // namespace vislib

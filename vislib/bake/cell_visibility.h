@@ -2,7 +2,9 @@
 //
 // A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeter of
 // the view region's bottom and top rectangles (the paper's perimeter heuristic, §4.1, applied at
-// the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell.
+// the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell; or, for
+// cells that carry their own segments (ViewCells::segments: a BSP leaf's faces swept,
+// bsp_cells.h), the union of runs on those.
 #pragma once
 
 #include <cstdint>
@@ -10,6 +12,7 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/view_cells.h"
 #include "vislib/base/vec.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/scene.h"
@@ -28,7 +31,7 @@ uint64_t cell_seed(uint64_t seed, uint32_t cell);
 struct CellVisibility {
   std::vector<uint32_t> triangles;  // visible triangle ids, sorted
   std::vector<uint32_t> spheres;    // visible sphere indices, sorted
-  std::vector<Segment> segments;    // cell_boundary_segments(view region)
+  std::vector<Segment> segments;    // every group of cell_segment_groups, in order
   double seconds = 0;               // kernel seconds
 };
 
@@ -36,13 +39,26 @@ struct CellVisibility {
 // region (one when the region is flat in y).
 std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell);
 
-// Visible triangles of cell `cell` of `layout`: region_visibility (options.runs orientations,
+// The segments cell `cell`'s visibility is computed on, in groups: group g's runs are seeded
+// Rng::derive(cell_seed(seed, cell), g) (segments_visibility). Cells with their own segments
+// (cells.segments not empty): cells.segments[cell], one group. Otherwise the perimeter segments
+// of each of cell_rectangles(cells.layout, cell), one group per rectangle.
+std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell);
+
+// Visible triangles of cell `cell` of `layout` (a grid or box list: BSP leaf cells carry their
+// segments, use the ViewCells overload below): region_visibility (options.runs orientations,
 // options.segment settings) on the bottom and the top rectangle of the view region, united.
 // Depends only on the scene, the view region, `options` and `cell` (not on the thread count).
 // Thread-safe; parallel inside (TBB). `progress(fraction)`, if given, is called after each
 // from-segment run with the fraction in (0, 1] of the cell's runs done (from the calling thread
 // or a worker; never two calls at once).
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
+                               const RegionOptions& options,
+                               const std::function<void(double)>& progress = {});
+
+// The same on the segment groups of cell_segment_groups(cells, cell): segments_visibility on each
+// group, united. Same contract (thread-safe, independent of the thread count).
+CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress = {});
 

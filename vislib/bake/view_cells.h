@@ -34,6 +34,10 @@ namespace vislib {
 struct ViewCells {
   pvs::CellLayout layout;
   std::string description;
+  // Empty, or one list per cell: the segments each cell's visibility is computed on instead of
+  // the perimeters of its view region's rectangles (cell_visibility.h), for cells whose region
+  // is not a box (BSP leaves: bsp_cells.h). Scene coordinates.
+  std::vector<std::vector<Segment>> segments;
 };
 
 pvs::Box to_pvs_box(const Box3& b);

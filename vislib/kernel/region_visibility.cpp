@@ -41,8 +41,14 @@ Mat3 run_orientation(uint64_t seed, size_t segment, int run) {
 
 RegionResult region_visibility(const Scene& scene, const Box3& box, const RegionOptions& options,
                                const std::function<void(size_t, size_t)>& progress) {
+  return segments_visibility(scene, perimeter_segments(box), options, progress);
+}
+
+RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segments,
+                                 const RegionOptions& options,
+                                 const std::function<void(size_t, size_t)>& progress) {
   RegionResult result;
-  result.segments = perimeter_segments(box);
+  result.segments = std::move(segments);
   const size_t total = result.segments.size() * size_t(options.runs);
   std::vector<uint8_t> in_union(scene.triangle_count(), 0),
       sphere_in_union(scene.sphere_count(), 0);

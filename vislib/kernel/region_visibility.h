@@ -76,10 +76,17 @@ struct RegionResult {
   double seconds = 0;
 };
 
-// Runs every perimeter segment `runs` times. `progress(done, total)` is called after each run if
-// given (from the calling thread).
+// Runs every perimeter segment `runs` times: segments_visibility(perimeter_segments(box)).
+// `progress(done, total)` is called after each run if given (from the calling thread).
 RegionResult region_visibility(const Scene& scene, const Box3& box, const RegionOptions& options,
                                const std::function<void(size_t, size_t)>& progress = {});
+
+// The same on any list of segments (a region whose boundary is not a box's: bsp_cells.h sweeps a
+// polytope's faces): segment s is run `runs` times with run_orientation(options.seed, s, k), in
+// list order; result.segments = `segments`. Deterministic as region_visibility.
+RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segments,
+                                 const RegionOptions& options,
+                                 const std::function<void(size_t, size_t)>& progress = {});
 
 // Object ids (sorted) of the objects owning at least one of `triangles` or `spheres`.
 std::vector<uint32_t> objects_of(const Scene& scene, const std::vector<uint32_t>& triangles,
