@@ -89,10 +89,12 @@ PY
 # moved to a free point when the scene encloses it; its default radii), which it reports and the
 # page is given; last the same with the cylinder lookup. Eye lookup, 512 x 512 faces, 90 degrees,
 # 320 x 240. PSNR at least 38 dB.
-nf_compare() {  # NAME CENTRE R1,R2 [LOOKUP]
+nf_compare() {  # NAME CENTRE R1,R2 [LOOKUP]  (CENTRE -: the page reads pvs export --centres)
+  local pin=(--centre "$2")
+  [[ $2 == - ]] && pin=()
   set +e
   PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
-    --path "0,1.6,0@30,1.6,0" --fov 90 --size 320x240 --near-far "$3" --centre "$2" \
+    --path "0,1.6,0@30,1.6,0" --fov 90 --size 320x240 --near-far "$3" "${pin[@]}" \
     --env-size 512 --lookup "${4:-eye}" --json "$work/$1.json" --png "$work/$1" --png-frames 0
   local rc=$?
   set -e
@@ -121,7 +123,49 @@ nf_compare near_far 0,1.6,0 15,40
   --json "$work/near_far_default/cpu.json"
 read -r centre radii < <(python3 -c 'import json, sys; j = json.load(open(sys.argv[1]))
 print(",".join(repr(v) for v in j["centre"]), "%r,%r" % (j["r1"], j["r2"]))' "$work/near_far_default/cpu.json")
-nf_compare near_far_default "$centre" "$radii"
+nf_compare near_far_default - "$radii"
+python3 - "$work/near_far_default/cpu.json" "$work/near_far_default.json" <<'PY'
+import json, sys
+cpu = json.load(open(sys.argv[1]))["centre"]
+web = json.load(open(sys.argv[2]))["frames"][0]
+ok = web["centre"] == cpu and web["centre_source"] == "pvs view"
+print("web-check-test: the page's centre %s (%s), pvs view's %s: %s"
+      % (web["centre"], web["centre_source"], cpu, "pass" if ok else "FAIL"))
+sys.exit(0 if ok else 1)
+PY
+# The centre in every cell the page enters with near-far on equals pvs view's (without --centre):
+# the page reads the centres pvs export --centres computes with pvs view's function.
+centres_path="-60,1.6,0;-40,1.6,0;-20,1.6,0;0,1.6,0;20,1.6,0;40,1.6,0;0,1.6,40;0,1.6,80"
+set +e
+PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
+  --path "$centres_path" --size 160x120 --near-far 30,60 --env-size 32 --json "$work/centres.json"
+rc=$?
+set -e
+[[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh (centres) exited $rc"; exit 1; }
+python3 - "$pvs" "$work/city.pvs" "$root/data/city.glb" "$work/centres.json" "$work/centres" \
+  "$centres_path" <<'PY'
+import json, subprocess, sys
+pvs, pvs_file, scene, check, out, path = sys.argv[1:7]
+frames = json.load(open(check))["frames"]
+points = path.split(";")
+ok, cells, moved = len(frames) == len(points), set(), 0
+for f, p in zip(frames, points):
+    x, y, z = (float(v) for v in p.split(","))
+    subprocess.run([pvs, "view", pvs_file, "--scene", scene, "--at", p, "--look",
+                    "%r,%r,%r" % (x + 1, y, z), "--frame", "16x12",
+                    "--env-size", "16", "-q", "-o", out + "/cpu.png", "--json", out + "/cpu.json"],
+                   check=True, stderr=subprocess.DEVNULL)
+    cpu = json.load(open(out + "/cpu.json"))
+    good = f["cell"] == cpu["cell"] and f["centre"] == cpu["centre"] and f["centre_source"] == "pvs view"
+    ok = ok and good
+    cells.add(f["cell"])
+    print("  frame %d at %-12s cell %3d: page's centre %s, pvs view's %s %s"
+          % (f["frame"], p, f["cell"], f["centre"], cpu["centre"], "" if good else "MISMATCH"))
+ok = ok and len(cells) >= 5
+print("web-check-test: near-far centres in %d cells equal pvs view's: %s"
+      % (len(cells), "pass" if ok else "FAIL"))
+sys.exit(0 if ok else 1)
+PY
 "$pvs" view "$work/city.pvs" --scene "$root/data/city.glb" --at 0,1.6,0 --look 30,1.6,0 \
   --near-far "$radii" --centre "$centre" --env-size 512 --lookup cylinder --frame 320x240 -q \
   -o "$work/near_far_cylinder/cpu.png"
@@ -130,31 +174,57 @@ centre=0,1.6,0
 # CloVR: entering the crossing's cell, the near region grows by the C API's scheduler; 40 frames
 # at the same eye. The near count never shrinks, grows (frame 0 injects the first merged ring's
 # objects), reaches the end (done), and near + environment map is the cell's whole set in every
-# frame.
+# frame of the growth. Once complete, the page draws the cell's exact partition by triangle:
+# triangles drawn + far (environment map) + dynamic far equal the cell's PVS count, and the last
+# frame equals, triangle counts and pixels, the frame of the same view with CloVR off.
 clovr_path=$(printf '0,1.6,0@30,1.6,0;%.0s' $(seq 40))
 set +e
 PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
   --path "${clovr_path%;}" --fov 90 --size 160x120 --near-far 15,40 --centre "$centre" \
-  --env-size 128 --clovr --json "$work/clovr.json"
+  --env-size 128 --clovr --json "$work/clovr.json" --png "$work/clovr" --png-frames 39
 rc=$?
+PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$root/data/city.glb" "$work/city.pvs" --bare \
+  --path "0,1.6,0@30,1.6,0" --fov 90 --size 160x120 --near-far 15,40 --centre "$centre" \
+  --env-size 128 --json "$work/clovr_off.json" --png "$work/clovr_off" --png-frames 0
+rc=$((rc | $?))
 set -e
 [[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh (CloVR) exited $rc"; exit 1; }
-python3 - "$pvs" "$work/city.pvs" "$work/clovr.json" <<'PY'
+/usr/bin/python3 - "$pvs" "$work/city.pvs" "$work/clovr.json" "$work/clovr_off.json" \
+  "$work/clovr/frame_0039.png" "$work/clovr_off/frame_0000.png" <<'PY'
 import json, subprocess, sys
-pvs, pvs_file, check = sys.argv[1:4]
+import matplotlib.image as mi
+import numpy as np
+pvs, pvs_file, check, off_check, png, off_png = sys.argv[1:7]
 frames = json.load(open(check))["frames"]
+off = json.load(open(off_check))["frames"][0]
 count = json.loads(subprocess.run([pvs, "inspect", pvs_file, "--at", "0,1.6,0", "--json", "-q"],
                                   capture_output=True, text=True, check=True).stdout)["visible_count"]
 near = [f["clovr"]["near_count"] for f in frames]
 ok = all(f["clovr"] is not None for f in frames) and frames[-1]["clovr"]["done"] == 1
 ok = ok and all(b >= a for a, b in zip(near, near[1:])) and near[0] < near[-1]
-ok = ok and all(f["triangles_drawn"] == f["clovr"]["near_count"] and
-                f["clovr"]["near_count"] + f["clovr"]["environment_count"] == count for f in frames)
-done = next(i for i, f in enumerate(frames) if f["clovr"]["done"]) if frames[-1]["clovr"]["done"] else None
+growing = [f for f in frames if not f["clovr"]["done"]]
+final = [f for f in frames if f["clovr"]["done"]]
+ok = ok and all(not f["clovr"]["exact"] and f["triangles_drawn"] == f["clovr"]["near_count"] and
+                f["clovr"]["near_count"] + f["clovr"]["environment_count"] == count for f in growing)
+ok = ok and len(final) > 0 and all(f["clovr"]["exact"] for f in final)
+done = len(growing) if final else None
 print("web-check-test: CloVR near region over %d frames: %s (of %d; complete at frame %s); "
       "ms per frame %s: %s" % (len(frames), near, count, done,
                                [round(f["ms"]) for f in frames[:12]], "pass" if ok else "FAIL"))
-sys.exit(0 if ok else 1)
+last = frames[-1]
+a, b = (np.round(mi.imread(f)[:, :, :3] * 255) for f in (png, off_png))
+differ = int((np.abs(a - b).max(axis=2) > 0).sum())
+exact = (last["triangles_drawn"] + last["triangles_far"] + last["triangles_far_dynamic"] == count
+         and all(last[k] == off[k] for k in ("triangles_drawn", "triangles_far",
+                                              "triangles_far_dynamic"))
+         and a.shape == b.shape and differ == 0)
+print("web-check-test: CloVR complete: drawn %d + far %d + dynamic far %d = %d (PVS count %d); "
+      "CloVR off: %d + %d + %d; %d pixels differ from the CloVR-off frame: %s"
+      % (last["triangles_drawn"], last["triangles_far"], last["triangles_far_dynamic"],
+         last["triangles_drawn"] + last["triangles_far"] + last["triangles_far_dynamic"], count,
+         off["triangles_drawn"], off["triangles_far"], off["triangles_far_dynamic"], differ,
+         "pass" if exact else "FAIL"))
+sys.exit(0 if ok and exact else 1)
 PY
 # Prefetch (prefetch=0): on entering a cell the worker fetches each touching neighbour's block and
 # its Delta chain (pvs_rt_delta_chain), so that walking into a neighbour waits for no request.

@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cmath>
 
+#include "vislib/bake/cell_set.h"
 #include "vislib/bake/free_space.h"
 #include "vislib/bake/view_cells.h"
 
@@ -27,6 +28,16 @@ std::optional<ViewCentre> default_view_centre(const Scene& scene, const Box3& vi
   if (!fs.centre_enclosed) return ViewCentre{region_centre, false};
   if (!fs.free_point) return std::nullopt;
   return ViewCentre{*fs.free_point, true};
+}
+
+std::vector<std::optional<ViewCentre>> default_view_centres(const Scene& scene,
+                                                            const pvs::CellLayout& layout) {
+  std::vector<std::optional<ViewCentre>> out;
+  out.reserve(layout.cell_count());
+  for (uint32_t c = 0; c < layout.cell_count(); ++c)
+    out.push_back(
+        default_view_centre(scene, to_box3(layout.view_region(c)), view_region_centre(layout, c)));
+  return out;
 }
 
 NearFarRadii default_near_far_radii(const pvs::Box& cell_box, double eye_axis) {
