@@ -9,10 +9,12 @@
 # frame's pixels: rasterisation against ray casting on triangle edges, and coplanar faces).
 # Then the page's near-far frame against `pvs view`'s with the same choices (the centre pvs view
 # chose, radii, environment map size, eye lookup, 90 degrees, 320 x 240): PSNR at least 38 dB; the
-# CloVR growth of the near region frame by frame; and that prefetching neighbours with their Delta
-# chains leaves nothing to wait for on entering one.
+# CloVR growth of the near region frame by frame, ending on the exact set by triangle; the page's
+# near-far centre in 7 cells against pvs view's; that prefetching neighbours with their Delta
+# chains leaves nothing to wait for on entering one; and dynamic far objects against pvs view's,
+# both failing (BoxAnimated) and passing (a box in front of a wall) the range test.
 # Usage: web-check-test.sh PVS_EXE WORKDIR. Exit 0 pass, 1 fail, 2 missing build, 77 chromium
-# cannot start. Time budget: the bake about 20 s on 2 cores, the replay about 10 s.
+# cannot start. Time budget: the bake about 20 s on 2 cores, the checks about 90 s.
 set -euo pipefail
 pvs=$1 work=$2
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -286,3 +288,77 @@ PY
 else
   echo "web-check-test: dynamic far check skipped: $box absent"
 fi
+# Dynamic far objects that pass the range test: a static wall 20 m away and, 6.5-9.5 m away in
+# front of it, a 3 m box whose node moves 2 m along x (a glTF written here; 4 states). Eye and
+# centre at the origin, radii 2,5: the box's triangles are dynamic far, displaced by Eq. 2, and in
+# front of the wall in the range map, so its fragments pass (pvs view: far_dynamic_shown > 0);
+# the page's frame must show the box as pvs view's does (PSNR at least 38 dB, and over a thousand
+# pixels of the box's colour).
+mkdir -p "$work/wallbox"
+python3 - "$work/wallbox/wallbox.gltf" <<'PY'
+import base64, json, struct, sys
+# A static wall (z = -20) behind a box (centre 0,1,-10) whose node moves 2 along x.
+wall = [(-10, -1, -20), (10, -1, -20), (10, 6, -20), (-10, 6, -20)]
+wall_idx = [0, 1, 2, 0, 2, 3]
+box = [(x, y, z) for x in (-1.5, 1.5) for y in (0, 3) for z in (-9.5, -6.5)]
+box_idx = [0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4, 2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2,
+           1, 3, 7, 1, 7, 5]
+blob, views, accessors = b"", [], []
+def add(data, fmt, count, type_, ctype, minmax=None):
+    global blob
+    views.append({"buffer": 0, "byteOffset": len(blob), "byteLength": len(data)})
+    a = {"bufferView": len(views) - 1, "componentType": ctype, "count": count, "type": type_}
+    if minmax: a["min"], a["max"] = minmax
+    accessors.append(a)
+    blob += data + b"\0" * (-len(data) % 4)
+    return len(accessors) - 1
+def positions(ps):
+    lo = [min(p[k] for p in ps) for k in range(3)]; hi = [max(p[k] for p in ps) for k in range(3)]
+    return add(struct.pack("<%df" % (3 * len(ps)), *[c for p in ps for c in p]), "", len(ps), "VEC3", 5126, (lo, hi))
+def indices(ix):
+    return add(struct.pack("<%dI" % len(ix), *ix), "", len(ix), "SCALAR", 5125)
+meshes = [{"name": "wall", "primitives": [{"attributes": {"POSITION": positions(wall)}, "indices": indices(wall_idx)}]},
+          {"name": "box", "primitives": [{"attributes": {"POSITION": positions(box)}, "indices": indices(box_idx)}]}]
+times = add(struct.pack("<2f", 0, 1), "", 2, "SCALAR", 5126, ([0], [1]))
+moves = add(struct.pack("<6f", 0, 0, 0, 2, 0, 0), "", 2, "VEC3", 5126)
+g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1]}],
+     "nodes": [{"name": "wall", "mesh": 0}, {"name": "box", "mesh": 1, "translation": [0, 0, 0]}],
+     "meshes": meshes, "accessors": accessors, "bufferViews": views,
+     "buffers": [{"byteLength": len(blob), "uri": "data:application/octet-stream;base64," + base64.b64encode(blob).decode()}],
+     "animations": [{"channels": [{"sampler": 0, "target": {"node": 1, "path": "translation"}}],
+                     "samplers": [{"input": times, "output": moves, "interpolation": "LINEAR"}]}]}
+json.dump(g, open(sys.argv[1], "w"))
+PY
+"$pvs" bake "$work/wallbox/wallbox.gltf" --states 4 --cell-size 8 --box -4,0,-4,4,3,4 --res 16 \
+  --runs 1 -q -o "$work/wallbox/wallbox.pvs"
+"$pvs" view "$work/wallbox/wallbox.pvs" --scene "$work/wallbox/wallbox.gltf" --states 4 \
+  --at 0,1.6,0 --look 0,1.6,-10 --near-far 2,5 --centre 0,1.6,0 --env-size 256 --lookup eye \
+  --frame 320x240 -q -o "$work/wallbox/cpu.png" --json "$work/wallbox/cpu.json"
+set +e
+WEB_STATES=4 PVS_EXE=$pvs bash "$root/scripts/web-check.sh" "$work/wallbox/wallbox.gltf" \
+  "$work/wallbox/wallbox.pvs" --bare --path "0,1.6,0@0,1.6,-10" --fov 90 --size 320x240 \
+  --near-far 2,5 --centre 0,1.6,0 --env-size 256 --lookup eye --json "$work/wallbox/web.json" \
+  --png "$work/wallbox/web" --png-frames 0
+rc=$?
+set -e
+[[ $rc -eq 0 ]] || { echo "web-check-test: FAIL: web-check.sh (dynamic far shown) exited $rc"; exit 1; }
+/usr/bin/python3 - "$work/wallbox/cpu.png" "$work/wallbox/web/frame_0000.png" \
+  "$work/wallbox/cpu.json" "$work/wallbox/web.json" <<'PY'
+import json, sys
+import matplotlib.image as mi
+import numpy as np
+a, b = (np.round(mi.imread(f)[:, :, :3] * 255) for f in sys.argv[1:3])
+cpu = json.load(open(sys.argv[3]))["triangles"]
+web = json.load(open(sys.argv[4]))["frames"][0]
+mse = float(((a - b) ** 2).mean())
+psnr = 10 * np.log10(255.0 ** 2 / mse) if mse > 0 else float("inf")
+box = a[a.shape[0] // 2, a.shape[1] // 2]  # the frame's centre shows the box
+shown = int((np.abs(b - box).max(axis=2) <= 8).sum())
+ok = (a.shape == b.shape and psnr >= 38.0 and cpu["far_dynamic_shown"] > 0 and shown > 1000
+      and web["triangles_far_dynamic"] == cpu["far_dynamic_drawn"])
+print("web-check-test: dynamic far shown: %d dynamic far triangles (pvs view %d, %d of them shown), "
+      "%d pixels of the box in the page's frame, PSNR %.2f dB (>= 38): %s"
+      % (web["triangles_far_dynamic"], cpu["far_dynamic_drawn"], cpu["far_dynamic_shown"], shown,
+         psnr, "pass" if ok else "FAIL"))
+sys.exit(0 if ok else 1)
+PY

@@ -1,6 +1,8 @@
 // view_setup.cpp: the camera, centre and radii of a near-far view of a cell.
 #include "vislib/render/view_setup.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -32,11 +34,12 @@ std::optional<ViewCentre> default_view_centre(const Scene& scene, const Box3& vi
 
 std::vector<std::optional<ViewCentre>> default_view_centres(const Scene& scene,
                                                             const pvs::CellLayout& layout) {
-  std::vector<std::optional<ViewCentre>> out;
-  out.reserve(layout.cell_count());
-  for (uint32_t c = 0; c < layout.cell_count(); ++c)
-    out.push_back(
-        default_view_centre(scene, to_box3(layout.view_region(c)), view_region_centre(layout, c)));
+  // Cells are independent and each writes its own slot: the same result for any thread count.
+  std::vector<std::optional<ViewCentre>> out(layout.cell_count());
+  tbb::parallel_for(uint32_t(0), layout.cell_count(), [&](uint32_t c) {
+    out[c] =
+        default_view_centre(scene, to_box3(layout.view_region(c)), view_region_centre(layout, c));
+  });
   return out;
 }
 
