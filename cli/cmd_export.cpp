@@ -13,25 +13,37 @@
 // check that visible sets do not depend on placement, orientation and units
 // (docs/visibility-math.md §6); with --rotate the rotation's matrix is printed for
 // `pvs segment --orientation`.
+// --centres FILE.json --pvs FILE.pvs (with a .glb): the near-far centre O of every cell of the
+// PVS as `pvs view` chooses it without --centre (default_view_centres: the centre of the cell's
+// view region, moved to the nearest free sample when the scene encloses it), for the web page
+// (docs/web.md): {"format": "vislib-view-centres 1", "cell_count": N, "centres": [[x, y, z] or
+// null (every sample enclosed), ...], "moved": [cells whose centre was moved]}. The PVS must have
+// been baked for the scene (fingerprint and universe, else exit 2).
 // Spheres, if any, go to OUT.spheres in the sphere text format (docs/sphere-format.md): all key
 // states without --time, the single state at TAU with --time.
 #include <cstdio>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
+#include "pvs_format/pvs_format.h"
+#include "vislib/bake/cell_set.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/render/view_setup.h"
 #include "vislib/scene/id_map.h"
 #include "vislib/scene/scene_transform.h"
+#include "vislib/scene/scene_fingerprint.h"
 #include "vislib/scene/write_gltf.h"
 
 namespace pvs_cli {
 namespace {
 
 struct ExportOptions {
-  std::string scene, out, id_map;
+  std::string scene, out, id_map, centres, pvs;
   int states = 1;
   std::optional<double> time;
   ImportArgs import;
@@ -44,13 +56,46 @@ void append_f(std::string& s, const char* fmt, double a, double b, double c) {
   s += buf;
 }
 
+// --centres: every cell's default near-far centre (the one pvs view chooses), as JSON.
+std::string centres_json(const vislib::Scene& scene, const std::string& pvs_path) {
+  pvs::ReadOptions opt;
+  opt.expected_fingerprint = vislib::scene_fingerprint(scene);
+  const pvs::CellLayout layout = vislib::reading_pvs(pvs_path, [&] {
+    pvs::Reader r = pvs::Reader::from_file(pvs_path, opt);
+    vislib::check_universe(pvs_path, r.info(), scene);
+    return r.info().layout;
+  });
+  const auto centres = vislib::default_view_centres(scene, layout);
+  nlohmann::json list = nlohmann::json::array(), moved = nlohmann::json::array();
+  for (uint32_t c = 0; c < centres.size(); ++c) {
+    if (!centres[c]) {
+      list.push_back(nullptr);
+      continue;
+    }
+    const vislib::Vec3 p = centres[c]->point;
+    list.push_back({p.x, p.y, p.z});
+    if (centres[c]->moved) moved.push_back(c);
+  }
+  const nlohmann::json j = {{"format", "vislib-view-centres 1"},
+                            {"pvs", std::filesystem::path(pvs_path).filename().string()},
+                            {"cell_count", centres.size()},
+                            {"centres", list},
+                            {"moved", moved}};
+  return j.dump() + "\n";
+}
+
 void run_export(const ExportOptions& o) {
   const bool glb = vislib::file_extension(o.out) == ".glb";
   if (glb && o.time)
     throw CLI::ValidationError("--time", "a .glb export keeps every key state (morph targets)");
   if (glb && !o.id_map.empty())
     throw CLI::ValidationError("--id-map", "goes with an .obj export (a .glb keeps the id order)");
+  if (o.centres.empty() != o.pvs.empty())
+    throw CLI::ValidationError("--centres", "--centres FILE.json and --pvs FILE.pvs go together");
+  if (!o.centres.empty() && !glb)
+    throw CLI::ValidationError("--centres", "goes with a .glb export (for the web client)");
   check_output_file(o.out, "--output");  // before any work
+  if (!o.centres.empty()) check_output_file(o.centres, "--centres");
   if (!o.id_map.empty()) check_output_file(o.id_map, "--id-map");
   const vislib::Similarity sim = parse_transform(o.transform);
   vislib::Scene scene = load_scene_for_cli(o.scene, o.states, o.import);
@@ -68,7 +113,10 @@ void run_export(const ExportOptions& o) {
                                               ": the objects are not in id order, so a .glb export "
                                               "would not keep the triangle ids "
                                               "(export .obj instead)");
+    // The centres first: a PVS that does not fit the scene leaves no output at all.
+    const std::string centres = o.centres.empty() ? "" : centres_json(scene, o.pvs);
     vislib::write_file_atomic(o.out, vislib::scene_to_glb(scene));
+    if (!o.centres.empty()) vislib::write_file_atomic(o.centres, centres);
     if (show_progress())
       std::fprintf(stderr, "pvs: wrote %s (%zu objects, %zu triangles in id order)\n",
                    o.out.c_str(), scene.objects.size(), scene.triangle_count());
@@ -140,6 +188,10 @@ const Registration reg("export", [](CLI::App& app) {
       "Also write FILE.json: runs of consecutive triangle ids of one object and their vertex "
       "blocks (PVS ids to draw calls; docs/runtime.md)");
   add_transform_options(cmd, o->transform, "the scene");
+  cmd->add_option("--centres", o->centres,
+                  "With a .glb: also write FILE.json, the near-far centre pvs view chooses for "
+                  "each cell of --pvs (docs/web.md)");
+  cmd->add_option("--pvs", o->pvs, "The PVS file whose cells --centres describes");
   cmd->callback([o] { run_export(*o); });
 });
 

@@ -8,7 +8,7 @@ scene=${1:-$root/data/city.glb}
 pvs=${2:-$root/out/city.pvs}
 source "$root/scripts/web_stage.sh"
 trap web_unstage EXIT
-WEB_PORT=${WEB_PORT:-8035} web_stage "$scene" "$pvs"
+WEB_PORT=${WEB_PORT:-8035} web_stage "$scene" "$pvs" centres  # near-far: pvs view's centres
 echo "Open $PAGE&at=0,1.6,0&prefetch=0"
 echo "  with near-far (Eq. 1 morph within 15-40 m, the far region from the cell's cube map) and"
 echo "  CloVR's progressive near region: $PAGE&at=0,1.6,0&prefetch=0&nearfar=15,40&clovr=1"

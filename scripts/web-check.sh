@@ -11,6 +11,8 @@
 # --popping K: the popping meter every K frames (popping_pixels per measured frame).
 # --clovr: the near region grows by the CloVR scheduler on entering a cell (per frame: clovr).
 # --bare: the frames without the overlays (to compare with pvs inspect --render's frames).
+# --near-far without --centre: each cell's centre is pvs view's (pvs export --centres); per frame
+# `centre` and `centre_source`.
 # Exit: 0 done, 1 the page failed, 2 bad arguments or missing build, 77 chromium cannot start.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -18,7 +20,7 @@ usage() { sed -n 's/^# Usage: //p;s/^#   *\(\[--png.*\)/\1/p' "$0" >&2; exit 2; 
 [[ $# -ge 2 ]] || usage
 scene=$1 pvs=$2
 shift 2
-path_text="" json="" png="" png_frames="" size=640x400 fov=60 extra=
+path_text="" json="" png="" png_frames="" size=640x400 fov=60 extra= near_far="" pinned=""
 while [[ $# -gt 0 ]]; do
   if [[ $1 == --bare ]]; then
     extra+="&overlay=0"
@@ -39,8 +41,8 @@ while [[ $# -gt 0 ]]; do
     --size) size=$2 ;;
     --fov) fov=$2 ;;
     --popping) extra+="&popping=$2" ;;
-    --near-far) extra+="&nearfar=$2" ;;
-    --centre) extra+="&centre=$2" ;;
+    --near-far) extra+="&nearfar=$2" near_far=1 ;;
+    --centre) extra+="&centre=$2" pinned=1 ;;
     --env-size) extra+="&envsize=$2" ;;
     --lookup) extra+="&lookup=$2" ;;
     --prefetch) extra+="&prefetch=$2" ;;
@@ -52,7 +54,9 @@ done
 command -v node >/dev/null || { echo "web-check: node not found (bash scripts/install-web-deps.sh)" >&2; exit 2; }
 source "$root/scripts/web_stage.sh"
 trap web_unstage EXIT
-web_stage "$scene" "$pvs"
+centres=""
+[[ -n $near_far && -z $pinned ]] && centres=centres
+web_stage "$scene" "$pvs" $centres
 query=$(python3 -c 'import sys, urllib.parse as u; print(u.quote(sys.argv[1], safe=",;@.-"))' "$path_text")
 url="$PAGE&path=$query&size=$size&fov=$fov$extra"
 mkdir -p "$(dirname "$json")"

@@ -1,10 +1,13 @@
 # web_stage.sh (sourced by view.sh and web-check.sh): stages SCENE and PVS for the web client
 # and starts the range server on them.
-#   web_stage SCENE PVS  -> sets STAGE (a temporary folder: web/ linked, scene.glb exported in id
+#   web_stage SCENE PVS [centres]
+#                        -> sets STAGE (a temporary folder: web/ linked, scene.glb exported in id
 #                           order, the PVS linked), PORT, SERVER_PID, PAGE (the page's URL,
 #                           without the query's path) and SERVER_LOG; the caller stops the server.
+#                           With `centres`: also centres.json, each cell's near-far centre as
+#                           pvs view chooses it (pvs export --centres), named in PAGE.
 web_stage() {
-  local scene=$1 pvs=$2 root
+  local scene=$1 pvs=$2 centres=${3:-} root
   root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
   local exe=${PVS_EXE:-$root/build/cli/pvs}
   [[ -x $exe ]] || { echo "web: $exe not found (bash scripts/build.sh)" >&2; return 2; }
@@ -16,7 +19,8 @@ web_stage() {
   ln -s "$root/web" "$STAGE/web"
   # WEB_STATES=K: sample the scene's animation at K states (pvs export --states K), so that the
   # GLB carries them as morph targets and the page knows the moving (dynamic) triangles.
-  "$exe" export "$scene" ${WEB_STATES:+--states "$WEB_STATES"} -o "$STAGE/scene.glb" -q || return 2
+  "$exe" export "$scene" ${WEB_STATES:+--states "$WEB_STATES"} -o "$STAGE/scene.glb" -q \
+    ${centres:+--pvs "$pvs" --centres "$STAGE/centres.json"} || return 2
   PVS_NAME=$(basename "$pvs")
   ln -s "$(realpath "$pvs")" "$STAGE/$PVS_NAME"
   SERVER_LOG=$STAGE/server.log
@@ -30,6 +34,7 @@ web_stage() {
   done
   PORT=$(cat "$STAGE/port")
   PAGE="http://127.0.0.1:$PORT/web/index.html?scene=/scene.glb&pvs=/$PVS_NAME"
+  [[ -z $centres ]] || PAGE+="&centres=/centres.json"
 }
 
 web_unstage() {

@@ -1,10 +1,13 @@
 // view_setup.cpp: the camera, centre and radii of a near-far view of a cell.
 #include "vislib/render/view_setup.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 
+#include "vislib/bake/cell_set.h"
 #include "vislib/bake/free_space.h"
 #include "vislib/bake/view_cells.h"
 
@@ -27,6 +30,17 @@ std::optional<ViewCentre> default_view_centre(const Scene& scene, const Box3& vi
   if (!fs.centre_enclosed) return ViewCentre{region_centre, false};
   if (!fs.free_point) return std::nullopt;
   return ViewCentre{*fs.free_point, true};
+}
+
+std::vector<std::optional<ViewCentre>> default_view_centres(const Scene& scene,
+                                                            const pvs::CellLayout& layout) {
+  // Cells are independent and each writes its own slot: the same result for any thread count.
+  std::vector<std::optional<ViewCentre>> out(layout.cell_count());
+  tbb::parallel_for(uint32_t(0), layout.cell_count(), [&](uint32_t c) {
+    out[c] =
+        default_view_centre(scene, to_box3(layout.view_region(c)), view_region_centre(layout, c));
+  });
+  return out;
 }
 
 NearFarRadii default_near_far_radii(const pvs::Box& cell_box, double eye_axis) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <vector>
 
 #include "pvs_format/pvs_format.h"
 #include "vislib/base/vec.h"
@@ -25,6 +26,14 @@ struct ViewCentre {
 };
 std::optional<ViewCentre> default_view_centre(const Scene& scene, const Box3& view_region,
                                               Vec3 region_centre);
+
+// default_view_centre of every cell of `layout` (its view region and that region's centre), in
+// cell order: the centres `pvs view` uses, for a client that cannot compute them (the web page
+// reads them from `pvs export --centres`). Cost: cells x 17 samples x 14 rays x triangles (the
+// brute force of cell_free_space, cells in parallel), so seconds for the city, more for large
+// scenes.
+std::vector<std::optional<ViewCentre>> default_view_centres(const Scene& scene,
+                                                            const pvs::CellLayout& layout);
 
 // Radii of the near and far cylinders about the centre's vertical axis (scene units).
 struct NearFarRadii {

@@ -7,7 +7,8 @@
 // within MARGIN scene units; off by default, so that only visited cells are fetched), overlay=0
 // (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
 // frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size),
-// nearfar=r1,r2 with centre=x,y,z, envsize=N, lookup=eye|cylinder and clovr=1 (docs/web.md).
+// nearfar=r1,r2 with centre=x,y,z or centres=URL (JSON), envsize=N, lookup=eye|cylinder and
+// clovr=1 (docs/web.md).
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
 // scene), and the overlay says so in red.
@@ -202,7 +203,8 @@ class Viewer {
     if (params.get("overlay") === "0")
       for (const id of ["overlay", "map", "help"]) document.getElementById(id).style.display = "none";
     // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size;
-    // centre=x,y,z: O for every cell (default: the centre of the cell's view region).
+    // centre=x,y,z: O for every cell; centres=URL: each cell's O as pvs view chooses it (the JSON
+    // of `pvs export --centres`); neither: the centre of the cell's lookup box.
     this.nearFar = params.get("nearfar") ? params.get("nearfar").split(",").map(Number) : null;
     this.envSize = Number(params.get("envsize") || 512);
     // popping=K: the popping meter every K frames (0: off; key P measures once).
@@ -290,7 +292,9 @@ class Viewer {
   // and range (distance from O, float), from the static triangles with a vertex beyond r2; the
   // main pass draws the near and intermediate triangles (morphed, Eq. 1) over the far region, and
   // the dynamic far ones displaced by Eq. 2 under the range test (Eq. 3). `centre=x,y,z` pins O;
-  // otherwise it is the centre of the cell's lookup box. `lookup=eye|cylinder` as pvs view's.
+  // otherwise `centres=URL` gives each cell's (pvs view's choice, computed by `pvs export
+  // --centres`); else, or for a cell listed as null there, it is the centre of the cell's lookup
+  // box. `lookup=eye|cylinder` as pvs view's.
   // `clovr=1`: the near region grows by CloVR's scheduler (pvs_rt_clovr_*) on entering a cell.
   async initNearFar() {
     const [r1, r2] = this.nearFar;
@@ -349,7 +353,19 @@ class Viewer {
     this.backgroundMesh.visible = false;
     this.world.add(this.backgroundMesh);
     const centre = params.get("centre") ? vec3(params.get("centre")) : null;
-    await this.client.setGeometry(this.scene, {r1, r2, centre, clovr: this.clovr});
+    let centres = null;
+    if (!centre && params.get("centres")) {
+      const url = params.get("centres");
+      const response = await fetch(url);
+      if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
+      const j = await response.json();
+      if (j.format !== "vislib-view-centres 1" || !Array.isArray(j.centres))
+        throw new Error(`${url}: not the output of pvs export --centres`);
+      if (j.centres.length !== this.pvs.info.cell_count)
+        throw new Error(`${url}: ${j.centres.length} cells, the PVS ${this.pvs.info.cell_count}: not this PVS's centres`);
+      centres = j.centres;
+    }
+    await this.client.setGeometry(this.scene, {r1, r2, centre, centres, clovr: this.clovr});
   }
 
   // Renders the cube maps (colour and range) from O of the triangles `ids`.
@@ -374,11 +390,24 @@ class Viewer {
   applyPartition(part) {
     const o = part.centre;
     this.centre = o;
+    this.centreSource = part.centreSource;
     this.material.uniforms.centre.value.set(...o);
     this.dynMaterial.uniforms.centre.value.set(...o);
     this.background.uniforms.centre.value.set(...o);
     this.material.uniforms.mode.value = 1;
+    this.partition = part;
+    this.clovrExact = false;
     if (this.clovr) return [];  // the scheduler's first frame (setClovr) sets the sets
+    return this.applyExact(part);
+  }
+
+  // The cell's exact near-far partition by triangle: the environment map from its environment
+  // ids, the dynamic far triangles under the range test, and (returned) the ids drawn morphed.
+  applyExact(part) {
+    const o = part.centre;
+    this.material.uniforms.mode.value = 1;
+    this.material.uniforms.r1.value = this.nearFar[0];
+    this.material.uniforms.r2.value = this.nearFar[1];
     this.renderEnvironment(part.environment, o);
     this.dynGeometry.setIndex(indexOf(part.farDynamic));
     this.dynMesh.visible = part.farDynamic.length > 0;
@@ -389,9 +418,19 @@ class Viewer {
   }
 
   // A CloVR frame (pvs_worker.js clovrNext): R and R_n drive the injection (mode 3); when the near
-  // set changed, the draw list and the environment map (from the same O) are rebuilt.
+  // set changed, the draw list and the environment map (from the same O) are rebuilt. Once the
+  // growth is complete (done), the scheduler's object-level sets give way to the cell's exact
+  // partition by triangle (applyExact), as drawn with CloVR off.
   setClovr(f) {
     this.clovrFrame = f;
+    if (this.clovrExact) return;
+    if (f.done && this.partition) {
+      this.clovrExact = true;
+      const ids = this.applyExact(this.partition);
+      this.geometry.setIndex(indexOf(ids));
+      this.drawn = ids.length;
+      return;
+    }
     const u = this.material.uniforms;
     u.mode.value = 3;
     u.r1.value = f.near_radius;
@@ -503,11 +542,13 @@ class Viewer {
                                       ring_count: this.clovrFrame.ring_count, radius: this.clovrFrame.radius,
                                       near_radius: this.clovrFrame.near_radius, done: this.clovrFrame.done,
                                       near_count: this.clovrFrame.near_count,
-                                      environment_count: this.clovrFrame.environment_count} : null,
+                                      environment_count: this.clovrFrame.environment_count,
+                                      exact: this.clovrExact} : null,
             popping_pixels: measure ? this.popping : null,
             triangles_total: this.total, ms, bytes_fetched: this.bytes,
             range_requests: this.requests, frame_range_requests: this.lookupRequests,
-            prefetched_chain_blocks: this.chainBlocks, eye: [p.x, p.y, p.z]};
+            prefetched_chain_blocks: this.chainBlocks, eye: [p.x, p.y, p.z],
+            centre: this.centre ?? null, centre_source: this.centreSource ?? null};
   }
 
   // Replay: frame i of the path.
@@ -540,7 +581,7 @@ class Viewer {
       ` (${(100 * (this.drawn + this.far) / this.total).toFixed(1)}%)\n${ms.toFixed(1)} ms/frame\n` +
       `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
       `\nscene ${this.sceneBytes} bytes` +
-      (this.clovrFrame ? `\nCloVR ring ${this.clovrFrame.ring} of ${this.clovrFrame.ring_count}, R ${this.clovrFrame.radius.toFixed(1)}${this.clovrFrame.done ? " (complete)" : ""}` : "") +
+      (this.clovrFrame ? `\nCloVR ring ${this.clovrFrame.ring} of ${this.clovrFrame.ring_count}, R ${this.clovrFrame.radius.toFixed(1)}${this.clovrFrame.done ? " (complete: the exact set by triangle)" : ""}` : "") +
       (this.popping === null ? "" : `\npopping pixels ${this.popping} (last measured; P measures)`);
   }
 

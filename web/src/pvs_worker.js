@@ -139,7 +139,8 @@ function prefetchNeighbours(cell, margin) {
 // ---- Near-far and CloVR through the C API (runtime/near_far_c.h) -----------------------------
 
 let geometry = 0;  // pvs_rt_geometry* (its arrays live as long as the worker)
-let nearFar = null;  // {r1, r2, centre (null: the cell box's centre), clovr}
+// {r1, r2, centre (pinned, or null), centres (per cell, pvs export --centres; or null), clovr}
+let nearFar = null;
 let triangleCount = 0;
 let clovr = 0;  // pvs_rt_clovr*
 let clovrFrame = 0;  // pvs_rt_clovr_frame*
@@ -177,13 +178,17 @@ function setGeometry(m) {
   }
 }
 
+// O of a cell and where it came from: pinned (centre=), pvs view's choice (centres=), or the
+// centre of the cell's lookup box (neither given, or every sample of the cell enclosed).
 function cellCentre(cell) {
-  if (nearFar.centre) return nearFar.centre;
+  if (nearFar.centre) return {centre: nearFar.centre, source: "pinned"};
+  if (nearFar.centres && nearFar.centres[cell])
+    return {centre: nearFar.centres[cell], source: "pvs view"};
   const p = rt._malloc(48);
   rt._pvs_rt_cell_box(handle, cell, p, p + 24);
   const b = new Float64Array(rt.HEAPU8.buffer, p, 6).slice();
   rt._free(p);
-  return [(b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2];
+  return {centre: [(b[0] + b[3]) / 2, (b[1] + b[4]) / 2, (b[2] + b[5]) / 2], source: "lookup box"};
 }
 
 function idList(p, n) {
@@ -264,7 +269,9 @@ self.onmessage = async (ev) => {
       if (cell >= 0 && m.have !== cell) {
         reply.ids = visibleIds(cell);
         if (nearFar) {
-          reply.partition = partition(reply.ids, cellCentre(cell));
+          const o = cellCentre(cell);
+          reply.partition = partition(reply.ids, o.centre);
+          reply.partition.centreSource = o.source;
           if (clovr) {
             const c = rt._malloc(24);
             new Float64Array(rt.HEAPU8.buffer, c, 3).set(reply.partition.centre);
