@@ -141,6 +141,12 @@ TEST(BenchmarkCompare, SmallRunIsConsistent) {
       }
     }
   }
+  // Every id: almost every id of the set re-casts from its witness (a float ray at a grazing or
+  // tied pixel may not); the every-id count never exceeds the set or what from-point found.
+  EXPECT_LE(r.equal_quality.confirmed, r.segment.set.size());
+  EXPECT_GE(double(r.equal_quality.confirmed), 0.95 * double(r.segment.set.size()));
+  EXPECT_LE(r.equal_quality.confirmed_found, r.equal_quality.confirmed);
+  EXPECT_LE(r.equal_quality.confirmed_found, r.point.set.size());
   // Every missed pixel of the equal-time frames is a frame triangle the set lacks.
   EXPECT_EQ(r.equal_time.segment.runs, 8);
   EXPECT_EQ(r.equal_time.segment_found, r.segment.set.size());
@@ -227,4 +233,29 @@ TEST(BenchJson, RecordsTheRunAsGivenTheResultAndNullForNonFiniteNumbers) {
   // The automatic point runs are recorded as such.
   info.given.point_runs = 0;
   EXPECT_EQ(json::parse(bench_json(info, r))["settings"]["point_runs_automatic"], true);
+}
+
+// Every id: the run that found the last confirmed id, or the share found at the cap with the
+// ratio as a bound.
+TEST(BenchmarkCompare, EveryIdIsTheRunThatFoundTheLastConfirmedIdOrABoundAtTheCap) {
+  const uint32_t never = MethodRun::kNever;
+  const std::vector<uint32_t> first_run = {never, 0, never, 2, never, 1};
+  const std::vector<double> elapsed = {1.0, 2.0, 3.0};
+  EqualQuality q;
+  q.segment_seconds = 0.5;
+  equal_quality_every_id({1, 3, 5}, first_run, elapsed, q);
+  EXPECT_TRUE(q.all_found);
+  EXPECT_EQ(q.confirmed, 3u);
+  EXPECT_EQ(q.confirmed_found, 3u);
+  EXPECT_DOUBLE_EQ(q.all_point_runs, 3.0);  // id 3, found in run 2 (0-based)
+  EXPECT_DOUBLE_EQ(q.all_point_seconds, 3.0);
+  EXPECT_DOUBLE_EQ(q.all_time_ratio, 6.0);
+  EXPECT_TRUE(std::isnan(q.all_time_ratio_bound));
+
+  equal_quality_every_id({1, 2, 5}, first_run, elapsed, q);  // id 2 never found
+  EXPECT_FALSE(q.all_found);
+  EXPECT_EQ(q.confirmed_found, 2u);
+  EXPECT_DOUBLE_EQ(q.confirmed_share, 2.0 / 3.0);
+  EXPECT_TRUE(std::isnan(q.all_time_ratio));
+  EXPECT_DOUBLE_EQ(q.all_time_ratio_bound, 6.0);  // all 3 runs' seconds over 0.5 s
 }

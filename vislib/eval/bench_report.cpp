@@ -106,7 +106,15 @@ std::string bench_json(const BenchRunInfo& info, const BenchResult& r) {
                         {"rate_coefficient", num(eq.rate_coefficient)},
                         {"rate_exponent", num(eq.rate_exponent)},
                         {"fit_points", eq.fit_points},
-                        {"note", eq.note}};
+                        {"note", eq.note},
+                        {"confirmed", eq.confirmed},
+                        {"confirmed_found", eq.confirmed_found},
+                        {"confirmed_share", num(eq.confirmed_share)},
+                        {"all_found", eq.all_found},
+                        {"all_point_runs", num(eq.all_point_runs)},
+                        {"all_point_seconds", num(eq.all_point_seconds)},
+                        {"all_time_ratio", num(eq.all_time_ratio)},
+                        {"all_time_ratio_bound", num(eq.all_time_ratio_bound)}};
   j["frame_triangles"] = r.frame_triangles.size();
   j["reference_triangles"] = r.reference.size();
   j["timings"] = {{"load_seconds", info.load_seconds},

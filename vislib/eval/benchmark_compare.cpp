@@ -7,7 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
+#include <limits>
 
+#include "vislib/base/cubemap.h"
 #include "vislib/base/random.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/eval/point_visibility.h"
@@ -248,6 +250,33 @@ EqualQuality equal_quality(const std::vector<size_t>& union_size,
   return q;
 }
 
+void equal_quality_every_id(const std::vector<uint32_t>& confirmed,
+                            const std::vector<uint32_t>& point_first_run,
+                            const std::vector<double>& elapsed_seconds, EqualQuality& q) {
+  assert(!elapsed_seconds.empty() && q.segment_seconds > 0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  q.confirmed = confirmed.size();
+  q.confirmed_found = 0;
+  uint32_t last = 0;  // the run that found the last of them
+  for (uint32_t id : confirmed) {
+    const uint32_t f = point_first_run[id];
+    if (f == MethodRun::kNever || f >= elapsed_seconds.size()) continue;
+    ++q.confirmed_found;
+    last = std::max(last, f);
+  }
+  q.confirmed_share = q.confirmed ? double(q.confirmed_found) / double(q.confirmed) : 1.0;
+  q.all_found = q.confirmed_found == q.confirmed;
+  q.all_point_runs = q.all_point_seconds = q.all_time_ratio = nan;
+  q.all_time_ratio_bound = nan;
+  if (q.all_found) {
+    q.all_point_runs = q.confirmed ? double(last) + 1 : 0.0;
+    q.all_point_seconds = q.confirmed ? elapsed_seconds[last] : 0.0;
+    q.all_time_ratio = q.all_point_seconds / q.segment_seconds;
+  } else {
+    q.all_time_ratio_bound = elapsed_seconds.back() / q.segment_seconds;
+  }
+}
+
 BenchResult run_bench(const Scene& scene, const BenchOptions& options,
                       const BenchProgress& progress) {
   assert(!options.box.empty() && options.segment_runs >= 1 && options.point_runs >= 0);
@@ -285,6 +314,9 @@ BenchResult run_bench(const Scene& scene, const BenchOptions& options,
   ro.segment.near = options.near;
   ro.runs = options.segment_runs;
   ro.seed = options.seed;
+  // Witnesses, to confirm each id of the set by a re-cast (equal quality, every id); included in
+  // the from-segment seconds.
+  ro.segment.want_witnesses = true;
   RegionResult region = region_visibility(scene, options.box, ro, [&](size_t done, size_t total) {
     report("from-segment runs", done, total);
   });
@@ -408,6 +440,23 @@ BenchResult run_bench(const Scene& scene, const BenchOptions& options,
                                     std::max(seg_seconds, 1e-12));
   else
     r.equal_quality.note = "the from-segment set is empty";
+  // Every id: the ids whose witness re-casts to them, and the from-point runs until it holds all.
+  {
+    std::vector<uint32_t> confirmed;
+    for (size_t i = 0; i < region.visible.size() && i < region.witnesses.size(); ++i) {
+      const RegionWitness& w = region.witnesses[i];
+      const Segment& seg = region.segments[w.segment];
+      const Mat3& R = region.runs[w.segment * K + size_t(w.run)].orientation;
+      const Vec3 eye = lerp(seg.from, seg.to, w.witness.t);
+      const Vec3 dir = pixel_direction(face_axes(w.witness.face, R), w.witness.x, w.witness.y,
+                                       options.resolution);
+      if (rt.first_hit(eye, dir, options.near).tri == w.witness.tri)
+        confirmed.push_back(w.witness.tri);
+    }
+    std::sort(confirmed.begin(), confirmed.end());
+    r.equal_quality.segment_seconds = std::max(seg_seconds, 1e-12);
+    equal_quality_every_id(confirmed, r.point.first_run, pv.elapsed_seconds, r.equal_quality);
+  }
 
   // Dense reference.
   std::vector<uint32_t> both;

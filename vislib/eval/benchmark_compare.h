@@ -139,6 +139,19 @@ struct EqualQuality {
   double rate_coefficient = 0, rate_exponent = 0;
   int fit_points = 0;
   std::string note;  // why a value is missing or extrapolated; empty when measured
+
+  // Every id, measured (equal_quality_every_id): S_c, the ids of the from-segment set whose
+  // witness re-casts to them (one Embree ray from the witness's eye through its pixel centre), and
+  // the from-point runs until its union holds every one of them. Not found within the runs: the
+  // share found is reported, and the ratio only as a bound.
+  size_t confirmed = 0;             // |S_c|
+  size_t confirmed_found = 0;       // |P ∩ S_c| after the last from-point run
+  double confirmed_share = 0;       // confirmed_found / confirmed
+  bool all_found = false;           // P ⊇ S_c within the runs
+  double all_point_runs = 0;        // runs until P ⊇ S_c (all_found; NaN otherwise)
+  double all_point_seconds = 0;     // their seconds (all_found; NaN otherwise)
+  double all_time_ratio = 0;        // all_point_seconds / segment_seconds (NaN otherwise)
+  double all_time_ratio_bound = 0;  // not all_found: the ratio exceeds this (all runs' seconds)
 };
 
 // The equal-quality comparison from a from-point growth curve (union_size[i] and
@@ -147,6 +160,13 @@ struct EqualQuality {
 EqualQuality equal_quality(const std::vector<size_t>& union_size,
                            const std::vector<double>& elapsed_seconds, size_t target,
                            double segment_seconds);
+
+// Fills the every-id fields of `q` (q.segment_seconds > 0 set): `confirmed` sorted ids,
+// `point_first_run` the from-point run (0-based) that first found each triangle or
+// MethodRun::kNever, `elapsed_seconds[i]` the seconds after run i (at least one run).
+void equal_quality_every_id(const std::vector<uint32_t>& confirmed,
+                            const std::vector<uint32_t>& point_first_run,
+                            const std::vector<double>& elapsed_seconds, EqualQuality& q);
 
 struct BenchResult {
   BenchOptions options;  // as run (point_runs = the M actually used)

@@ -3,7 +3,9 @@
 // per-thread visibility marks and witnesses with their deterministic reduction.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "vislib/kernel/witness.h"
@@ -43,26 +45,62 @@ inline bool better_witness(double len_a, const Witness& a, double len_b, const W
   return a.tau < b.tau;
 }
 
-// What one thread found: a mark per visible primitive and, if wanted, its best witness so far.
+// What one thread found in one run: a mark per visible primitive and, if wanted, its best witness
+// so far. The marks are kept in pages of kMarkPageIds primitives, allocated on the first mark in
+// them: a run sees a few thousand of a scene's triangles, lying in a few pages, so a thread's marks
+// cost about the run's visible set, not 1 byte per primitive of the scene. A thread that helps J
+// runs in flight holds J sets; dense marks made that J x J x (scene size) bytes over a bake.
+// The witnesses, when wanted (never in a bake), stay dense: 8 bytes and a Witness per primitive.
 struct FoundMarks {
-  std::vector<uint8_t> seen;        // per primitive: 1, or a bit per part of a split segment
+  static constexpr unsigned kMarkPageShift = 10;
+  static constexpr size_t kMarkPageIds = size_t(1) << kMarkPageShift;  // primitives a page
+
   std::vector<double> witness_len;  // per primitive: length of the witness piece (-1 = none)
   std::vector<Witness> witness;     // per primitive
 
-  FoundMarks(size_t count, bool witnesses) : seen(count, 0) {
+  FoundMarks(size_t count, bool witnesses) : pages_((count + kMarkPageIds - 1) >> kMarkPageShift) {
     if (witnesses) {
       witness_len.assign(count, -1.0);
       witness.resize(count);
     }
   }
+  // Primitive p's mark: 0 (not seen), 1, or a bit per part of a split segment.
+  uint8_t seen(uint32_t p) const {
+    const auto& page = pages_[p >> kMarkPageShift];
+    return page ? page[p & (kMarkPageIds - 1)] : uint8_t(0);
+  }
+  // Sets `bits` in primitive p's mark.
+  void add(uint32_t p, uint8_t bits) {
+    auto& page = pages_[p >> kMarkPageShift];
+    if (!page) page.reset(new uint8_t[kMarkPageIds]());
+    page[p & (kMarkPageIds - 1)] |= bits;
+  }
   // Marks primitive p visible through a piece of length `len` (in t) with witness w.
   void mark(uint32_t p, double len, const Witness& w) {
-    seen[p] = 1;
+    add(p, 1);
     if (!witness_len.empty() && better_witness(len, w, witness_len[p], witness[p])) {
       witness_len[p] = len;
       witness[p] = w;
     }
   }
+  // ORs these marks into seen (size: the primitive count).
+  void unite_into(std::vector<uint8_t>& seen) const {
+    for (size_t g = 0; g < pages_.size(); ++g) {
+      if (!pages_[g]) continue;
+      const size_t first = g << kMarkPageShift;
+      const size_t n = std::min(kMarkPageIds, seen.size() - first);
+      for (size_t i = 0; i < n; ++i) seen[first + i] |= pages_[g][i];
+    }
+  }
+  // Bytes held by the marks (the page table and the pages in use).
+  size_t mark_bytes() const {
+    size_t n = pages_.size() * sizeof(pages_[0]);
+    for (const auto& page : pages_) n += page ? kMarkPageIds : 0;
+    return n;
+  }
+
+ private:
+  std::vector<std::unique_ptr<uint8_t[]>> pages_;
 };
 
 // Marks primitive p visible from the parts of a split segment (SegmentOptions::splits) that the
@@ -74,7 +112,7 @@ inline void mark_parts(FoundMarks& found, const std::vector<double>& bounds, dou
     if (!(bounds[i] < t1)) break;
     const double a = t0 > bounds[i] ? t0 : bounds[i];
     const double b = t1 < bounds[i + 1] ? t1 : bounds[i + 1];
-    if ((b - a) / (bounds[i + 1] - bounds[i]) > eps_len) found.seen[p] |= uint8_t(1u << i);
+    if ((b - a) / (bounds[i + 1] - bounds[i]) > eps_len) found.add(p, uint8_t(1u << i));
   }
 }
 
@@ -87,7 +125,7 @@ void reduce_found(const Range& found, size_t count, bool witnesses, std::vector<
   std::vector<double> best_len(witnesses ? count : 0, -1.0);
   best.assign(witnesses ? count : 0, Witness{});
   for (const FoundMarks& f : found) {
-    for (size_t p = 0; p < count; ++p) seen[p] |= f.seen[p];
+    f.unite_into(seen);
     if (witnesses)
       for (size_t p = 0; p < count; ++p)
         if (f.witness_len[p] >= 0 &&

@@ -401,7 +401,7 @@ class StaticKind {
     const bool witnesses = !found.witness_len.empty();
     for (size_t i = 0; i < sc.see_through.size(); ++i) {
       const Pending& b = sc.see_through[i];
-      if (!witnesses && part_bounds_.empty() && found.seen[b.id]) continue;  // nothing to add
+      if (!witnesses && part_bounds_.empty() && found.seen(b.id)) continue;  // nothing to add
       const Vec2* hull = &sc.see_through_hulls[i * kMaxFootprintPoints];
       const StaticTriangle& st = b.st;
       for (int y = b.y0; y <= b.y1; ++y) {
@@ -434,7 +434,7 @@ class StaticKind {
                                          const double len = t1 - t0;
                                          if (!(len > opt_.eps_len)) return;
                                          if (!witnesses) {
-                                           found.seen[b.id] = 1;
+                                           found.add(b.id, 1);
                                            return;
                                          }
                                          Witness w;
@@ -535,14 +535,14 @@ class StaticKind {
       return;
     }
     const bool witnesses = !found.witness_len.empty();
-    auto settled = [&](uint32_t id) { return !witnesses && found.seen[id] != 0; };
+    auto settled = [&](uint32_t id) { return !witnesses && found.seen(id) != 0; };
     for_each_visible(
         l, sc.ties[k],
         [&](uint32_t id, double t0, double t1) {
           double len = t1 - t0;
           if (!(len > opt_.eps_len)) return;
           if (!witnesses) {  // the mark alone (no witness to build and compare)
-            found.seen[id] = 1;
+            found.add(id, 1);
             return;
           }
           Witness w;

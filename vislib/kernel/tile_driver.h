@@ -53,6 +53,7 @@
 //   bool node_bounds(uint32_t node, const FaceAxes&, int* box, double& zmin) const;
 #pragma once
 
+#include <sys/mman.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -62,6 +63,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <new>
 #include <type_traits>
 #include <vector>
@@ -116,7 +118,7 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
 // that finds it being written computes its own copy (the same values: the computation is
 // deterministic). Entries carry the stamp of the face they were written for, so a new face costs
 // no pass over all entries (the stamps are cleared only when they wrap, every 2^31 faces).
-// Memory: the arrays are allocated untouched (calloc and malloc), so a run's resident memory grows
+// Memory: the arrays are mapped untouched (mmap), so a run's resident memory grows
 // with the entries its walk touches (nodes and leaves lie in tree order, so those are few pages),
 // not with the scene: several runs of a bake hold these at once.
 class FaceBoundsCache {
@@ -131,11 +133,14 @@ class FaceBoundsCache {
     if (n > size_) {
       release();
       // std::atomic<uint32_t> is trivially constructible: zeroed memory holds zero stamps.
-      stamp_ = static_cast<std::atomic<uint32_t>*>(std::calloc(n, sizeof(std::atomic<uint32_t>)));
-      box_ = static_cast<int*>(std::malloc(n * 4 * sizeof(int)));  // read only under a stamp
-      zmin_ = static_cast<float*>(std::malloc(n * sizeof(float)));
-      if (!stamp_ || !box_ || !zmin_) throw std::bad_alloc();
       size_ = n;
+      stamp_ = static_cast<std::atomic<uint32_t>*>(map_untouched(stamp_bytes()));
+      box_ = static_cast<int*>(map_untouched(box_bytes()));  // read only under a stamp
+      zmin_ = static_cast<float*>(map_untouched(zmin_bytes()));
+      if (!stamp_ || !box_ || !zmin_) {
+        release();
+        throw std::bad_alloc();
+      }
       epoch_ = 0;
     }
     if (epoch_ >= 0xfffffff0u) {
@@ -170,10 +175,23 @@ class FaceBoundsCache {
   }
 
  private:
+  size_t stamp_bytes() const { return size_ * sizeof(std::atomic<uint32_t>); }
+  size_t box_bytes() const { return size_ * 4 * sizeof(int); }
+  size_t zmin_bytes() const { return size_ * sizeof(float); }
+  // Zeroed pages straight from the kernel, resident only once written, and returned to it by
+  // release(). (malloc would hand back memory freed by earlier runs, resident already: every run
+  // in flight would then hold its whole arrays.)
+  static void* map_untouched(size_t bytes) {
+    void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    return p == MAP_FAILED ? nullptr : p;
+  }
+  static void unmap(void* p, size_t bytes) {
+    if (p) munmap(p, bytes);
+  }
   void release() {
-    std::free(stamp_);
-    std::free(box_);
-    std::free(zmin_);
+    unmap(stamp_, stamp_bytes());
+    unmap(box_, box_bytes());
+    unmap(zmin_, zmin_bytes());
     stamp_ = nullptr;
     box_ = nullptr;
     zmin_ = nullptr;
@@ -350,6 +368,49 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
   stats.triangle_tiles += queued_triangles;
 }
 
+// Working memory a thread keeps between tiles, in MB: the tile scratch of a kind (its pixels'
+// lists, ties and pools) and the BVH walk's queue. One set per thread, whatever the runs in flight
+// (a thread runs one tile at a time; TBB hands it tiles of whichever run waits), reused by every
+// run of every segment on that thread. A set that ends a tile holding more than this is freed
+// rather than kept, so a deep tile costs its memory only while it runs. 0.75 MB held on the 2 m
+// street of the 300K-triangle city at N = 512 with 32-pixel tiles; see docs/performance.md,
+// "Memory per thread".
+constexpr double kThreadTileMemoryBudgetMB = 8.0;
+
+// The tile scratch and walk queue of one thread (see kThreadTileMemoryBudgetMB).
+template <class Scratch>
+struct TileWork {
+  Scratch sc;
+  std::vector<QueueItem> queue;
+};
+
+// Hands out the calling thread's TileWork for `Scratch` (made by `make` when the thread has none,
+// or when its own was made for another tile size, or is in use further up the stack) and takes it
+// back after the tile.
+template <class Scratch>
+class ThreadTileWork {
+ public:
+  template <class Make>
+  static std::unique_ptr<TileWork<Scratch>> take(int tile_size, Make make) {
+    std::unique_ptr<TileWork<Scratch>> w = std::move(slot());
+    if (!w || w->sc.lists.size() != size_t(tile_size) * size_t(tile_size))
+      w.reset(new TileWork<Scratch>{make(), {}});
+    return w;
+  }
+  // `bytes`: what the scratch holds (the peak_tile_bytes of its tile).
+  static void give_back(std::unique_ptr<TileWork<Scratch>> w, size_t bytes) {
+    const size_t queue_bytes = w->queue.capacity() * sizeof(QueueItem);
+    if (double(bytes + queue_bytes) <= kThreadTileMemoryBudgetMB * 1e6 && !slot())
+      slot() = std::move(w);
+  }
+
+ private:
+  static std::unique_ptr<TileWork<Scratch>>& slot() {
+    thread_local std::unique_ptr<TileWork<Scratch>> w;
+    return w;
+  }
+};
+
 // Runs the six faces of one from-segment run of `kind`. tile_stats has 6 * tiles^2 entries
 // (counts are added to them, so several runs can share them); found_by_thread gets the marks.
 template <class Kind>
@@ -359,8 +420,8 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   const int N = opt.resolution, TS = opt.tile_size;
   const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
   const size_t count = kind.count();
-  tbb::enumerable_thread_specific<typename Kind::Scratch> scratch(
-      [&kind, TS] { return kind.make_scratch(TS); });
+  using Work = ThreadTileWork<typename Kind::Scratch>;
+  auto take_work = [&kind, TS] { return Work::take(TS, [&] { return kind.make_scratch(TS); }); };
   const TriangleBvh* bvh = nullptr;
   if constexpr (Kind::kHasBvh) bvh = kind.bvh();
   std::vector<int> bbox(bvh ? 0 : count * 4);
@@ -368,7 +429,6 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   std::vector<uint32_t> bin_start;
   std::vector<TileItem> bins;
   FaceBoundsCache node_cache, tri_cache;
-  tbb::enumerable_thread_specific<std::vector<QueueItem>> queues;
 
   for (int face = 0; face < kCubeFaces; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
@@ -401,7 +461,9 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
     // (3) tiles in parallel.
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1),
                       [&](const tbb::blocked_range<int>& r) {
-                        auto& sc = scratch.local();
+                        auto work = take_work();  // this thread's scratch and walk queue
+                        auto& sc = work->sc;
+                        size_t held = 0;
                         FoundMarks& found = found_by_thread.local();
                         for (int tile = r.begin(); tile != r.end(); ++tile) {
                           SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
@@ -420,7 +482,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           if (bvh) {
                             if constexpr (Kind::kHasBvh)
                               walk_tile(kind, *bvh, face, axes, rect, opt.depth_culling, sc,
-                                        tile_far, node_cache, tri_cache, queues.local(), stats);
+                                        tile_far, node_cache, tri_cache, work->queue, stats);
                           } else {
                             TileItem* tb = bins.data() + bin_start[tile];
                             TileItem* te = bins.data() + bin_start[tile + 1];
@@ -462,7 +524,9 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                               kind.finish_pixel(sc, k, face, x, y, found);
                             }
                           stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
+                          held = std::max(held, bytes);
                         }
+                        Work::give_back(std::move(work), held);
                       });
   }
 }
