@@ -357,8 +357,8 @@ int main(int argc, char** argv) {
       print_row(c.name, "1", w);
       const SegmentStats& st = w.r.stats;
       if (st.covered_pairs > 0)
-        depth_rows.push_back({c.name, {w.seg_cpu * 1e9 / double(st.covered_pairs),
-                                       st.pieces_per_pixel()}});
+        depth_rows.push_back(
+            {c.name, {w.seg_cpu * 1e9 / double(st.covered_pairs), st.pieces_per_pixel()}});
     }
     if (cores != "1") print_row(c.name, "all", measure(scene, c, *es, reps, 0));
   }
@@ -373,7 +373,7 @@ int main(int argc, char** argv) {
   for (const auto& r : depth_rows)
     std::printf("# %-8s %6.1f pieces per covered pixel, %7.1f CPU ns per covered pair\n",
                 r.first.c_str(), r.second.second, r.second.first);
-  if (const auto *d = find("deep"), *c = find("city20"); d && c)
+  if (const auto* d = find("deep"), *c = find("city20"); d && c)
     std::printf("# deep / city20 ns per covered pair: %.2f (target <= 1.3)\n", d->first / c->first);
   return 0;
 }
