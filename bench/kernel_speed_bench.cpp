@@ -16,7 +16,7 @@
 //   spheres  generate spheres (500 bouncing spheres of radius 1, 3 states), 20 m segment
 //            (dynamic kernel; Embree holds no spheres, so its cubemap column is an empty scene's)
 //   deep     generate grass --states 1 (a static 8 m diorama of 8,000 triangles, flat ground), a
-//            1.1 m segment 0.35 m high through the blades: about 35 final pieces per covered
+//            1.1 m segment 0.35 m high through the blades: about 36 final pieces per covered
 //            pixel: deep lists, whose cost per covered pair the closing lines set beside the 20 m
 //            street's
 //
