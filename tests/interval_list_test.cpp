@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <tuple>
 #include <vector>
 
@@ -168,6 +169,43 @@ TEST(IntervalList, ThousandsOfDisjointPiecesAreAllKeptInOrder) {
     EXPECT_FALSE(lookup(l, (i + 0.75) / double(n)).has_value()) << i;
   }
   EXPECT_FALSE(covers_segment(l));
+}
+
+TEST(IntervalList, SearchFromTheGuessFindsTheIndexOfABinarySearch) {
+  // detail::first_ending_after gallops from the index s would have in equal pieces; the oracle is
+  // std::upper_bound over the whole list. Lists of every length around the scan/search switch up
+  // to deep ones, with pieces bunched at one end (the guess far off) or even, queried at every
+  // piece end, inside pieces, in gaps and outside [0, 1].
+  Rng rng(11);
+  for (int n : {0, 1, 15, 16, 17, 18, 31, 64, 200, 1000}) {
+    for (int shape = 0; shape < 3; ++shape) {
+      std::vector<double> cuts;  // 2n increasing values in [0, 1]: t0, t1 of each piece
+      for (int k = 0; k < 2 * n; ++k) {
+        const double u = rng.uniform();
+        cuts.push_back(shape == 0 ? u : shape == 1 ? u * u * u * u : 1 - u * u * u * u);
+      }
+      std::sort(cuts.begin(), cuts.end());
+      cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+      PieceList l;
+      for (size_t k = 0; k + 1 < cuts.size(); k += 2)
+        l.push_back(Piece{cuts[k], cuts[k + 1], uint32_t(k), line(1, 0)});
+      std::vector<double> queries = {-1, 0, 1, 2, std::nan("")};
+      for (const Piece& p : l) {
+        queries.push_back(p.t0);
+        queries.push_back(p.t1);
+        queries.push_back(0.5 * (p.t0 + p.t1));
+        queries.push_back(std::nextafter(p.t1, 2.0));
+      }
+      for (int k = 0; k < 200; ++k) queries.push_back(rng.uniform());
+      for (double s : queries) {
+        const size_t want =
+            size_t(std::upper_bound(l.begin(), l.end(), s,
+                                    [](double v, const Piece& q) { return v < q.t1; }) -
+                   l.begin());
+        ASSERT_EQ(detail::first_ending_after(l, s), want) << "n " << l.size() << " s " << s;
+      }
+    }
+  }
 }
 
 TEST(IntervalList, ValidityCheckRejectsOverlapsUnmergedNeighboursAndEmptyPieces) {

@@ -492,6 +492,12 @@ class StaticKind {
       }
       Coverage4 cov;
       coverage4_(st, axes, &pixel_centers_[size_t(xb)], tc, lanes, opt_.near, cov);
+      // Deep lists rarely stay in the cache: ask for the line where insert_piece's search starts
+      // in each of the (up to) four lists at once, so that their misses overlap.
+      for (int i = 0; i < lanes; ++i) {
+        const PieceList& l = sc.lists[kb + size_t(i)];
+        if (cov.ok[i] && l.size() > 16) __builtin_prefetch(&l[detail::guess_index(l, cov.lo[i])]);
+      }
       for (int i = 0; i < lanes; ++i) {
         const size_t k = kb + size_t(i);
         if (opt_.depth_culling &&
