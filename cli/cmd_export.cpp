@@ -35,8 +35,8 @@
 #include "vislib/base/file_util.h"
 #include "vislib/render/view_setup.h"
 #include "vislib/scene/id_map.h"
-#include "vislib/scene/scene_transform.h"
 #include "vislib/scene/scene_fingerprint.h"
+#include "vislib/scene/scene_transform.h"
 #include "vislib/scene/write_gltf.h"
 
 namespace pvs_cli {
