@@ -2,6 +2,7 @@
 // Eq. 1/4/5 morph, Eq. 2/3, the CloVR scheduler, version and fingerprint argument checks. Every
 // call goes through the C functions; expectations are computed here from the papers' formulas.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -390,8 +391,10 @@ RangeCase make_range_case() {
     cells.emplace_back(ids);
   }
   rc.bytes = pvs::write_pvs(rc.info, cells);
+  // One file per process: ctest runs each test in its own process, in parallel, and rewriting a
+  // file another test has mapped would fault it.
   rc.path = (std::filesystem::temp_directory_path() /
-             ("vislib_range_case_" + std::to_string(rng()) + ".pvs"))
+             ("vislib_range_case_" + std::to_string(::getpid()) + ".pvs"))
                 .string();
   std::ofstream(rc.path, std::ios::binary).write(rc.bytes.data(), std::streamsize(rc.bytes.size()));
   return rc;
