@@ -106,18 +106,43 @@ bool ends_with_bsp(const std::string& path) {
   return ext == ".bsp";
 }
 
-// --leaves A-B (or A): the cell leaves of the map numbered A to B.
+// --leaves ITEM[,ITEM...]: the cell leaves of the map named by any item, where an item is A (one
+// leaf number), A-B (A to B) or A-B/K (A, A+K, A+2K, ... up to B: a spread sample of a large map).
 std::vector<uint32_t> parse_leaves(const std::string& text, const std::vector<uint32_t>& all) {
-  unsigned lo = 0, hi = 0;
-  char extra;
-  int n = std::sscanf(text.c_str(), "%u-%u%c", &lo, &hi, &extra);
-  if (n == 1) hi = lo;
-  if ((n != 1 && n != 2) || lo > hi)
-    throw CLI::ValidationError("--leaves",
-                               "expected A-B (leaf numbers, A <= B), got '" + text + "'");
+  const auto bad = [&] {
+    return CLI::ValidationError("--leaves",
+                                "expected A, A-B or A-B/K (leaf numbers, A <= B, K > 0), "
+                                "comma-separated; got '" +
+                                    text + "'");
+  };
+  // One item, whole: "%u" alone would also take a sign, spaces or trailing text.
+  const auto parse_item = [&](const std::string& item, unsigned& lo, unsigned& hi, unsigned& step) {
+    if (item.empty() || item.find_first_not_of("0123456789-/") != std::string::npos) throw bad();
+    int used = -1;
+    step = 1;
+    if (std::sscanf(item.c_str(), "%u-%u/%u%n", &lo, &hi, &step, &used) != 3) {
+      used = -1;
+      step = 1;
+      if (std::sscanf(item.c_str(), "%u-%u%n", &lo, &hi, &used) != 2) {
+        used = -1;
+        if (std::sscanf(item.c_str(), "%u%n", &lo, &used) != 1) throw bad();
+        hi = lo;
+      }
+    }
+    if (size_t(used) != item.size() || lo > hi || step == 0) throw bad();
+  };
+  const uint32_t last = all.empty() ? 0 : all.back();
+  std::vector<bool> wanted(size_t(last) + 1, false);
+  for (size_t start = 0; start <= text.size();) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    unsigned lo = 0, hi = 0, step = 1;
+    parse_item(text.substr(start, comma - start), lo, hi, step);
+    for (uint64_t l = lo; l <= std::min<uint64_t>(hi, last); l += step) wanted[size_t(l)] = true;
+    start = comma + 1;
+  }
   std::vector<uint32_t> out;
   for (uint32_t l : all)
-    if (l >= lo && l <= hi) out.push_back(l);
+    if (wanted[l]) out.push_back(l);
   if (out.empty())
     throw CLI::ValidationError("--leaves", "no empty or liquid leaf of model 0 in " + text);
   return out;
@@ -219,8 +244,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->check(in_range(0.0, 1e6))
       ->capture_default_str();
   cmd->add_option("--leaves", a.leaves,
-                  "bsp-leaves: bake only the leaves numbered A to B (A-B), for a partial "
-                  "measurement");
+                  "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
+                  "A-B/K (every K-th from A), comma-separated");
   cmd->add_option("--box", a.box,
                   "Grid box x0,y0,z0,x1,y1,z1 (with --walkable: only place cells in it)");
   cmd->add_option("--grid", a.grid, "Grid cells nx,ny,nz over --box");

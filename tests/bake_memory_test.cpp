@@ -2,21 +2,16 @@
 // resident memory read from the kernel's accounting of each child (wait4's ru_maxrss). Memory
 // only, never time. Release builds only: the sanitizers' shadow memory and quarantine dwarf what
 // is measured, and a debug build's figures are not the shipped program's.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
 #include "tests/test_support.h"
-
-extern char** environ;
+#include "vislib/base/file_util.h"
 
 using namespace vislib_test;
 
@@ -25,29 +20,13 @@ namespace {
 // Runs `pvs args...` with stdout and stderr sent to /dev/null; returns its peak RSS in MB, or a
 // negative value when it could not be run or did not exit 0.
 double run_pvs_peak_mb(const std::vector<std::string>& args) {
-  std::vector<std::string> all{VISLIB_PVS_EXE};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid = 0;
-  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) return -1;
+  const pid_t pid = spawn_pvs_quiet(args);
+  if (pid < 0) return -1;
   int status = 0;
   struct rusage ru {};
   if (wait4(pid, &status, 0, &ru) != pid) return -1;
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) return -1;
   return double(ru.ru_maxrss) / 1024.0;  // kilobytes on Linux
-}
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
 }
 
 }  // namespace
@@ -83,5 +62,5 @@ TEST(BakeMemory, PeakMemoryGrowsBoundedPerThreadAndFilesAreIdentical) {
   std::printf("peak RSS: %.1f MB at -j 1, %.1f MB at -j 8: %.2f MB per added thread\n", one, eight,
               per_thread);
   EXPECT_LE(per_thread, 5.0) << one << " MB at -j 1, " << eight << " MB at -j 8";
-  EXPECT_EQ(read_bytes(dir + "/j1.pvs"), read_bytes(dir + "/j8.pvs"));
+  EXPECT_EQ(vislib::read_file(dir + "/j1.pvs"), vislib::read_file(dir + "/j8.pvs"));
 }

@@ -4,7 +4,6 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,8 +19,6 @@
 #include "tests/test_support.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/import.h"
-
-extern char** environ;
 
 using namespace vislib_test;
 using json = nlohmann::json;
@@ -71,20 +68,10 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
 
   // Start the same bake as a child process and kill -9 it once a few cells are checkpointed.
   std::string target = dir + "/killed.pvs";
-  std::vector<std::string> args = {
-      "pvs",          "bake",    city(),  "--box", "-60,0,-60,60,3,60", "--grid", "4,1,4",
-      "--eye-height", "1.5,1.8", "--res", "24",    "--threads",         "1",      "-o",
-      target};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid;
-  ASSERT_EQ(posix_spawn(&pid, VISLIB_PVS_EXE, &fa, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&fa);
+  const pid_t pid =
+      spawn_pvs_quiet({"bake", city(), "--box", "-60,0,-60,60,3,60", "--grid", "4,1,4",
+                       "--eye-height", "1.5,1.8", "--res", "24", "--threads", "1", "-o", target});
+  ASSERT_GT(pid, 0);
   auto start = std::chrono::steady_clock::now();
   bool finished_early = false;
   while (checkpoint_records(target + ".ckpt") < 3) {

@@ -95,6 +95,22 @@ Totals run_segments(const Scene& a, const std::vector<Segment>& segs, int n, con
   return tot;
 }
 
+// The check on one scene: 4 random walkable cells' diagonals at resolution n, every differing id a
+// grazing ray within kInvarianceUlps or a depth tie, none a defect. Prints the time against
+// `budget_s`.
+void expect_only_grazing_and_ties(const Scene& a, const WalkableOptions& wo, uint64_t seed, int n,
+                                  const char* name, double budget_s) {
+  const auto start = std::chrono::steady_clock::now();
+  const auto segs = random_cell_segments(a, wo, 4, seed);
+  ASSERT_EQ(segs.size(), 4u);
+  const Totals t = run_segments(a, segs, n, name);
+  EXPECT_GT(t.visible, 0u);
+  EXPECT_EQ(t.defects, 0u);
+  EXPECT_LE(t.max_ulps, kInvarianceUlps);
+  std::printf("time budget %.0f s: took %.1f s\n", budget_s,
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+}
+
 TEST(SceneTransform, AxisAngleGivesARotationMovingTheAxisNowhere) {
   const Mat3 r = axis_angle_rotation({0.3, 1, 0.5}, 37);
   EXPECT_TRUE(is_rotation(r));
@@ -133,19 +149,10 @@ TEST(SceneTransform, MovesEveryVertexAndRefusesANonSimilarity) {
 // A generated city, its copy moved far, rotated and scaled: the differing ids are all grazing
 // rays or depth ties within the stated bound.
 TEST(Invariance, GeneratedCityDiffersOnlyByGrazingRaysAndTies) {
-  const auto start = std::chrono::steady_clock::now();
   CityOptions co;
   co.blocks_x = co.blocks_z = 2;
   co.panel_size = 4;
-  const Scene a = generate_city(co);
-  const auto segs = random_cell_segments(a, WalkableOptions{}, 4, 7);
-  ASSERT_EQ(segs.size(), 4u);
-  const Totals t = run_segments(a, segs, 64, "city 2x2");
-  EXPECT_GT(t.visible, 0u);
-  EXPECT_EQ(t.defects, 0u);
-  EXPECT_LE(t.max_ulps, kInvarianceUlps);
-  std::printf("time budget 20 s: took %.1f s\n",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  expect_only_grazing_and_ties(generate_city(co), WalkableOptions{}, 7, 64, "city 2x2", 20);
 }
 
 // The classifier is not blind: a triangle of the moved copy pushed 1 km down (not a similarity of
@@ -256,21 +263,12 @@ TEST(InvarianceCli, SegmentTransformMatchesTheExportedMovedScene) {
   EXPECT_FALSE(std::ifstream(dir + "/bad.obj").good());
 }
 
-// The check on the real maps: 4 random walkable cells' diagonals, N = 128.
+// A shared map: 4 random walkable cells' diagonals, N = 128.
 void check_shared_map(const std::string& path, const char* name) {
-  const auto start = std::chrono::steady_clock::now();
-  const Scene a = load_scene(path);
   WalkableOptions wo;
   wo.cell_size = 16;  // Sauerbraten units (a player is about 15 tall)
   wo.eye = {10, 14};
-  const auto segs = random_cell_segments(a, wo, 4, 38);
-  ASSERT_EQ(segs.size(), 4u);
-  const Totals t = run_segments(a, segs, 128, name);
-  EXPECT_GT(t.visible, 0u);
-  EXPECT_EQ(t.defects, 0u);
-  EXPECT_LE(t.max_ulps, kInvarianceUlps);
-  std::printf("time budget 60 s: took %.1f s\n",
-              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  expect_only_grazing_and_ties(load_scene(path), wo, 38, 128, name, 60);
 }
 
 TEST(Invariance, PandoraDiffersOnlyByGrazingRaysAndTies) {

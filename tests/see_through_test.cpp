@@ -22,19 +22,6 @@ bool contains(const std::vector<uint32_t>& v, uint32_t id) {
   return std::binary_search(v.begin(), v.end(), id);
 }
 
-// View depth of triangle `id` along eye + lambda d (double), inf when the ray misses it.
-double depth_along(const Scene& scene, uint32_t id, Vec3 eye, Vec3 d) {
-  auto c = scene.corners(id, 0);
-  Vec3 a = c[0] - eye, e1 = c[1] - c[0], e2 = c[2] - c[0], pv = cross(d, e2);
-  double det = dot(e1, pv);
-  if (det == 0) return INFINITY;
-  double u = dot(-a, pv) / det;
-  Vec3 qv = cross(-a, e1);
-  double v = dot(d, qv) / det, lam = dot(e2, qv) / det;
-  if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9) return INFINITY;
-  return lam;
-}
-
 // Re-casts every witness of `r` with brute_force_hits: the witnessed triangle must be the first
 // opaque hit or a see-through hit in front of it, or lie within 2 eps_z of the opaque hit (a tie),
 // or be ambiguous there. Returns the failures.
@@ -50,7 +37,7 @@ int witness_failures(const Scene& s, const SegmentResult& r, Vec3 v0, Vec3 v1,
         std::find(ray.see_through_ambiguous.begin(), ray.see_through_ambiguous.end(), w.tri) !=
             ray.see_through_ambiguous.end())
       continue;
-    const double mine = depth_along(s, w.tri, eye, d);
+    const double mine = triangle_depth(s, w.tri, eye, d, o.near);
     if (ray.opaque.tri != kNoHit && std::fabs(mine - ray.opaque.lambda) <= 2 * o.eps_z * mine)
       continue;
     ++failures;

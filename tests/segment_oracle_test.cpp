@@ -21,20 +21,6 @@ using vislib_test::random_soup;
 
 namespace {
 
-// View depth of triangle `id` along eye + lambda d (double, Moller-Trumbore), lambda > near; inf
-// when the ray misses it.
-double triangle_depth(const Scene& scene, uint32_t id, Vec3 eye, Vec3 d, double near) {
-  auto c = scene.corners(id, 0);
-  Vec3 a = c[0] - eye, e1 = c[1] - c[0], e2 = c[2] - c[0], pv = cross(d, e2);
-  double det = dot(e1, pv);
-  if (det == 0) return INFINITY;
-  double u = dot(-a, pv) / det;
-  Vec3 qv = cross(-a, e1);
-  double v = dot(d, qv) / det, lam = dot(e2, qv) / det;
-  if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9 || !(lam > near)) return INFINITY;
-  return lam;
-}
-
 struct OracleCounts {
   uint64_t forward = 0, forward_ambiguous = 0, misses = 0;
   uint64_t settled_by_double = 0;  // Embree (float) disagreed, the double reference agreed

@@ -1,5 +1,7 @@
 #include "tests/test_support.h"
 
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -8,6 +10,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+
+extern char** environ;
 
 namespace vislib_test {
 
@@ -61,6 +65,22 @@ int run_pvs_split(const std::string& args, std::string* out, std::string* err) {
   std::filesystem::remove(err_path);
   if (err) *err = e;
   return rc;
+}
+
+pid_t spawn_pvs_quiet(const std::vector<std::string>& args) {
+  std::vector<std::string> all{VISLIB_PVS_EXE};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  return rc == 0 ? pid : -1;
 }
 
 std::string temp_dir(const std::string& name) {

@@ -1,8 +1,11 @@
 // test_support.h: helpers shared by the tests (paths to data and ../shared, running `pvs`).
 #pragma once
 
+#include <sys/types.h>
+
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace vislib_test {
 
@@ -16,6 +19,10 @@ std::optional<std::string> shared_dir();
 int run_pvs(const std::string& args, std::string* output = nullptr);
 // The same with stdout and stderr captured apart (stderr through a temporary file).
 int run_pvs_split(const std::string& args, std::string* out, std::string* err);
+// Starts the built `pvs` with `args` (argv after the program name, unquoted) as a child process
+// with stdout and stderr sent to /dev/null; returns its pid (for waitpid, wait4 or kill), or -1
+// when it could not be started.
+pid_t spawn_pvs_quiet(const std::vector<std::string>& args);
 // A fresh empty temporary directory for one test.
 std::string temp_dir(const std::string& name);
 

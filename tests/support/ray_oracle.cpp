@@ -54,4 +54,16 @@ OracleSample RayOracle::sample(int face, int x, int y, double t) const {
   return {h.tri, h.lambda, is_ambiguous(face, x, y, t)};
 }
 
+double triangle_depth(const Scene& scene, uint32_t id, Vec3 eye, Vec3 d, double near) {
+  auto c = scene.corners(id, 0);
+  Vec3 a = c[0] - eye, e1 = c[1] - c[0], e2 = c[2] - c[0], pv = cross(d, e2);
+  double det = dot(e1, pv);
+  if (det == 0) return INFINITY;
+  double u = dot(-a, pv) / det;
+  Vec3 qv = cross(-a, e1);
+  double v = dot(d, qv) / det, lam = dot(e2, qv) / det;
+  if (u < -1e-9 || v < -1e-9 || u + v > 1 + 1e-9 || !(lam > near)) return INFINITY;
+  return lam;
+}
+
 }  // namespace vislib

@@ -66,4 +66,9 @@ class RayOracle {
   double z_near_;
 };
 
+// View depth of triangle `id` (at animation time 0) along eye + lambda d, in double
+// (Moller-Trumbore, barycentric margin 1e-9), when lambda > near; infinity when the ray misses it.
+// For telling a witness that lies within eps_z of the first hit (a tie) from a false one.
+double triangle_depth(const Scene& scene, uint32_t id, Vec3 eye, Vec3 d, double near);
+
 }  // namespace vislib

@@ -13,24 +13,38 @@
 
 namespace vislib {
 
+namespace {
+
+// Calls row_fn(row, dirs) for each of the 6 n rows of the cube's faces (row = face * n + y), rows
+// in parallel, with dirs the row's n pixel directions; each call writes only its row's outputs.
+template <class RowFn>
+void for_each_cube_row(const Mat3& R, int n, RowFn&& row_fn) {
+  const size_t side = size_t(n), rows = size_t(kCubeFaces) * side;
+  FaceAxes axes[kCubeFaces];
+  for (int k = 0; k < kCubeFaces; ++k) axes[k] = face_axes(k, R);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rows), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Vec3> dirs(side);
+    for (size_t row = r.begin(); row != r.end(); ++row) {
+      const int face = int(row / side), y = int(row % side);
+      for (int x = 0; x < n; ++x) dirs[size_t(x)] = pixel_direction(axes[face], x, y, n);
+      row_fn(row, dirs);
+    }
+  });
+}
+
+}  // namespace
+
 std::vector<uint32_t> point_cubemap(const EmbreeScene& scene, Vec3 eye, const Mat3& R, int n,
                                     double z_near) {
   assert(n >= 1 && z_near >= 0.0);
   const size_t side = size_t(n);
   std::vector<uint32_t> ids(size_t(kCubeFaces) * side * side, kNoHit);
-  FaceAxes axes[kCubeFaces];
-  for (int k = 0; k < kCubeFaces; ++k) axes[k] = face_axes(k, R);
-  const size_t rows = size_t(kCubeFaces) * side;
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, rows), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<Vec3> dirs(side);
-    std::vector<Hit> hits(side);
-    for (size_t row = r.begin(); row != r.end(); ++row) {
-      const int face = int(row / side), y = int(row % side);
-      for (int x = 0; x < n; ++x) dirs[size_t(x)] = pixel_direction(axes[face], x, y, n);
-      scene.first_hits(eye, dirs.data(), side, z_near, hits.data());
-      uint32_t* out = ids.data() + row * side;
-      for (size_t x = 0; x < side; ++x) out[x] = hits[x].tri;
-    }
+  for_each_cube_row(R, n, [&](size_t row, const std::vector<Vec3>& dirs) {
+    thread_local std::vector<Hit> hits;
+    hits.resize(side);
+    scene.first_hits(eye, dirs.data(), side, z_near, hits.data());
+    uint32_t* out = ids.data() + row * side;
+    for (size_t x = 0; x < side; ++x) out[x] = hits[x].tri;
   });
   return ids;
 }
@@ -49,21 +63,15 @@ std::vector<uint32_t> point_visible_set(const EmbreeScene& scene, Vec3 eye, cons
                                         double z_near) {
   if (!scene.has_see_through()) return visible_set(point_cubemap(scene, eye, R, n, z_near));
   // The see-through rule: each pixel's first opaque hit and the see-through hits in front of it.
-  const size_t side = size_t(n), rows = size_t(kCubeFaces) * side;
-  FaceAxes axes[kCubeFaces];
-  for (int k = 0; k < kCubeFaces; ++k) axes[k] = face_axes(k, R);
-  std::vector<std::vector<uint32_t>> row_ids(rows);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, rows), [&](const tbb::blocked_range<size_t>& r) {
-    std::vector<Vec3> dirs(side);
-    std::vector<Hit> hits(side);
-    for (size_t row = r.begin(); row != r.end(); ++row) {
-      const int face = int(row / side), y = int(row % side);
-      for (int x = 0; x < n; ++x) dirs[size_t(x)] = pixel_direction(axes[face], x, y, n);
-      std::vector<uint32_t>& ids = row_ids[row];
-      scene.hits_through(eye, dirs.data(), side, z_near, hits.data(), ids);
-      for (const Hit& h : hits)
-        if (h.tri != kNoHit) ids.push_back(h.tri);
-    }
+  const size_t side = size_t(n);
+  std::vector<std::vector<uint32_t>> row_ids(size_t(kCubeFaces) * side);
+  for_each_cube_row(R, n, [&](size_t row, const std::vector<Vec3>& dirs) {
+    thread_local std::vector<Hit> hits;
+    hits.resize(side);
+    std::vector<uint32_t>& ids = row_ids[row];
+    scene.hits_through(eye, dirs.data(), side, z_near, hits.data(), ids);
+    for (const Hit& h : hits)
+      if (h.tri != kNoHit) ids.push_back(h.tri);
   });
   std::vector<uint32_t> all;
   for (const auto& ids : row_ids) all.insert(all.end(), ids.begin(), ids.end());
