@@ -117,7 +117,9 @@ std::vector<uint32_t> parse_leaves(const std::string& text, const std::vector<ui
   };
   // One item, whole: "%u" alone would also take a sign, spaces or trailing text.
   const auto parse_item = [&](const std::string& item, unsigned& lo, unsigned& hi, unsigned& step) {
-    if (item.empty() || item.find_first_not_of("0123456789-/") != std::string::npos) throw bad();
+    if (item.empty() || item[0] == '-' ||
+        item.find_first_not_of("0123456789-/") != std::string::npos)
+      throw bad();
     int used = -1;
     step = 1;
     if (std::sscanf(item.c_str(), "%u-%u/%u%n", &lo, &hi, &step, &used) != 3) {

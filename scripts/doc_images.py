@@ -132,14 +132,14 @@ def main(work, out):
     plt.close(fig)
 
 
-def finish(ax, polys):
+def finish(ax, polys, unit="m"):
     xs = [p[0] for poly in polys for p in poly]
     zs = [p[1] for poly in polys for p in poly]
     ax.set_xlim(min(xs), max(xs))
     ax.set_ylim(max(zs), min(zs))
     ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("z (m)")
+    ax.set_xlabel("x (%s)" % unit)
+    ax.set_ylabel("z (%s)" % unit)
     ax.tick_params(labelsize=7)
 
 

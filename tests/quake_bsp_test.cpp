@@ -976,6 +976,15 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_NE(out.find("--cell-size"), std::string::npos) << out;
   EXPECT_EQ(run_pvs("bake " + map + " --face-spacing 8 --walkable -o " + dir + "/x.pvs", &out), 2);
   EXPECT_NE(out.find("--face-spacing"), std::string::npos) << out;
+  // --leaves: a list of A, A-B and A-B/K items; anything else exits 2 naming the option.
+  for (const char* bad : {"5-", "x", "3-1", "1-4/0", "-3", "1,,2", "2 3"}) {
+    EXPECT_EQ(
+        run_pvs("bake " + map + " --cells bsp-leaves --leaves '" + bad + "' -o " + dir + "/x.pvs",
+                &out),
+        2)
+        << bad;
+    EXPECT_NE(out.find("--leaves"), std::string::npos) << out;
+  }
   const std::string glb = dir + "/scene.glb";
   ASSERT_EQ(run_pvs("generate city --blocks 2,2 -o " + glb, &out), 0) << out;
   EXPECT_EQ(run_pvs("bake " + glb + " --cells bsp-leaves -o " + dir + "/x.pvs", &out), 2);
@@ -1043,6 +1052,20 @@ TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourBakeThroughTheCliAndHoldTheirRays)
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256);
+}
+
+// --leaves picks the listed leaves of a real map: every 10th from 1 to 40, and 3.
+TEST(QuakeBakeLibreQuake, LeavesListAndStrideSelectThoseLeaves) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  const std::string dir = temp_dir("quake_bake_leaves");
+  std::string out;
+  ASSERT_EQ(run_pvs("bake " + *path + " --cells bsp-leaves --leaves 1-40/10,3 --dry-run -o " + dir +
+                        "/x.pvs",
+                    &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("5 cells (bsp-leaves)"), std::string::npos) << out;
 }
 
 // The whole of lqdm1 (opt-in: VISLIB_LONG_TESTS=1; tens of minutes on the 2-core host).
