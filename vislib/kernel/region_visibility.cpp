@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <functional>
 
+#include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
 #include "vislib/kernel/segment_run_cache.h"
 
@@ -64,12 +65,16 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       const Segment& seg = result.segments[s];
       SegmentResult sr;
       bool computed = true;
+      // Phases for a caller that times them (phase_times.h): a run computed here, or one another
+      // thread computes (whose tiles this thread joins while it waits).
       // A planned long segment keeps no witnesses per part: such regions compute their own.
       if (options.shared_runs && k == 0 &&
           !(witnesses && options.shared_runs->chains_planned() > 0)) {
+        PhaseScope waiting(Phase::SharedWait);
         auto shared = options.shared_runs->get(
             seg.from, seg.to,
             [&](Vec3 a, Vec3 b, const std::vector<double>& splits) {
+              PhaseScope running(Phase::Run);
               SegmentOptions o = so;
               o.splits = splits;
               return segment_visibility(scene, a, b, o);
@@ -78,8 +83,10 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;
       } else {
+        PhaseScope running(Phase::Run);
         sr = segment_visibility(scene, seg.from, seg.to, so);
       }
+      PhaseScope merging(Phase::Merge);
       // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
       for (size_t i = 0; i < sr.visible.size(); ++i) {
         uint32_t id = sr.visible[i];
@@ -108,6 +115,7 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       if (progress) progress(result.runs.size(), total);
     }
   }
+  PhaseScope merging(Phase::Merge);
   for (uint32_t id = 0; id < in_union.size(); ++id)
     if (in_union[id]) {
       result.visible.push_back(id);
