@@ -3,7 +3,9 @@
 #include "vislib/kernel/region_visibility.h"
 
 #include <algorithm>
+#include <cassert>
 #include <functional>
+#include <iterator>
 
 #include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
@@ -51,10 +53,14 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
   RegionResult result;
   result.segments = std::move(segments);
   const size_t total = result.segments.size() * size_t(options.runs);
-  std::vector<uint8_t> in_union(scene.triangle_count(), 0),
-      sphere_in_union(scene.sphere_count(), 0);
-  size_t union_size = 0;
   const bool witnesses = options.segment.want_witnesses;
+  // Without witnesses the union is merged from the runs' sorted lists, in memory of the visible
+  // sets (a bake holds one per cell in flight); with them, flags per id keep each id's first
+  // witness.
+  std::vector<uint8_t> in_union(witnesses ? scene.triangle_count() : 0),
+      sphere_in_union(witnesses ? scene.sphere_count() : 0);
+  std::vector<uint32_t> tri_union, sphere_union, merged;
+  size_t union_size = 0;
   std::vector<RegionWitness> tri_witness(witnesses ? scene.triangle_count() : 0),
       sphere_witness(witnesses ? scene.sphere_count() : 0);
   for (size_t s = 0; s < result.segments.size(); ++s) {
@@ -87,19 +93,33 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
         sr = segment_visibility(scene, seg.from, seg.to, so);
       }
       PhaseScope merging(Phase::Merge);
-      // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
-      for (size_t i = 0; i < sr.visible.size(); ++i) {
-        uint32_t id = sr.visible[i];
-        if (in_union[id]) continue;
-        in_union[id] = 1;
-        ++union_size;
-        if (witnesses) tri_witness[id] = {s, k, sr.witnesses[i]};
-      }
-      for (size_t i = 0; i < sr.visible_spheres.size(); ++i) {
-        uint32_t sp = sr.visible_spheres[i];
-        if (sphere_in_union[sp]) continue;
-        sphere_in_union[sp] = 1;
-        if (witnesses) sphere_witness[sp] = {s, k, sr.witnesses[sr.visible.size() + i]};
+      if (witnesses) {
+        // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
+        for (size_t i = 0; i < sr.visible.size(); ++i) {
+          uint32_t id = sr.visible[i];
+          if (in_union[id]) continue;
+          in_union[id] = 1;
+          ++union_size;
+          tri_witness[id] = {s, k, sr.witnesses[i]};
+        }
+        for (size_t i = 0; i < sr.visible_spheres.size(); ++i) {
+          uint32_t sp = sr.visible_spheres[i];
+          if (sphere_in_union[sp]) continue;
+          sphere_in_union[sp] = 1;
+          sphere_witness[sp] = {s, k, sr.witnesses[sr.visible.size() + i]};
+        }
+      } else {
+        assert(std::adjacent_find(sr.visible.begin(), sr.visible.end(),
+                                  std::greater_equal<uint32_t>()) == sr.visible.end());
+        merged.clear();
+        std::set_union(tri_union.begin(), tri_union.end(), sr.visible.begin(), sr.visible.end(),
+                       std::back_inserter(merged));
+        tri_union.swap(merged);
+        union_size = tri_union.size();
+        merged.clear();
+        std::set_union(sphere_union.begin(), sphere_union.end(), sr.visible_spheres.begin(),
+                       sr.visible_spheres.end(), std::back_inserter(merged));
+        sphere_union.swap(merged);
       }
       result.seconds += sr.stats.seconds;
       RunRecord rec;
@@ -116,15 +136,20 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
     }
   }
   PhaseScope merging(Phase::Merge);
+  if (!witnesses) {
+    result.visible = std::move(tri_union);
+    result.visible_spheres = std::move(sphere_union);
+    return result;
+  }
   for (uint32_t id = 0; id < in_union.size(); ++id)
     if (in_union[id]) {
       result.visible.push_back(id);
-      if (witnesses) result.witnesses.push_back(tri_witness[id]);
+      result.witnesses.push_back(tri_witness[id]);
     }
   for (uint32_t s = 0; s < sphere_in_union.size(); ++s)
     if (sphere_in_union[s]) {
       result.visible_spheres.push_back(s);
-      if (witnesses) result.witnesses.push_back(sphere_witness[s]);
+      result.witnesses.push_back(sphere_witness[s]);
     }
   return result;
 }
