@@ -421,6 +421,27 @@ TEST(BakeReportJson, StatesTheRunTheCellsTimingsAndTheFileSizes) {
   for (const char* k :
        {"cells_cpu_seconds", "progress_seconds", "checkpoint_seconds", "writing_seconds"})
     EXPECT_GE(t[k].get<double>(), 0) << k;
+  // Phase by phase: every thread's time counted once, so the pipeline's phases and idle add up
+  // to threads x bake_seconds (wall) and to the process's CPU seconds (within the timers' rounding
+  // of 1 ns per reading).
+  const json& ph = t["phases"];
+  double wall_sum = 0, cpu_sum = 0;
+  for (const char* k : {"runs", "shared_waits", "merge", "cell", "progress", "checkpoint", "encode",
+                        "write", "idle"}) {
+    ASSERT_TRUE(ph.contains(k)) << k;
+    EXPECT_GE(ph[k]["wall_seconds"].get<double>(), 0) << k;
+    EXPECT_GE(ph[k]["cpu_seconds"].get<double>(), 0) << k;
+    wall_sum += ph[k]["wall_seconds"].get<double>();
+    cpu_sum += ph[k]["cpu_seconds"].get<double>();
+  }
+  EXPECT_GT(ph["runs"]["wall_seconds"].get<double>(), 0);
+  EXPECT_GT(ph["runs"]["cpu_seconds"].get<double>(), 0);
+  EXPECT_GT(ph["encode"]["wall_seconds"].get<double>(), 0);
+  EXPECT_GE(ph["bvh"]["wall_seconds"].get<double>(), 0);
+  EXPECT_GE(ph["pilot"]["wall_seconds"].get<double>(), 0);
+  const double thread_seconds = j["threads"].get<int>() * t["bake_seconds"].get<double>();
+  EXPECT_NEAR(wall_sum, thread_seconds, 1e-3 + 1e-6 * thread_seconds);
+  EXPECT_GE(cpu_sum, t["process_cpu_seconds"].get<double>() - 1e-3);
   info.cell_size = 8;
   EXPECT_EQ(json::parse(bake_report_json(info, r))["preset"]["cell_size"], 8.0);
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <set>
 
 #include "tests/scene_builders.h"
 #include "tests/support/ray_oracle.h"
@@ -226,6 +227,16 @@ TEST(RegionVisibility, UnionGrowsWithRunsAndRunZeroIsAxisAligned) {
   for (size_t k = 1; k < r.runs.size(); ++k)
     EXPECT_GE(r.runs[k].union_size_after, r.runs[k - 1].union_size_after);
   EXPECT_EQ(r.runs.back().union_size_after, r.visible.size());
+  // The union is that of the runs' sets, after each run too (an ordered set as the oracle).
+  std::set<uint32_t> all;
+  for (const RunRecord& run : r.runs) {
+    all.insert(run.visible.begin(), run.visible.end());
+    EXPECT_EQ(run.union_size_after, all.size());
+  }
+  EXPECT_EQ(r.visible, std::vector<uint32_t>(all.begin(), all.end()));
+  // With witnesses (flags per id instead of merged lists) the same union.
+  o.segment.want_witnesses = true;
+  EXPECT_EQ(region_visibility(s, rect, o).visible, r.visible);
 }
 
 namespace {

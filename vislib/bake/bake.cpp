@@ -1,10 +1,8 @@
 // bake.cpp: parallel bake over view cells with checkpoint and shards (bake.h, docs/bake.md).
 #include "vislib/bake/bake.h"
 
-#include <sys/resource.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
-#include <time.h>
 
 #include <atomic>
 #include <cassert>
@@ -20,6 +18,7 @@
 #include "vislib/bake/long_segments.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/base/phase_times.h"
 #include "vislib/kernel/segment_run_cache.h"
 #include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/scene_fingerprint.h"
@@ -82,6 +81,7 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
                                 const std::function<void(double)>& progress) {
   CellVisibility v = cell_visibility(scene, layout, cell, settings.region, progress);
   if (seconds) *seconds = v.seconds;
+  PhaseScope merging(Phase::Merge);
   return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
@@ -90,6 +90,7 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const ViewCells& cells, uint
                                 const std::function<void(double)>& progress) {
   CellVisibility v = cell_visibility(scene, cells, cell, settings.region, progress);
   if (seconds) *seconds = v.seconds;
+  PhaseScope merging(Phase::Merge);
   return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
@@ -120,20 +121,9 @@ std::vector<std::vector<Segment>> all_cell_segments(const ViewCells& cells) {
   return out;
 }
 
-// Wall and CPU clocks of the calling thread, and of the whole process.
+// Wall clock of the calling thread.
 double wall_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-double thread_cpu_now() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-double process_cpu_now() {
-  rusage u;
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 // Adds `seconds` to `*sum` (std::atomic<double> has no fetch_add before C++20).
@@ -229,6 +219,23 @@ void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const Vi
   report.long_segment_choice.runs.clear();
 }
 
+// The pipeline's phases into report.times.phases, and the rest of the threads' time (idle).
+// Precondition: report.seconds, report.threads and report.times.process_cpu are set.
+void record_phases(const PhaseTimes& t, BakeReport& report) {
+  BakePhases& p = report.times.phases;
+  auto get = [&t](Phase phase) { return PhaseSeconds{t.wall(phase), t.cpu(phase)}; };
+  p.cell = get(Phase::Cell);
+  p.runs = get(Phase::Run);
+  p.shared_waits = get(Phase::SharedWait);
+  p.merge = get(Phase::Merge);
+  p.progress = get(Phase::Progress);
+  p.checkpoint = get(Phase::Checkpoint);
+  p.encode = get(Phase::Encode);
+  p.write = get(Phase::Write);
+  p.idle.wall = std::max(0.0, double(report.threads) * report.seconds - t.wall_total());
+  p.idle.cpu = std::max(0.0, report.times.process_cpu - t.cpu_total());
+}
+
 // Streaming: cells are baked in parallel and written in cell order as soon as every earlier
 // cell is written (a TBB pipeline whose last stage is serial and in order), so the memory held
 // is the cells in flight (a bounded number of tokens) plus what pvs::StreamWriter keeps for
@@ -241,9 +248,12 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                   Checkpoint* checkpoint, const BakeFiles& files, const BakeProgressFn& progress,
                   std::atomic<uint64_t>& runs_done, BakeReport& report) {
   const uint32_t n = info.layout.cell_count();
+  PhaseTimes phases;
   AtomicFile out(files.output);
-  pvs::StreamWriter writer(
-      info, [&out](uint64_t offset, std::string_view bytes) { out.write_at(offset, bytes); });
+  pvs::StreamWriter writer(info, [&out, &phases](uint64_t offset, std::string_view bytes) {
+    PhaseScope writing(Phase::Write, &phases);
+    out.write_at(offset, bytes);
+  });
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -272,7 +282,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
   };
   if (progress) progress(state());
   std::atomic<double> t_cells{0}, t_cells_cpu{0}, t_progress{0}, t_checkpoint{0}, t_writing{0};
-  const double cpu_start = process_cpu_now();
+  const double cpu_start = process_cpu_seconds();
   const size_t tokens = 4 * size_t(std::max(1, report.threads));
   uint32_t next = 0;
   try {
@@ -289,6 +299,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
             tbb::make_filter<uint32_t, std::shared_ptr<pvs::CellSet>>(
                 tbb::filter_mode::parallel,
                 [&](uint32_t c) {
+                  PhaseScope in_cell_phase(Phase::Cell, &phases);
                   auto set = std::make_shared<pvs::CellSet>();
                   if (!in_shard(c, shard)) return set;  // absent from this shard's file
                   if (recovered[c]) {
@@ -300,6 +311,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                   std::function<void(double)> in_cell;  // progress inside the cell
                   if (progress)
                     in_cell = [&, c](double fraction) {
+                      PhaseScope reporting(Phase::Progress, &phases);
                       const double w0 = wall_now();
                       std::lock_guard<std::mutex> guard(progress_mutex);
                       running += fraction - partial[c];
@@ -311,7 +323,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                   const bool outer = g_cell_depth++ == 0;
                   const double nested_before = g_nested_cpu;
                   g_nested_cpu = 0;
-                  const double w0 = wall_now(), c0 = thread_cpu_now();
+                  const double w0 = wall_now(), c0 = thread_cpu_seconds();
                   std::vector<uint32_t> ids;
                   try {
                     ids = with_memory_stage(
@@ -324,7 +336,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                     throw;
                   }
                   --g_cell_depth;
-                  const double cpu = thread_cpu_now() - c0;
+                  const double cpu = thread_cpu_seconds() - c0;
                   report.cell_cpu_seconds[c] = cpu - g_nested_cpu;
                   g_nested_cpu = nested_before + cpu;
                   if (outer) {
@@ -332,11 +344,15 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                     add_to(&t_cells_cpu, cpu);
                   }
                   runs_done += cell_runs(cells, c, runs);
-                  const double k0 = wall_now();
-                  if (checkpoint) checkpoint->append(c, ids);
-                  add_to(&t_checkpoint, wall_now() - k0);
+                  {
+                    PhaseScope appending(Phase::Checkpoint, &phases);
+                    const double k0 = wall_now();
+                    if (checkpoint) checkpoint->append(c, ids);
+                    add_to(&t_checkpoint, wall_now() - k0);
+                  }
                   *set = std::move(ids);
                   report.cell_seconds[c] = seconds;
+                  PhaseScope reporting(Phase::Progress, &phases);
                   std::lock_guard<std::mutex> guard(progress_mutex);
                   ++done;
                   ++report.baked;
@@ -349,6 +365,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                 }) &
             tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
                 tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
+                  PhaseScope encoding(Phase::Encode, &phases);
                   const double w0 = wall_now();
                   with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
                   add_to(&t_writing, wall_now() - w0);
@@ -358,15 +375,22 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
     if (checkpoint && done == 0) checkpoint->remove();
     throw;
   }
-  report.seconds = elapsed();
-  report.times.process_cpu = process_cpu_now() - cpu_start;
   report.times.cells = t_cells;
   report.times.cells_cpu = t_cells_cpu;
   report.times.progress = t_progress;
   report.times.checkpoint = t_checkpoint;
   report.times.writing = t_writing;
-  report.stats = writer.finish();
-  out.commit();
+  {
+    PhaseScope encoding(Phase::Encode, &phases);
+    report.stats = writer.finish();
+  }
+  {
+    PhaseScope writing(Phase::Write, &phases);
+    out.commit();
+  }
+  report.seconds = elapsed();
+  report.times.process_cpu = process_cpu_seconds() - cpu_start;
+  record_phases(phases, report);
 }
 
 }  // namespace
@@ -380,8 +404,13 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   BakeReport report;
   report.threads = tbb::this_task_arena::max_concurrency();
   TriangleBvh tree;
+  double w0 = wall_now(), c0 = process_cpu_seconds();
   const TriangleBvh* bvh = bake_bvh(scene, requested, tree, report);
+  report.times.phases.bvh = {wall_now() - w0, process_cpu_seconds() - c0};
+  w0 = wall_now();
+  c0 = process_cpu_seconds();
   const BakeSettings settings = resolved_settings(scene, cells, requested, bvh, report);
+  report.times.phases.pilot = {wall_now() - w0, process_cpu_seconds() - c0};
   pvs::FileInfo info = bake_file_info(scene, cells, settings);
   info.partial = shard.count > 1;
   const uint32_t n = info.layout.cell_count();

@@ -106,6 +106,36 @@ struct BakeFiles {
   bool lock = true;
 };
 
+// Wall and CPU seconds of one phase, summed over threads.
+struct PhaseSeconds {
+  double wall = 0, cpu = 0;
+};
+
+// Where each thread's time went, phase by phase (phase_times.h: a thread's time goes to the
+// innermost phase it is in, so no second counts twice). In the pipeline over cells, the phases'
+// wall seconds and `idle` add up to threads x BakeReport::seconds, their CPU seconds and `idle`
+// to BakeTimes::process_cpu. Read from the clocks a few times per from-segment run.
+struct BakePhases {
+  // Before the pipeline, on the calling thread while the arena's other threads join its parallel
+  // loops: wall seconds, and the process's CPU seconds (every thread) over the same time.
+  PhaseSeconds bvh;    // building the BVH (BakeSettings::bvh)
+  PhaseSeconds pilot;  // the pilot of --long-segments auto (long_segments.h)
+  // In the pipeline:
+  PhaseSeconds runs;          // from-segment runs a thread computes, with the tiles it runs in them
+  PhaseSeconds shared_waits;  // in a shared or long-segment run another thread computes: joining
+                              // its tiles (CPU) or waiting idle for them to end (wall only)
+  PhaseSeconds merge;         // the union of a cell's runs and the ids of its set
+  PhaseSeconds cell;          // the rest of a cell's computation (set-up, copies)
+  PhaseSeconds progress;      // waiting for the progress lock and reporting
+  PhaseSeconds checkpoint;    // appending finished cells to the checkpoint
+  PhaseSeconds encode;        // encoding blocks in cell order, and the index at the end
+  PhaseSeconds write;         // writing the bytes, the final fsync and rename
+  // The rest: wall, threads x BakeReport::seconds less every phase (threads with no cell or
+  // block to work on, or running tiles of a run another thread computes outside any cell of
+  // their own); CPU, process_cpu less every phase (those tiles, and the scheduler's spinning).
+  PhaseSeconds idle;
+};
+
 // Where a bake's threads spent the pipeline over cells (the BVH and the pilot come before it:
 // BakeReport::bvh_seconds, long_segment_choice.seconds). Seconds summed over the calls, from
 // timers inside the bake; the threads had threads * BakeReport::seconds of wall time in all.
@@ -119,6 +149,7 @@ struct BakeTimes {
   double progress = 0;     // of `cells`: waiting for the progress lock and reporting (wall)
   double checkpoint = 0;   // appending finished cells to the checkpoint (wall)
   double writing = 0;      // in the writer stage, one cell at a time in cell order (wall)
+  BakePhases phases;       // the same time, phase by phase
 };
 
 struct BakeReport {

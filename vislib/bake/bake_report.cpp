@@ -2,6 +2,7 @@
 #include "vislib/bake/bake_report.h"
 
 #include <nlohmann/json.hpp>
+#include <utility>
 
 namespace vislib {
 
@@ -38,6 +39,21 @@ json long_segments_json(const BakeReport& r) {
   return j;
 }
 
+// Each phase's wall and CPU seconds, summed over threads (BakePhases).
+json phases_json(const BakePhases& p) {
+  const std::pair<const char*, const PhaseSeconds*> phases[] = {
+      {"bvh", &p.bvh},           {"pilot", &p.pilot},
+      {"runs", &p.runs},         {"shared_waits", &p.shared_waits},
+      {"merge", &p.merge},       {"cell", &p.cell},
+      {"progress", &p.progress}, {"checkpoint", &p.checkpoint},
+      {"encode", &p.encode},     {"write", &p.write},
+      {"idle", &p.idle}};
+  json j = json::object();
+  for (const auto& [name, s] : phases)
+    j[name] = {{"wall_seconds", s->wall}, {"cpu_seconds", s->cpu}};
+  return j;
+}
+
 }  // namespace
 
 std::string bake_report_json(const BakeRunInfo& info, const BakeReport& r) {
@@ -68,7 +84,8 @@ std::string bake_report_json(const BakeRunInfo& info, const BakeReport& r) {
         {"shared_wait_seconds", r.times.shared_wait},
         {"progress_seconds", r.times.progress},
         {"checkpoint_seconds", r.times.checkpoint},
-        {"writing_seconds", r.times.writing}}},
+        {"writing_seconds", r.times.writing},
+        {"phases", phases_json(r.times.phases)}}},
       {"cell_seconds", r.cell_seconds},
       {"cell_cpu_seconds", r.cell_cpu_seconds},
       {"bytes",

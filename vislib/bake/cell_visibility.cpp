@@ -6,6 +6,7 @@
 #include <cassert>
 #include <iterator>
 
+#include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
 
 namespace vislib {
@@ -61,6 +62,7 @@ CellVisibility groups_visibility(const Scene& scene,
         progress((double(r) + double(done) / double(std::max<size_t>(1, total))) / double(count));
       };
     RegionResult rr = segments_visibility(scene, groups[r], o, run_done);
+    PhaseScope merging(Phase::Merge);
     std::vector<uint32_t> merged;
     merged.reserve(out.triangles.size() + rr.visible.size());
     std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(), rr.visible.end(),

@@ -1,6 +1,8 @@
 // long_segments.cpp: see long_segments.h.
 #include "vislib/bake/long_segments.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -78,17 +80,22 @@ LongSegmentChoice choose_long_segments(const Scene& scene, const std::vector<Seg
     c.parts = parts;
     runs_of.emplace_back();
     const auto t0 = std::chrono::steady_clock::now();
+    std::vector<LongSegmentChoice::Run>& runs = runs_of.back();
     for (const std::vector<SegmentEnds>& stretch : sample) {
       for (size_t i = 0, j; i < stretch.size(); i = j) {
         j = std::min(stretch.size(), i + size_t(parts));
-        const Vec3 from = stretch[i].first, to = stretch[j - 1].second;
-        o.splits = chain_splits(stretch, i, j);
-        SegmentResult r = segment_visibility(scene, from, to, o);
-        c.stats.add(r.stats);
-        ++c.runs;
-        runs_of.back().push_back({from, to, o.splits, std::move(r)});
+        runs.push_back({stretch[i].first, stretch[j - 1].second, chain_splits(stretch, i, j), {}});
       }
     }
+    // The candidate's runs side by side (each is parallel inside too): one run's tiles cannot
+    // keep many threads busy, and the runs are independent. The counts are summed in run order.
+    tbb::parallel_for(size_t(0), runs.size(), [&](size_t r) {
+      SegmentOptions ro = o;
+      ro.splits = runs[r].splits;
+      runs[r].result = segment_visibility(scene, runs[r].from, runs[r].to, ro);
+    });
+    for (const LongSegmentChoice::Run& run : runs) c.stats.add(run.result.stats);
+    c.runs = int(runs.size());
     c.seconds = seconds_since(t0);
     c.cost = estimated_work(c.stats);
     choice.candidates.push_back(c);

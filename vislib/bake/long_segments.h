@@ -9,7 +9,7 @@
 // candidate length L in {1, 2, 4, 8} (stopping at the first L that costs no less than a shorter
 // one), cut into chains of L from the low end exactly as the bake plans them, and keeps the
 // longest L whose estimated cost is 5% below every shorter one's. The chosen L's runs are runs
-// the bake needs, and are handed to it.
+// the bake needs, and are handed to it. A candidate's runs run side by side (tbb::parallel_for).
 //
 // The estimate is a weighted count of the kernel's work (SegmentStats), never a clock reading: the
 // same scene and settings give the same L on any machine, thread count, shard or resumed bake, so
@@ -30,7 +30,7 @@ struct LongSegmentCandidate {
   int runs = 0;        // kernel runs of the pilot for this L
   SegmentStats stats;  // their counts, summed
   double cost = 0;     // estimated_work of those runs
-  double seconds = 0;  // measured wall time of those runs (reported only; never decides)
+  double seconds = 0;  // measured wall time of those runs, run side by side (reported only)
 };
 
 struct LongSegmentChoice {

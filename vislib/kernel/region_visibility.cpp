@@ -3,8 +3,11 @@
 #include "vislib/kernel/region_visibility.h"
 
 #include <algorithm>
+#include <cassert>
 #include <functional>
+#include <iterator>
 
+#include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
 #include "vislib/kernel/segment_run_cache.h"
 
@@ -50,10 +53,14 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
   RegionResult result;
   result.segments = std::move(segments);
   const size_t total = result.segments.size() * size_t(options.runs);
-  std::vector<uint8_t> in_union(scene.triangle_count(), 0),
-      sphere_in_union(scene.sphere_count(), 0);
-  size_t union_size = 0;
   const bool witnesses = options.segment.want_witnesses;
+  // Without witnesses the union is merged from the runs' sorted lists, in memory of the visible
+  // sets (a bake holds one per cell in flight); with them, flags per id keep each id's first
+  // witness.
+  std::vector<uint8_t> in_union(witnesses ? scene.triangle_count() : 0),
+      sphere_in_union(witnesses ? scene.sphere_count() : 0);
+  std::vector<uint32_t> tri_union, sphere_union, merged;
+  size_t union_size = 0;
   std::vector<RegionWitness> tri_witness(witnesses ? scene.triangle_count() : 0),
       sphere_witness(witnesses ? scene.sphere_count() : 0);
   for (size_t s = 0; s < result.segments.size(); ++s) {
@@ -64,12 +71,16 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       const Segment& seg = result.segments[s];
       SegmentResult sr;
       bool computed = true;
+      // Phases for a caller that times them (phase_times.h): a run computed here, or one another
+      // thread computes (whose tiles this thread joins while it waits).
       // A planned long segment keeps no witnesses per part: such regions compute their own.
       if (options.shared_runs && k == 0 &&
           !(witnesses && options.shared_runs->chains_planned() > 0)) {
+        PhaseScope waiting(Phase::SharedWait);
         auto shared = options.shared_runs->get(
             seg.from, seg.to,
             [&](Vec3 a, Vec3 b, const std::vector<double>& splits) {
+              PhaseScope running(Phase::Run);
               SegmentOptions o = so;
               o.splits = splits;
               return segment_visibility(scene, a, b, o);
@@ -78,21 +89,37 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;
       } else {
+        PhaseScope running(Phase::Run);
         sr = segment_visibility(scene, seg.from, seg.to, so);
       }
-      // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
-      for (size_t i = 0; i < sr.visible.size(); ++i) {
-        uint32_t id = sr.visible[i];
-        if (in_union[id]) continue;
-        in_union[id] = 1;
-        ++union_size;
-        if (witnesses) tri_witness[id] = {s, k, sr.witnesses[i]};
-      }
-      for (size_t i = 0; i < sr.visible_spheres.size(); ++i) {
-        uint32_t sp = sr.visible_spheres[i];
-        if (sphere_in_union[sp]) continue;
-        sphere_in_union[sp] = 1;
-        if (witnesses) sphere_witness[sp] = {s, k, sr.witnesses[sr.visible.size() + i]};
+      PhaseScope merging(Phase::Merge);
+      if (witnesses) {
+        // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
+        for (size_t i = 0; i < sr.visible.size(); ++i) {
+          uint32_t id = sr.visible[i];
+          if (in_union[id]) continue;
+          in_union[id] = 1;
+          ++union_size;
+          tri_witness[id] = {s, k, sr.witnesses[i]};
+        }
+        for (size_t i = 0; i < sr.visible_spheres.size(); ++i) {
+          uint32_t sp = sr.visible_spheres[i];
+          if (sphere_in_union[sp]) continue;
+          sphere_in_union[sp] = 1;
+          sphere_witness[sp] = {s, k, sr.witnesses[sr.visible.size() + i]};
+        }
+      } else {
+        assert(std::adjacent_find(sr.visible.begin(), sr.visible.end(),
+                                  std::greater_equal<uint32_t>()) == sr.visible.end());
+        merged.clear();
+        std::set_union(tri_union.begin(), tri_union.end(), sr.visible.begin(), sr.visible.end(),
+                       std::back_inserter(merged));
+        tri_union.swap(merged);
+        union_size = tri_union.size();
+        merged.clear();
+        std::set_union(sphere_union.begin(), sphere_union.end(), sr.visible_spheres.begin(),
+                       sr.visible_spheres.end(), std::back_inserter(merged));
+        sphere_union.swap(merged);
       }
       result.seconds += sr.stats.seconds;
       RunRecord rec;
@@ -108,15 +135,21 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       if (progress) progress(result.runs.size(), total);
     }
   }
+  PhaseScope merging(Phase::Merge);
+  if (!witnesses) {
+    result.visible = std::move(tri_union);
+    result.visible_spheres = std::move(sphere_union);
+    return result;
+  }
   for (uint32_t id = 0; id < in_union.size(); ++id)
     if (in_union[id]) {
       result.visible.push_back(id);
-      if (witnesses) result.witnesses.push_back(tri_witness[id]);
+      result.witnesses.push_back(tri_witness[id]);
     }
   for (uint32_t s = 0; s < sphere_in_union.size(); ++s)
     if (sphere_in_union[s]) {
       result.visible_spheres.push_back(s);
-      if (witnesses) result.witnesses.push_back(sphere_witness[s]);
+      result.witnesses.push_back(sphere_witness[s]);
     }
   return result;
 }
