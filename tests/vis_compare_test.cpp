@@ -417,6 +417,17 @@ TEST(VisCompare, CliPrintsTheTableAndJsonAndRefusesAPvsOfAnotherScene) {
       2)
       << out;
   EXPECT_NE(out.find("BSP-tree"), std::string::npos) << out;
+  // Kernel witnesses need the bake recorded in the metadata: by default the step is then off and
+  // says why; required with --kernel-witnesses on, exit 2 naming the file and the missing key.
+  const std::string own = write_sets(m, their_sets(m), dir + "/own.pvs");
+  ASSERT_EQ(run_pvs("vis-compare " + m.path + " " + own + " --samples 0", &out), 0) << out;
+  EXPECT_NE(out.find("kernel witnesses       off (the metadata lacks face_spacing)"),
+            std::string::npos)
+      << out;
+  ASSERT_EQ(run_pvs("vis-compare " + m.path + " " + own + " --kernel-witnesses on", &out), 2)
+      << out;
+  EXPECT_NE(out.find("own.pvs"), std::string::npos) << out;
+  EXPECT_NE(out.find("lacks 'face_spacing'"), std::string::npos) << out;
 }
 
 TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
