@@ -25,7 +25,7 @@ namespace pvs_cli {
 namespace {
 
 struct VisCompareArgs {
-  std::string map, pvs, json;
+  std::string map, pvs, json, theirs_pvs;
   int samples = 4;
   int resolution = 0;
   int witness_eyes = 16, witness_targets = 8;
@@ -66,6 +66,7 @@ void import_from_metadata(const nlohmann::json& md, const std::string& key, std:
 
 void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   if (!a.json.empty()) check_output_file(a.json, "--json", true);
+  if (!a.theirs_pvs.empty()) check_output_file(a.theirs_pvs, "--theirs-pvs", false);
   pvs::Reader reader = vislib::reading_pvs(a.pvs, [&] { return pvs::Reader::from_file(a.pvs); });
   const pvs::FileInfo& info = reader.info();
   if (info.layout.kind != pvs::LayoutKind::BspTree)
@@ -118,6 +119,26 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   vislib::reading_pvs(a.pvs, [&] {
     for (uint32_t c = 0; c < cell_leaf.size(); ++c) ours[c] = reader.read_cell(c);
   });
+
+  // The map's own sets in our format: the same layout, cells and scene, the triangles the engine
+  // draws from each cell's leaf.
+  if (!a.theirs_pvs.empty()) {
+    pvs::FileInfo ti = info;
+    ti.partial = false;
+    nlohmann::json tm = {{"generator", "vislib pvs vis-compare --theirs-pvs"},
+                         {"sets",
+                          "the triangles the engine draws from each cell's leaf (the "
+                          "map's own vis)"},
+                         {"map", a.map},
+                         {"bsp_models", a.import.bsp_models},
+                         {"bsp_liquids", a.import.bsp_liquids}};
+    if (!md.is_discarded() && md.contains("cells")) tm["cells"] = md["cells"];
+    ti.metadata = tm.dump(1);
+    std::vector<pvs::CellSet> theirs;
+    for (uint32_t leaf : cell_leaf)
+      theirs.emplace_back(vislib::bsp_leaf_drawn_triangles(bsp, faces, leaf));
+    vislib::write_file_atomic(a.theirs_pvs, pvs::write_pvs(ti, theirs));
+  }
 
   // Kernel witnesses: the cells rebuilt and their runs re-made as the bake's metadata says.
   vislib::ViewCells cells;
@@ -253,6 +274,9 @@ const Registration reg("vis-compare", [](CLI::App& app) {
   cmd->add_option("map", a->map, "The Quake map (.bsp)")->required();
   cmd->add_option("pvs", a->pvs, "Our PVS file of that map (BSP-tree cells)")->required();
   cmd->add_option("--json", a->json, "Write totals and per-leaf rows as JSON here ('-': stdout)");
+  cmd->add_option("--theirs-pvs", a->theirs_pvs,
+                  "Also write the map's own sets (the triangles the engine draws from each leaf) "
+                  "as a PVS file of the same layout and cells, for pvs inspect and the web client");
   cmd->add_option("--samples", a->samples,
                   "Sampled eyes per leaf for the ground truth (0: none; default 4)")
       ->check(non_negative());

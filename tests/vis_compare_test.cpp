@@ -420,7 +420,20 @@ TEST(VisCompare, CliPrintsTheTableAndJsonAndRefusesAPvsOfAnotherScene) {
   // Kernel witnesses need the bake recorded in the metadata: by default the step is then off and
   // says why; required with --kernel-witnesses on, exit 2 naming the file and the missing key.
   const std::string own = write_sets(m, their_sets(m), dir + "/own.pvs");
-  ASSERT_EQ(run_pvs("vis-compare " + m.path + " " + own + " --samples 0", &out), 0) << out;
+  ASSERT_EQ(run_pvs("vis-compare " + m.path + " " + own + " --samples 0 --theirs-pvs " + dir +
+                        "/theirs.pvs",
+                    &out),
+            0)
+      << out;
+  {  // --theirs-pvs: the map's own sets, same layout, cells and scene
+    pvs::Reader t = pvs::Reader::from_file(dir + "/theirs.pvs");
+    const pvs::Reader o = pvs::Reader::from_file(own);
+    EXPECT_EQ(t.info().layout.cell_leaf, o.info().layout.cell_leaf);
+    EXPECT_EQ(t.info().scene_fingerprint, o.info().scene_fingerprint);
+    const auto theirs = their_sets(m);
+    ASSERT_EQ(t.cell_count(), theirs.size());
+    for (uint32_t c = 0; c < t.cell_count(); ++c) EXPECT_EQ(t.read_cell(c), theirs[c]);
+  }
   EXPECT_NE(out.find("kernel witnesses       off (the metadata lacks face_spacing)"),
             std::string::npos)
       << out;
