@@ -4,16 +4,20 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <stdexcept>
 
 #include "cli/commands.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
 #include "cli/threads.h"
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/bsp_cells.h"
 #include "vislib/bake/cell_set.h"
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/vis_compare.h"
+#include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/quake_bsp.h"
 #include "vislib/scene/scene_fingerprint.h"
 
@@ -21,11 +25,12 @@ namespace pvs_cli {
 namespace {
 
 struct VisCompareArgs {
-  std::string map, pvs, json;
+  std::string map, pvs, json, theirs_pvs;
   int samples = 4;
   int resolution = 0;
   int witness_eyes = 16, witness_targets = 8;
   uint64_t seed = 1;
+  std::string kernel_witnesses = "auto";
   int threads = 0;
   ImportArgs import;
 };
@@ -61,6 +66,7 @@ void import_from_metadata(const nlohmann::json& md, const std::string& key, std:
 
 void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   if (!a.json.empty()) check_output_file(a.json, "--json", true);
+  if (!a.theirs_pvs.empty()) check_output_file(a.theirs_pvs, "--theirs-pvs", false);
   pvs::Reader reader = vislib::reading_pvs(a.pvs, [&] { return pvs::Reader::from_file(a.pvs); });
   const pvs::FileInfo& info = reader.info();
   if (info.layout.kind != pvs::LayoutKind::BspTree)
@@ -114,6 +120,78 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
     for (uint32_t c = 0; c < cell_leaf.size(); ++c) ours[c] = reader.read_cell(c);
   });
 
+  // The map's own sets in our format: the same layout, cells and scene, the triangles the engine
+  // draws from each cell's leaf.
+  if (!a.theirs_pvs.empty()) {
+    pvs::FileInfo ti = info;
+    ti.partial = false;
+    nlohmann::json tm = {{"generator", "vislib pvs vis-compare --theirs-pvs"},
+                         {"sets",
+                          "the triangles the engine draws from each cell's leaf (the "
+                          "map's own vis)"},
+                         {"map", a.map},
+                         {"bsp_models", a.import.bsp_models},
+                         {"bsp_liquids", a.import.bsp_liquids}};
+    if (!md.is_discarded() && md.contains("cells")) tm["cells"] = md["cells"];
+    ti.metadata = tm.dump(1);
+    std::vector<pvs::CellSet> theirs;
+    for (uint32_t leaf : cell_leaf)
+      theirs.emplace_back(vislib::bsp_leaf_drawn_triangles(bsp, faces, leaf));
+    vislib::write_file_atomic(a.theirs_pvs, pvs::write_pvs(ti, theirs));
+  }
+
+  // Kernel witnesses: the cells rebuilt and their runs re-made as the bake's metadata says.
+  vislib::ViewCells cells;
+  vislib::RegionOptions ro;
+  vislib::TriangleBvh bvh;
+  // What the re-run needs from the metadata; the first key missing, if any.
+  std::string missing;
+  const nlohmann::json spacing = md.is_discarded() ? nullptr : find_key(md, "face_spacing");
+  if (!spacing.is_number()) missing = "face_spacing";
+  for (const char* k : {"resolution", "near", "eps_len", "eps_z", "runs", "seed"})
+    if (missing.empty() && (md.is_discarded() || !md.contains(k) || !md[k].is_number()))
+      missing = k;
+  if (a.kernel_witnesses == "on" && !missing.empty())
+    throw vislib::InputError(a.pvs, "its metadata lacks '" + missing +
+                                        "', needed to re-run its cells for kernel witnesses");
+  const bool rerun = a.kernel_witnesses != "off" && missing.empty();
+  if (rerun) {
+    vislib::BspCellOptions co;
+    co.face_spacing = spacing.get<double>();
+    co.leaves = cell_leaf;
+    co.scene = lo;
+    ro.segment.resolution = md["resolution"].get<int>();
+    ro.segment.near = md["near"].get<double>();
+    ro.segment.eps_len = md["eps_len"].get<double>();
+    ro.segment.eps_z = md["eps_z"].get<double>();
+    ro.runs = md["runs"].get<int>();
+    ro.seed = md["seed"].get<uint64_t>();
+    const nlohmann::json coplanar = find_key(md, "coplanar");
+    ro.segment.coplanar = coplanar.is_string() && coplanar.get<std::string>() == "first"
+                              ? vislib::CoplanarRule::First
+                              : vislib::CoplanarRule::Both;
+    if (!(co.face_spacing >= 0 && ro.segment.resolution >= 1 && ro.segment.near > 0 &&
+          ro.segment.eps_len >= 0 && ro.segment.eps_z >= 0 && ro.runs >= 1))
+      throw vislib::InputError(
+          a.pvs,
+          "metadata holds an invalid face_spacing, resolution, near, eps_len, eps_z or runs");
+    try {
+      cells = vislib::bsp_leaf_cells(bsp, co);
+    } catch (const std::invalid_argument& e) {
+      throw vislib::InputError(a.pvs,
+                               std::string("its cells are not the map's leaf cells: ") + e.what());
+    }
+    bvh = vislib::build_triangle_bvh(scene);
+    ro.segment.bvh = &bvh;
+    opt.kernel_witnesses = [&](uint32_t cell, const std::vector<uint32_t>& extras) {
+      std::vector<vislib::VisWitness> out;
+      for (const vislib::CellWitnessRay& w :
+           vislib::cell_witness_rays(scene, cells, cell, ro, extras))
+        out.push_back({w.tri, w.eye, w.dir, true});
+      return out;
+    };
+  }
+
   vislib::VisCompareResult r;
   const bool bar = show_progress();
   run_with_threads(a.threads, [&] {
@@ -149,11 +227,18 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
               t["mean_tightness"].get<double>(), t["median_tightness"].get<double>());
   std::printf(
       "  extras                 %lu: confirmed %lu, unconfirmed (ours wrong?) %lu, coincident "
-      "with a face of theirs %lu\n",
+      "with a face of theirs %lu, false witnesses (ours wrong) %lu\n",
       (unsigned long)(num("extras_confirmed") + num("extras_unconfirmed") +
-                      num("extras_coincident")),
+                      num("extras_coincident") + num("extras_false_witness")),
       (unsigned long)num("extras_confirmed"), (unsigned long)num("extras_unconfirmed"),
-      (unsigned long)num("extras_coincident"));
+      (unsigned long)num("extras_coincident"), (unsigned long)num("extras_false_witness"));
+  if (rerun)
+    std::printf("  kernel witnesses       %lu leaves re-run: %lu extras confirmed by them\n",
+                (unsigned long)num("kernel_rerun_leaves"),
+                (unsigned long)num("extras_confirmed_by_kernel"));
+  else
+    std::printf("  kernel witnesses       off%s\n",
+                missing.empty() ? "" : (" (the metadata lacks " + missing + ")").c_str());
   std::printf("  ours lacks             %lu\n", (unsigned long)num("ours_lacks"));
   std::printf(
       "  sampling               %d eyes a leaf, N = %d, %lu rays (%lu no hit, %lu "
@@ -170,12 +255,14 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
               (unsigned long)num("their_never_drawn"));
   std::printf("  leaves with our misses   %s\n", leaves_of("our_miss_leaves").c_str());
   std::printf("  leaves with their misses %s\n", leaves_of("their_miss_leaves").c_str());
-  std::printf("\n  %6s %6s %7s %7s %9s %9s %11s %6s %9s %9s\n", "cell", "leaf", "ours", "theirs",
-              "tightness", "confirmed", "unconfirmed", "lacks", "our-miss", "their-miss");
+  std::printf("\n  %6s %6s %7s %7s %9s %9s %11s %6s %6s %9s %9s\n", "cell", "leaf", "ours",
+              "theirs", "tightness", "confirmed", "unconfirmed", "false", "lacks", "our-miss",
+              "their-miss");
   for (const auto& l : r.leaves)
-    std::printf("  %6u %6u %7zu %7zu %9.4f %9zu %11zu %6zu %9lu %9lu\n", l.cell, l.leaf, l.ours,
-                l.theirs, l.tightness(), l.confirmed.size(), l.unconfirmed.size(), l.lacks.size(),
-                (unsigned long)l.our_misses, (unsigned long)l.their_misses);
+    std::printf("  %6u %6u %7zu %7zu %9.4f %9zu %11zu %6zu %6zu %9lu %9lu\n", l.cell, l.leaf,
+                l.ours, l.theirs, l.tightness(), l.confirmed.size(), l.unconfirmed.size(),
+                l.false_witnesses.size(), l.lacks.size(), (unsigned long)l.our_misses,
+                (unsigned long)l.their_misses);
 }
 
 const Registration reg("vis-compare", [](CLI::App& app) {
@@ -187,6 +274,9 @@ const Registration reg("vis-compare", [](CLI::App& app) {
   cmd->add_option("map", a->map, "The Quake map (.bsp)")->required();
   cmd->add_option("pvs", a->pvs, "Our PVS file of that map (BSP-tree cells)")->required();
   cmd->add_option("--json", a->json, "Write totals and per-leaf rows as JSON here ('-': stdout)");
+  cmd->add_option("--theirs-pvs", a->theirs_pvs,
+                  "Also write the map's own sets (the triangles the engine draws from each leaf) "
+                  "as a PVS file of the same layout and cells, for pvs inspect and the web client");
   cmd->add_option("--samples", a->samples,
                   "Sampled eyes per leaf for the ground truth (0: none; default 4)")
       ->check(non_negative());
@@ -199,6 +289,12 @@ const Registration reg("vis-compare", [](CLI::App& app) {
   cmd->add_option("--witness-targets", a->witness_targets,
                   "Points of an extra aimed at from each eye (default 8)")
       ->check(positive());
+  cmd->add_option("--kernel-witnesses", a->kernel_witnesses,
+                  "Re-run the cells whose extras the ray search leaves unconfirmed, as the bake "
+                  "made them (from the file's metadata), and re-cast the kernel's witnesses: "
+                  "auto (default: when the metadata records the bake), on (exit 2 if it does "
+                  "not) or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_option("--seed", a->seed, "Seed of the witness and sampling eyes (default 1)");
   cmd->add_option("-j,--threads", a->threads, "Threads (default: one per core)")
       ->check(CLI::Range(0, 256));

@@ -3,8 +3,10 @@
 // upper leaf "sees" only itself), with PVS files written here through the format writer: the
 // map's own sets (tightness 1, no extras), a visible extra (confirmed, its witness re-cast by the
 // brute-force reference), a removed visible triangle ("ours lacks" and our sampled misses), a file
-// of another scene (exit 2). On lqdm1 (skipped without ../shared): the map's own sets everywhere,
-// a hidden extra (unconfirmed) and a removed triangle.
+// of another scene (exit 2); a floor seen only through a slit, which the ray search misses and the
+// kernel's own witness confirms, and a false kernel witness. On lqdm1 (skipped without
+// ../shared): the map's own sets everywhere, a hidden extra (unconfirmed) and a removed triangle;
+// and (Release builds) the whole map baked at N = 64 and compared through the CLI.
 #include "vislib/eval/vis_compare.h"
 
 #include <gtest/gtest.h>
@@ -23,6 +25,7 @@
 #include "tests/support/bsp_writer.h"
 #include "tests/test_support.h"
 #include "vislib/bake/bsp_cells.h"
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/point_visibility.h"
 #include "vislib/eval/ray_reference.h"
@@ -42,7 +45,10 @@ namespace {
 // With `water`, face 10 ("*water", triangles 20, 21) lies on the node plane, marked in both
 // leaves. With `twin`, face 10 (triangles 20, 21) is a copy of the ceiling turned the other way,
 // marked in the lower leaf only (so the upper leaf does not draw it).
-QuakeBsp room_map(bool water = false, bool twin = false) {
+//
+// With `slit`, faces 10 and 11 (triangles 20..23, marked in the upper leaf) lie on the node plane
+// z = 32 and cover it but for the slit 40 < y < 44: the floor is seen from above only through it.
+QuakeBsp room_map(bool water = false, bool twin = false, bool slit = false) {
   QuakeBsp m;
   m.entities = "{\n\"classname\" \"worldspawn\"\n}\n";
   m.texture_names = {"wall", "*water"};
@@ -81,6 +87,10 @@ QuakeBsp room_map(bool water = false, bool twin = false) {
   }
   if (water) face({{{0, 0, 32}, {64, 0, 32}, {64, 64, 32}, {0, 64, 32}}}, 0, 1);
   if (twin) face({{{0, 0, 64}, {64, 0, 64}, {64, 64, 64}, {0, 64, 64}}}, 2);
+  if (slit) {
+    face({{{0, 0, 32}, {64, 0, 32}, {64, 40, 32}, {0, 40, 32}}}, 0);
+    face({{{0, 44, 32}, {64, 44, 32}, {64, 64, 32}, {0, 64, 32}}}, 0);
+  }
   BspNode n;
   n.plane = 0;
   n.children = {-3, -2};  // front (z > 32): leaf 2, back: leaf 1
@@ -110,6 +120,10 @@ QuakeBsp room_map(bool water = false, bool twin = false) {
     m.marksurfaces = {0, 2, 3, 4, 5, 10, 1, 6, 7, 8, 9};
     below.marksurface_count = 6;
     above.first_marksurface = 6;
+  }
+  if (slit) {
+    m.marksurfaces = {0, 2, 3, 4, 5, 1, 6, 7, 8, 9, 10, 11};
+    above.marksurface_count = 7;
   }
   m.leaves = {solid, below, above};
   m.visibility = {0x03, 0x02};
@@ -160,9 +174,9 @@ std::string write_sets(const MapCase& m, const std::vector<std::vector<uint32_t>
 }
 
 MapCase room(const std::string& dir, bool water = false, const LoadOptions& options = {},
-             bool twin = false) {
+             bool twin = false, bool slit = false) {
   const std::string path = dir + "/room.bsp";
-  std::ofstream(path, std::ios::binary) << encode_bsp(room_map(water, twin));
+  std::ofstream(path, std::ios::binary) << encode_bsp(room_map(water, twin, slit));
   return open_map(path, options);
 }
 
@@ -232,6 +246,84 @@ TEST(VisCompare, AVisibleExtraIsConfirmedByAWitnessThatTheReferenceRecasts) {
   // across the quad's diagonal, at the same depth).
   const OracleSample hit = brute_force_first_hit(m.scene, 0, w.eye, w.dir, kDefaultNear);
   EXPECT_TRUE(hit.tri == 0u || hit.tri == 1u) << hit.tri;
+}
+
+// The floor seen from the upper leaf only through a slit in a plate: a ray search of one eye
+// aimed at one point (the region's centroid at the triangle's centroid, which the plate hides)
+// leaves the extra unconfirmed (that ray meets the plate); the cell's own runs, re-made as the bake
+// makes them, give a witness through the slit that the reference re-casts: confirmed.
+TEST(VisCompare, AnExtraSeenOnlyThroughASlitIsConfirmedByTheKernelsWitness) {
+  MapCase m = room(temp_dir("vis_compare_slit"), false, {}, false, true);
+  auto sets = their_sets(m);
+  ASSERT_FALSE(std::binary_search(sets[1].begin(), sets[1].end(), 0u));
+  insert_sorted(sets[1], 0);  // a floor triangle, from the upper leaf
+  VisCompareOptions o = fast(0);
+  o.witness_eyes = 1;
+  o.witness_targets = 1;
+  const VisCompareResult before = vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, sets, o);
+  ASSERT_EQ(before.leaves[1].unconfirmed, (std::vector<uint32_t>{0}));
+
+  BspCellOptions co;
+  co.leaves = m.cell_leaf;
+  const ViewCells cells = bsp_leaf_cells(m.bsp, co);
+  RegionOptions ro;
+  ro.segment.resolution = 32;
+  std::vector<uint32_t> asked_cells;
+  o.kernel_witnesses = [&](uint32_t cell, const std::vector<uint32_t>& extras) {
+    asked_cells.push_back(cell);
+    std::vector<VisWitness> out;
+    for (const CellWitnessRay& w : cell_witness_rays(m.scene, cells, cell, ro, extras))
+      out.push_back({w.tri, w.eye, w.dir, true});
+    return out;
+  };
+  const VisCompareResult r = vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, sets, o);
+  EXPECT_EQ(asked_cells, (std::vector<uint32_t>{1}));  // only the cell with an unconfirmed extra
+  const VisCompareLeaf& up = r.leaves[1];
+  EXPECT_TRUE(up.kernel_rerun);
+  EXPECT_FALSE(r.leaves[0].kernel_rerun);
+  EXPECT_TRUE(up.unconfirmed.empty());
+  EXPECT_TRUE(up.false_witnesses.empty());
+  ASSERT_EQ(up.confirmed.size(), 1u);
+  const VisWitness& w = up.confirmed[0];
+  EXPECT_EQ(w.tri, 0u);
+  EXPECT_TRUE(w.from_kernel);
+  // The witness ray passes the plate's plane inside the slit, and the reference sees the floor.
+  const Vec3 eye = scene_to_quake(w.eye), dir = scene_to_quake(w.dir);
+  ASSERT_LT(dir.z, 0.0);
+  const double y = eye.y + dir.y * (32.0 - eye.z) / dir.z;
+  EXPECT_GT(y, 40.0);
+  EXPECT_LT(y, 44.0);
+  const OracleSample hit = brute_force_first_hit(m.scene, 0, w.eye, w.dir, kDefaultNear);
+  EXPECT_TRUE(hit.tri == 0u || hit.tri == 1u) << hit.tri;
+  const nlohmann::json j = nlohmann::json::parse(vis_compare_json(r));
+  EXPECT_EQ(j["totals"]["extras_confirmed_by_kernel"], 1);
+  EXPECT_EQ(j["per_leaf"][1]["extras_confirmed"][0]["source"], "kernel");
+}
+
+// A kernel witness that the reference does not see (here a ray aimed up, away from the extra) is
+// a false witness, reported with its ray; an extra the re-run does not see stays unconfirmed.
+TEST(VisCompare, AKernelWitnessTheReferenceDoesNotSeeIsAFalseWitness) {
+  MapCase m = room(temp_dir("vis_compare_false"), false, {}, false, true);
+  auto sets = their_sets(m);
+  insert_sorted(sets[1], 0);
+  insert_sorted(sets[1], 1);
+  VisCompareOptions o = fast(0);
+  o.witness_eyes = 1;
+  o.witness_targets = 1;
+  o.kernel_witnesses = [&](uint32_t, const std::vector<uint32_t>& extras) {
+    EXPECT_EQ(extras, (std::vector<uint32_t>{0, 1}));
+    return std::vector<VisWitness>{
+        {0, quake_to_scene({32, 32, 48}), quake_to_scene({0, 0, 1}), true}};
+  };
+  const VisCompareResult r = vis_compare(m.bsp, m.scene, m.faces, m.cell_leaf, sets, o);
+  const VisCompareLeaf& up = r.leaves[1];
+  ASSERT_EQ(up.false_witnesses.size(), 1u);
+  EXPECT_EQ(up.false_witnesses[0].tri, 0u);
+  EXPECT_TRUE(up.confirmed.empty());
+  EXPECT_EQ(up.unconfirmed, (std::vector<uint32_t>{1}));
+  const nlohmann::json j = nlohmann::json::parse(vis_compare_json(r));
+  EXPECT_EQ(j["totals"]["extras_false_witness"], 1);
+  EXPECT_EQ(j["per_leaf"][1]["extras_false_witness"][0]["triangle"], 0);
 }
 
 TEST(VisCompare, AnExtraSeenOnlyWithACoincidentFaceOfTheirsIsCoincidentNotConfirmed) {
@@ -325,6 +417,30 @@ TEST(VisCompare, CliPrintsTheTableAndJsonAndRefusesAPvsOfAnotherScene) {
       2)
       << out;
   EXPECT_NE(out.find("BSP-tree"), std::string::npos) << out;
+  // Kernel witnesses need the bake recorded in the metadata: by default the step is then off and
+  // says why; required with --kernel-witnesses on, exit 2 naming the file and the missing key.
+  const std::string own = write_sets(m, their_sets(m), dir + "/own.pvs");
+  ASSERT_EQ(run_pvs("vis-compare " + m.path + " " + own + " --samples 0 --theirs-pvs " + dir +
+                        "/theirs.pvs",
+                    &out),
+            0)
+      << out;
+  {  // --theirs-pvs: the map's own sets, same layout, cells and scene
+    pvs::Reader t = pvs::Reader::from_file(dir + "/theirs.pvs");
+    const pvs::Reader o = pvs::Reader::from_file(own);
+    EXPECT_EQ(t.info().layout.cell_leaf, o.info().layout.cell_leaf);
+    EXPECT_EQ(t.info().scene_fingerprint, o.info().scene_fingerprint);
+    const auto theirs = their_sets(m);
+    ASSERT_EQ(t.cell_count(), theirs.size());
+    for (uint32_t c = 0; c < t.cell_count(); ++c) EXPECT_EQ(t.read_cell(c), theirs[c]);
+  }
+  EXPECT_NE(out.find("kernel witnesses       off (the metadata lacks face_spacing)"),
+            std::string::npos)
+      << out;
+  ASSERT_EQ(run_pvs("vis-compare " + m.path + " " + own + " --kernel-witnesses on", &out), 2)
+      << out;
+  EXPECT_NE(out.find("own.pvs"), std::string::npos) << out;
+  EXPECT_NE(out.find("lacks 'face_spacing'"), std::string::npos) << out;
 }
 
 TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
@@ -458,4 +574,84 @@ TEST(VisCompareLibreQuake, LongOwnSetsOfE1m2AndE2m3) {
         faces.c_str(),
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
+}
+
+// The whole of lqdm1 baked through the CLI at N = 64 (default face spacing, -j 2) and held
+// against the map's vis through `pvs vis-compare --json` (4 sampled eyes a leaf at N = 64,
+// kernel witnesses for what the ray search leaves unconfirmed). Every extra is settled: none is
+// left unconfirmed. The false witnesses (measured: 7, all in leaf 146) are one known error of
+// ours (docs/quake.md, "The false witnesses of lqdm1"): each witness ray meets, in front of its
+// triangle, only crossings on triangle edges (a seam of collinear edges that are not shared, hit
+// exactly); any other false witness fails. Our sampled misses (measured: 15 rays of 31.6 million)
+// are triangles seen only between two chords of the 16-unit sweep (docs/quake.md, "Our sampled
+// misses"): bounded, not zero, at this spacing. Release builds only: the sanitizers multiply the
+// bake's cost, and the 4-leaf bake of quake_bsp_test.cpp covers the same code under them. Time
+// budget: printed; 390 CPU s for the bake (about 3.3 minutes wall on two idle cores, 16.5 on the
+// loaded host where it was measured) and 6 CPU s for the comparison.
+constexpr int kLqdm1N64FalseWitnessBound = 16;
+constexpr int kLqdm1N64MissBound = 32;  // sampled rays, of 31,555,584
+TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMisses) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "the whole-map bake is a release-suite test (AddressSanitizer multiplies its "
+                  "cost; the 4-leaf bake covers the code)";
+#endif
+#ifndef NDEBUG
+  GTEST_SKIP() << "the whole-map bake is a release-suite test";
+#endif
+  auto shared = shared_dir();
+  const std::string path =
+      shared ? *shared + "/scenes/librequake/lqdm1.bsp" : std::string("/nonexistent");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  const std::string dir = temp_dir("vis_compare_lqdm1_whole");
+  std::string out;
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(
+      run_pvs("bake -q " + path + " --cells bsp-leaves --res 64 -j 2 -o " + dir + "/w.pvs", &out),
+      0)
+      << out;
+  const auto t1 = std::chrono::steady_clock::now();
+  ASSERT_EQ(
+      run_pvs("vis-compare " + path + " " + dir + "/w.pvs --json " + dir + "/cmp.json -j 2", &out),
+      0)
+      << out;
+  const auto t2 = std::chrono::steady_clock::now();
+  const auto j = nlohmann::json::parse(read_file(dir + "/cmp.json"));
+  const auto& t = j["totals"];
+  std::printf(
+      "lqdm1 whole at N = 64: bake %.1f s, vis-compare %.1f s (budget: 3.5 minutes on two idle "
+      "cores); ours %d / theirs %d, extras confirmed %d (by kernel witnesses %d), coincident %d, "
+      "unconfirmed %d, false witnesses %d; sampled misses ours %d, theirs %d\n",
+      std::chrono::duration<double>(t1 - t0).count(),
+      std::chrono::duration<double>(t2 - t1).count(), t["ours"].get<int>(), t["theirs"].get<int>(),
+      t["extras_confirmed"].get<int>(), t["extras_confirmed_by_kernel"].get<int>(),
+      t["extras_coincident"].get<int>(), t["extras_unconfirmed"].get<int>(),
+      t["extras_false_witness"].get<int>(), t["our_misses"].get<int>(),
+      t["their_misses"].get<int>());
+  EXPECT_EQ(j["leaves"], 321);
+  EXPECT_EQ(t["extras_unconfirmed"], 0);
+  EXPECT_LE(t["extras_false_witness"].get<int>(), kLqdm1N64FalseWitnessBound);
+  const Scene scene = load_scene(path);
+  for (const auto& leaf : j["per_leaf"])
+    for (const auto& w : leaf["extras_false_witness"]) {
+      const uint32_t tri = w["triangle"].get<uint32_t>();
+      const Vec3 eye{w["eye"][0], w["eye"][1], w["eye"][2]};
+      const Vec3 ray{w["direction"][0], w["direction"][1], w["direction"][2]};
+      const std::vector<RayCrossing> cr = ray_crossings(scene, 0, eye, ray);
+      double lambda = -1;
+      for (const RayCrossing& c : cr)
+        if (c.tri == tri) lambda = c.lambda;
+      ASSERT_GT(lambda, 0) << "leaf " << leaf["leaf"] << ": the false witness of " << tri
+                           << " does not cross it";
+      size_t edge_hits = 0;
+      for (const RayCrossing& c : cr)
+        if (c.tri != tri && c.lambda > kDefaultNear && c.lambda < lambda &&
+            c.min_bary > -kReferenceBarycentric) {
+          EXPECT_LE(c.min_bary, kReferenceBarycentric)
+              << "leaf " << leaf["leaf"] << ", triangle " << tri << ": triangle " << c.tri
+              << " lies inside the witness ray, not on its edge: a false witness of another kind";
+          ++edge_hits;
+        }
+      EXPECT_GE(edge_hits, 2u) << "leaf " << leaf["leaf"] << ", triangle " << tri;
+    }
+  EXPECT_LE(t["our_misses"].get<int>(), kLqdm1N64MissBound) << out;
 }

@@ -6,6 +6,7 @@
 #include <cassert>
 #include <iterator>
 
+#include "vislib/base/cubemap.h"
 #include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
 
@@ -101,6 +102,41 @@ CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint3
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
   return groups_visibility(scene, cell_segment_groups(cells, cell), cell, options, progress);
+}
+
+std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,
+                                              uint32_t cell, const RegionOptions& options,
+                                              const std::vector<uint32_t>& wanted) {
+  assert(options.shared_runs == nullptr);
+  const std::vector<std::vector<Segment>> groups = cell_segment_groups(cells, cell);
+  const uint64_t seed = cell_seed(options.seed, cell);
+  const int n = options.segment.resolution;
+  std::vector<CellWitnessRay> out;
+  std::vector<uint8_t> found(wanted.size(), 0);
+  size_t left = wanted.size(), first_segment = 0;
+  for (size_t r = 0; r < groups.size() && left > 0; ++r) {
+    RegionOptions o = options;
+    o.seed = Rng::derive(seed, uint64_t(r));
+    o.segment.want_witnesses = true;
+    const RegionResult rr = segments_visibility(scene, groups[r], o);
+    for (size_t i = 0; i < rr.visible.size(); ++i) {
+      const auto it = std::lower_bound(wanted.begin(), wanted.end(), rr.visible[i]);
+      if (it == wanted.end() || *it != rr.visible[i] || found[size_t(it - wanted.begin())])
+        continue;
+      found[size_t(it - wanted.begin())] = 1;
+      --left;
+      const RegionWitness& w = rr.witnesses[i];
+      const Segment& s = groups[r][w.segment];
+      const Mat3& R = rr.runs[w.segment * size_t(o.runs) + size_t(w.run)].orientation;
+      const Vec3 d = pixel_direction(face_axes(w.witness.face, R), w.witness.x, w.witness.y, n);
+      out.push_back({rr.visible[i], s.from + (s.to - s.from) * w.witness.t, d * (1.0 / length(d)),
+                     first_segment + w.segment, w.run, w.witness.t});
+    }
+    first_segment += groups[r].size();
+  }
+  std::sort(out.begin(), out.end(),
+            [](const CellWitnessRay& a, const CellWitnessRay& b) { return a.tri < b.tri; });
+  return out;
 }
 
 }  // namespace vislib

@@ -62,4 +62,24 @@ CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint3
                                const RegionOptions& options,
                                const std::function<void(double)>& progress = {});
 
+// A witness of a cell's visible set as one ray: the triangle, the eye on the cell's segment
+// (segment: index into the concatenated groups of cell_segment_groups; t along it) and the unit
+// direction through the centre of the witness pixel of the run that saw it (scene coordinates).
+struct CellWitnessRay {
+  uint32_t tri = 0;
+  Vec3 eye, dir;
+  size_t segment = 0;
+  int run = 0;
+  double t = 0;
+};
+
+// Re-runs cell `cell`'s from-segment runs as cell_visibility does (the same segment groups, seeds,
+// orientations and options) with witnesses (segment_visibility.h), and returns the witness rays
+// of those of `wanted` (sorted triangle ids) that a run sees, in increasing id; an id no run sees
+// has none. Group by group, stopping once every wanted id has one, so the cost is at most that of
+// cell_visibility with witnesses. options.shared_runs must be null. Deterministic, thread-safe.
+std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,
+                                              uint32_t cell, const RegionOptions& options,
+                                              const std::vector<uint32_t>& wanted);
+
 }  // namespace vislib

@@ -157,6 +157,37 @@ Search find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& e
   return coincident ? Search::coincident : Search::none;
 }
 
+// Re-casts the kernel witnesses `kw` of some of row.unconfirmed: confirmed, coincident or false
+// witnesses (vis_compare.h); the extras without one stay unconfirmed. Keeps every list sorted.
+void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<VisWitness> kw,
+                        const std::vector<uint8_t>& in_theirs) {
+  std::sort(kw.begin(), kw.end(),
+            [](const VisWitness& a, const VisWitness& b) { return a.tri < b.tri; });
+  std::vector<uint32_t> still;
+  size_t k = 0;
+  for (uint32_t t : row.unconfirmed) {
+    while (k < kw.size() && kw[k].tri < t) ++k;
+    if (k == kw.size() || kw[k].tri != t) {
+      still.push_back(t);
+      continue;
+    }
+    VisWitness w = kw[k];
+    w.from_kernel = true;
+    const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, w.eye, w.dir);
+    const double lambda = seen_depth(ctx, cr, t);
+    if (lambda < 0)
+      row.false_witnesses.push_back(w);
+    else if (set_at_depth(ctx, cr, lambda, in_theirs))
+      row.coincident.push_back(t);
+    else
+      row.confirmed.push_back(w);
+  }
+  row.unconfirmed = std::move(still);
+  std::sort(row.coincident.begin(), row.coincident.end());
+  std::sort(row.confirmed.begin(), row.confirmed.end(),
+            [](const VisWitness& a, const VisWitness& b) { return a.tri < b.tri; });
+}
+
 // One hit `x` of the ray (eye, dir), missing from ours and/or theirs: the pre-filter (the next
 // surface behind it, on the same map plane, in the set) then the double-precision re-cast.
 void check_hit(const Context& ctx, VisCompareLeaf& row, Vec3 eye, Vec3 dir, uint32_t x,
@@ -364,6 +395,11 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
       else
         row.unconfirmed.push_back(t);
     }
+    if (options.kernel_witnesses && !row.unconfirmed.empty()) {
+      row.kernel_rerun = true;
+      settle_with_kernel(ctx, row, options.kernel_witnesses(uint32_t(c), row.unconfirmed),
+                         in_theirs);
+    }
     if (options.samples > 0 && !region_corners.empty())
       sample_leaf(ctx, row, region, region_corners, in_ours, in_theirs, sample_rng);
   };
@@ -399,15 +435,20 @@ std::string vis_compare_json(const VisCompareResult& r) {
   using nlohmann::json;
   json rows = json::array();
   size_t ours = 0, theirs = 0, common = 0, confirmed = 0, unconfirmed = 0, coincident = 0,
-         lacks = 0, never = 0;
+         lacks = 0, never = 0, false_witness = 0, rerun = 0, by_kernel = 0;
   uint64_t rays = 0, our_misses = 0, their_misses = 0, their_never = 0, ambiguous = 0, no_hit = 0;
   json our_miss_leaves = json::array(), their_miss_leaves = json::array();
   for (const VisCompareLeaf& l : r.leaves) {
-    json w = json::array();
-    for (const VisWitness& v : l.confirmed)
-      w.push_back({{"triangle", v.tri},
-                   {"eye", {v.eye.x, v.eye.y, v.eye.z}},
-                   {"direction", {v.dir.x, v.dir.y, v.dir.z}}});
+    auto witnesses = [](const std::vector<VisWitness>& ws) {
+      json w = json::array();
+      for (const VisWitness& v : ws)
+        w.push_back({{"triangle", v.tri},
+                     {"eye", {v.eye.x, v.eye.y, v.eye.z}},
+                     {"direction", {v.dir.x, v.dir.y, v.dir.z}},
+                     {"source", v.from_kernel ? "kernel" : "rays"}});
+      return w;
+    };
+    const json w = witnesses(l.confirmed);
     const double t = l.tightness();
     rows.push_back({{"cell", l.cell},
                     {"leaf", l.leaf},
@@ -421,6 +462,8 @@ std::string vis_compare_json(const VisCompareResult& r) {
                     {"extras_confirmed", w},
                     {"extras_unconfirmed", l.unconfirmed},
                     {"extras_coincident", l.coincident},
+                    {"extras_false_witness", witnesses(l.false_witnesses)},
+                    {"kernel_rerun", l.kernel_rerun},
                     {"ours_lacks", l.lacks},
                     {"sampled_rays", l.rays},
                     {"no_hit", l.no_hit},
@@ -433,6 +476,8 @@ std::string vis_compare_json(const VisCompareResult& r) {
     ours += l.ours, theirs += l.theirs, common += l.common, never += l.never_drawn;
     confirmed += l.confirmed.size(), unconfirmed += l.unconfirmed.size();
     coincident += l.coincident.size(), lacks += l.lacks.size();
+    false_witness += l.false_witnesses.size(), rerun += l.kernel_rerun;
+    for (const VisWitness& v : l.confirmed) by_kernel += v.from_kernel;
     rays += l.rays, our_misses += l.our_misses, their_misses += l.their_misses;
     their_never += l.their_never_drawn, ambiguous += l.ambiguous, no_hit += l.no_hit;
     if (l.our_misses) our_miss_leaves.push_back(l.leaf);
@@ -452,6 +497,9 @@ std::string vis_compare_json(const VisCompareResult& r) {
               {"extras_confirmed", confirmed},
               {"extras_unconfirmed", unconfirmed},
               {"extras_coincident", coincident},
+              {"extras_false_witness", false_witness},
+              {"extras_confirmed_by_kernel", by_kernel},
+              {"kernel_rerun_leaves", rerun},
               {"ours_lacks", lacks},
               {"never_drawn", never},
               {"sampled_rays", rays},

@@ -13,6 +13,15 @@
 // "coincident": no error of either side. The rest are "unconfirmed" (no witness found: ours
 // possibly wrong).
 //
+// Kernel witnesses: the ray search samples eyes and aim points, and can miss a triangle seen only
+// through a narrow gap. When options.kernel_witnesses is set, the extras a cell leaves unconfirmed
+// are handed to it, which re-runs the cell's from-segment runs as the bake made them and returns
+// the kernel's own witness rays (an eye on a segment, the witness pixel's direction). Each is
+// re-cast under the seeing rule below: seen, with no triangle of theirs at its depth, it is
+// confirmed (source "kernel"); seen with one, coincident; not seen, a **false witness**: the
+// kernel called the triangle visible where the double-precision reference does not, an error of
+// ours. An extra the re-run does not see at all stays unconfirmed.
+//
 // The seeing rule (both the witness and the sampling): along a ray, triangle T is seen when the
 // ray crosses T at lambda > z_near, farther than kReferenceBarycentric inside its edges, and no
 // opaque triangle is crossed (its edges widened by kReferenceBarycentric) in front of T by more
@@ -41,6 +50,13 @@
 
 namespace vislib {
 
+// A witness of an extra: the eye, the direction of the ray from it, the triangle seen.
+struct VisWitness {
+  uint32_t tri = 0;
+  Vec3 eye, dir;             // scene coordinates
+  bool from_kernel = false;  // a kernel witness (file comment), not one of the ray search
+};
+
 struct VisCompareOptions {
   int witness_eyes = 16;    // eyes tried per extra (the region's corners first, then random); >= 1
   int witness_targets = 8;  // points of the extra aimed at from each eye (centroid first); >= 1
@@ -49,12 +65,12 @@ struct VisCompareOptions {
   double z_near = kDefaultNear;  // near distance of every ray (scene units); > 0
   double eps_z = kDefaultEpsZ;   // depth tie tolerance, relative (the bake's)
   uint64_t seed = 1;             // eyes of the witness search and of the sampling
-};
-
-// A witness of an extra: the eye, the direction of the ray from it, the triangle seen.
-struct VisWitness {
-  uint32_t tri = 0;
-  Vec3 eye, dir;  // scene coordinates
+  // Kernel witnesses (file comment): called with a cell and its extras left unconfirmed by the ray
+  // search (sorted), from a worker thread (several cells at once), returns witness rays (scene
+  // coordinates, unit directions, from_kernel set) for those the cell's runs see. Empty: no
+  // re-run.
+  std::function<std::vector<VisWitness>(uint32_t cell, const std::vector<uint32_t>& extras)>
+      kernel_witnesses;
 };
 
 struct VisCompareLeaf {
@@ -67,7 +83,10 @@ struct VisCompareLeaf {
   std::vector<uint32_t> coincident;  // extras seen only where theirs has a face at the same depth
                                      // (a coincident twin they draw), increasing
   std::vector<uint32_t> lacks;       // theirs \ ours, increasing
-  double inset = 0;                  // of the view region (Quake units)
+  // Kernel witnesses that the re-cast does not see (our errors), increasing id.
+  std::vector<VisWitness> false_witnesses;
+  bool kernel_rerun = false;  // the cell's runs were re-run for kernel witnesses
+  double inset = 0;           // of the view region (Quake units)
   // Sampling.
   uint64_t rays = 0, no_hit = 0, ambiguous = 0;
   uint64_t our_misses = 0, their_misses = 0;  // rays (pixels)
