@@ -326,8 +326,11 @@ class StaticKind {
 
   Scratch make_scratch(int ts) const {
     const size_t n = size_t(ts) * size_t(ts);
-    return Scratch{std::vector<PieceList>(n), std::vector<double>(n),
-                   std::vector<std::vector<TieRecord>>(n)};
+    Scratch s;
+    s.lists.resize(n);
+    s.far.resize(n);
+    s.ties.resize(n);
+    return s;
   }
 
   // The pixel rectangle of the footprint (footprint_bounds: the hull's rectangle without the
