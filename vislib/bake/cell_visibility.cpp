@@ -44,7 +44,15 @@ std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell) 
 
 namespace {
 
-// The union of segments_visibility over `groups`, group g seeded Rng::derive(cell_seed, g).
+// The options of group g of a cell's segment groups: its runs seeded Rng::derive(cell_seed, g),
+// so that a re-run of one group (cell_witness_rays) makes the bake's own runs.
+RegionOptions group_options(const RegionOptions& options, uint64_t cell_seed, size_t g) {
+  RegionOptions o = options;
+  o.seed = Rng::derive(cell_seed, uint64_t(g));
+  return o;
+}
+
+// The union of segments_visibility over `groups`, each with group_options.
 CellVisibility groups_visibility(const Scene& scene,
                                  const std::vector<std::vector<Segment>>& groups, uint32_t cell,
                                  const RegionOptions& options,
@@ -55,8 +63,7 @@ CellVisibility groups_visibility(const Scene& scene,
   const int count = int(groups.size());
   const uint64_t seed = cell_seed(options.seed, cell);
   for (int r = 0; r < count; ++r) {
-    RegionOptions o = options;
-    o.seed = Rng::derive(seed, uint64_t(r));
+    const RegionOptions o = group_options(options, seed, size_t(r));
     std::function<void(size_t, size_t)> run_done;
     if (progress)
       run_done = [&](size_t done, size_t total) {
@@ -115,8 +122,7 @@ std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCell
   std::vector<uint8_t> found(wanted.size(), 0);
   size_t left = wanted.size(), first_segment = 0;
   for (size_t r = 0; r < groups.size() && left > 0; ++r) {
-    RegionOptions o = options;
-    o.seed = Rng::derive(seed, uint64_t(r));
+    RegionOptions o = group_options(options, seed, r);
     o.segment.want_witnesses = true;
     const RegionResult rr = segments_visibility(scene, groups[r], o);
     for (size_t i = 0; i < rr.visible.size(); ++i) {
