@@ -145,6 +145,7 @@ bool g_no_bvh = false;  // --no-bvh: SegmentOptions::bvh stays null (every trian
 int g_time_res = 512;   // N of the timed rows (--res N with the timing mode: the grass case at
                         // N = 512 takes minutes; its rows at a smaller N say nothing about ratios)
 const TriangleBvh* g_bvh = nullptr;  // the case's tree (static cases, unless --no-bvh)
+const EdgeLines* g_lines = nullptr;  // the case's runs of collinear edges (static cases)
 
 SegmentOptions options(int n) {
   SegmentOptions o;
@@ -153,6 +154,7 @@ SegmentOptions options(int n) {
   if (g_tile > 0) o.tile_size = g_tile;
   if (g_first) o.coplanar = CoplanarRule::First;
   o.bvh = g_bvh;
+  o.edge_lines = g_lines;
   return o;
 }
 
@@ -338,6 +340,16 @@ int main(int argc, char** argv) {
     // the kernel's column).
     TriangleBvh tree;
     g_bvh = nullptr;
+    EdgeLines lines;
+    g_lines = nullptr;
+    if (bvh_applies(scene)) {
+      double cpu = 0;
+      const double wall = seconds_of([&] { lines = build_edge_lines(scene); }, &cpu);
+      g_lines = &lines;
+      if (digest_file.empty())
+        std::printf("# %s: edge lines built in %.3f s (%.3f CPU s), %zu edges on %zu lines\n",
+                    c.name.c_str(), wall, cpu, lines.edge_count(), lines.lines.size());
+    }
     if (!g_no_bvh && bvh_applies(scene)) {
       double cpu = 0;
       const double wall = seconds_of([&] { tree = build_triangle_bvh(scene); }, &cpu);

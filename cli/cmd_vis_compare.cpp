@@ -144,6 +144,7 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   vislib::ViewCells cells;
   vislib::RegionOptions ro;
   vislib::TriangleBvh bvh;
+  vislib::EdgeLines lines;
   // What the re-run needs from the metadata; the first key missing, if any.
   std::string missing;
   const nlohmann::json spacing = md.is_discarded() ? nullptr : find_key(md, "face_spacing");
@@ -183,6 +184,8 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
     }
     bvh = vislib::build_triangle_bvh(scene);
     ro.segment.bvh = &bvh;
+    lines = vislib::build_edge_lines(scene);
+    ro.segment.edge_lines = &lines;
     opt.kernel_witnesses = [&](uint32_t cell, const std::vector<uint32_t>& extras) {
       std::vector<vislib::VisWitness> out;
       for (const vislib::CellWitnessRay& w :
@@ -227,11 +230,12 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
               t["mean_tightness"].get<double>(), t["median_tightness"].get<double>());
   std::printf(
       "  extras                 %lu: confirmed %lu, unconfirmed (ours wrong?) %lu, coincident "
-      "with a face of theirs %lu, false witnesses (ours wrong) %lu\n",
+      "with a face of theirs %lu, seen at a tie %lu, false witnesses (ours wrong) %lu\n",
       (unsigned long)(num("extras_confirmed") + num("extras_unconfirmed") +
-                      num("extras_coincident") + num("extras_false_witness")),
+                      num("extras_coincident") + num("extras_tie") + num("extras_false_witness")),
       (unsigned long)num("extras_confirmed"), (unsigned long)num("extras_unconfirmed"),
-      (unsigned long)num("extras_coincident"), (unsigned long)num("extras_false_witness"));
+      (unsigned long)num("extras_coincident"), (unsigned long)num("extras_tie"),
+      (unsigned long)num("extras_false_witness"));
   if (rerun)
     std::printf("  kernel witnesses       %lu leaves re-run: %lu extras confirmed by them\n",
                 (unsigned long)num("kernel_rerun_leaves"),
@@ -255,14 +259,14 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
               (unsigned long)num("their_never_drawn"));
   std::printf("  leaves with our misses   %s\n", leaves_of("our_miss_leaves").c_str());
   std::printf("  leaves with their misses %s\n", leaves_of("their_miss_leaves").c_str());
-  std::printf("\n  %6s %6s %7s %7s %9s %9s %11s %6s %6s %9s %9s\n", "cell", "leaf", "ours",
-              "theirs", "tightness", "confirmed", "unconfirmed", "false", "lacks", "our-miss",
-              "their-miss");
+  std::printf("\n  %6s %6s %7s %7s %9s %9s %11s %4s %6s %6s %9s %9s\n", "cell", "leaf", "ours",
+              "theirs", "tightness", "confirmed", "unconfirmed", "tie", "false", "lacks",
+              "our-miss", "their-miss");
   for (const auto& l : r.leaves)
-    std::printf("  %6u %6u %7zu %7zu %9.4f %9zu %11zu %6zu %6zu %9lu %9lu\n", l.cell, l.leaf,
+    std::printf("  %6u %6u %7zu %7zu %9.4f %9zu %11zu %4zu %6zu %6zu %9lu %9lu\n", l.cell, l.leaf,
                 l.ours, l.theirs, l.tightness(), l.confirmed.size(), l.unconfirmed.size(),
-                l.false_witnesses.size(), l.lacks.size(), (unsigned long)l.our_misses,
-                (unsigned long)l.their_misses);
+                l.tie_witnesses.size(), l.false_witnesses.size(), l.lacks.size(),
+                (unsigned long)l.our_misses, (unsigned long)l.their_misses);
 }
 
 const Registration reg("vis-compare", [](CLI::App& app) {

@@ -80,6 +80,15 @@ double maybe_build_bvh(const VisibilityArgs& a, bool auto_on, const vislib::Scen
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+double build_edge_lines(const vislib::Scene& scene, vislib::EdgeLines& lines,
+                        vislib::SegmentOptions& so) {
+  if (!vislib::bvh_applies(scene)) return 0.0;
+  const auto t0 = std::chrono::steady_clock::now();
+  lines = vislib::build_edge_lines(scene, so.state);
+  so.edge_lines = &lines;
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 vislib::SegmentOptions segment_options(const VisibilityArgs& a) {
   vislib::SegmentOptions o;
   o.resolution = a.resolution;

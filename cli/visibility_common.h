@@ -40,6 +40,12 @@ struct VisibilityArgs {
 double maybe_build_bvh(const VisibilityArgs& a, bool auto_on, const vislib::Scene& scene,
                        vislib::TriangleBvh& tree, vislib::SegmentOptions& so);
 
+// Builds the runs of collinear edges (SegmentOptions::edge_lines) into `lines` for a static scene
+// without spheres and sets so.edge_lines; returns the build's wall seconds (0 when none was
+// built: the kernel then builds none either, or its own for a moving scene's static kernel).
+double build_edge_lines(const vislib::Scene& scene, vislib::EdgeLines& lines,
+                        vislib::SegmentOptions& so);
+
 void add_common(CLI::App* cmd, VisibilityArgs& a);
 vislib::SegmentOptions segment_options(const VisibilityArgs& a);
 double peak_rss_bytes();  // of this process, bytes

@@ -157,7 +157,7 @@ const TriangleBvh* bake_bvh(const Scene& scene, const BakeSettings& requested, T
 // `requested` with --long-segments auto (0) resolved.
 BakeSettings resolved_settings(const Scene& scene, const ViewCells& cells,
                                const BakeSettings& requested, const TriangleBvh* bvh,
-                               BakeReport& report) {
+                               const EdgeLines* lines, BakeReport& report) {
   // --long-segments auto: L from a pilot over every cell of the layout (not only this shard's),
   // so that every shard and every resumed run chooses the same L (long_segments.h).
   BakeSettings settings = requested;
@@ -170,6 +170,7 @@ BakeSettings resolved_settings(const Scene& scene, const ViewCells& cells,
     if (long_segments_apply(scene, settings)) {
       SegmentOptions run0 = settings.region.segment;
       run0.bvh = bvh;
+      run0.edge_lines = lines;
       report.long_segment_choice = choose_long_segments(scene, all_edges(cells), run0);
       settings.long_segments = report.long_segment_choice.parts;
     }
@@ -406,10 +407,17 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   TriangleBvh tree;
   double w0 = wall_now(), c0 = process_cpu_seconds();
   const TriangleBvh* bvh = bake_bvh(scene, requested, tree, report);
+  // The runs of collinear edges, once for every static run (the kernel would build them per run).
+  EdgeLines own_lines;
+  const EdgeLines* lines = requested.region.segment.edge_lines;
+  if (!lines && bvh_applies(scene)) {
+    own_lines = build_edge_lines(scene, requested.region.segment.state);
+    lines = &own_lines;
+  }
   report.times.phases.bvh = {wall_now() - w0, process_cpu_seconds() - c0};
   w0 = wall_now();
   c0 = process_cpu_seconds();
-  const BakeSettings settings = resolved_settings(scene, cells, requested, bvh, report);
+  const BakeSettings settings = resolved_settings(scene, cells, requested, bvh, lines, report);
   report.times.phases.pilot = {wall_now() - w0, process_cpu_seconds() - c0};
   pvs::FileInfo info = bake_file_info(scene, cells, settings);
   info.partial = shard.count > 1;
@@ -437,6 +445,7 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
     plan_shared_runs(scene, settings, cells, info, shard, recovered, shared_runs, report);
   }
   run_settings.region.segment.bvh = bvh;
+  run_settings.region.segment.edge_lines = lines;
   std::atomic<uint64_t> runs_done{0};
 
   stream_cells(scene, cells, info, shard, run_settings, settings.region.runs, recovered,

@@ -95,6 +95,20 @@ double seen_depth(const Context& ctx, const std::vector<RayCrossing>& cr, uint32
   return t->lambda;
 }
 
+// The tie class of vis_compare.h: `tri` is crossed beyond z_near but not farther than
+// kReferenceBarycentric inside its edges (so seen_depth refused it), and no opaque crossing lies
+// in front of it by more than eps_z: only the kernel's tie rules decide such a ray.
+bool seen_at_tie(const Context& ctx, const std::vector<RayCrossing>& cr, uint32_t tri) {
+  const RayCrossing* t = crossing_of(cr, tri);
+  if (!t || t->lambda <= ctx.opt.z_near + kReferenceNear) return false;
+  const double front = t->lambda * (1.0 - ctx.opt.eps_z);
+  for (const RayCrossing& c : cr)
+    if (c.tri != tri && !ctx.scene.triangle_see_through(c.tri) &&
+        c.lambda > ctx.opt.z_near - kReferenceNear && c.lambda < front)
+      return false;
+  return true;
+}
+
 // Whether a triangle with in_set != 0 is crossed within eps_z of depth `lambda`.
 bool set_at_depth(const Context& ctx, const std::vector<RayCrossing>& cr, double lambda,
                   const std::vector<uint8_t>& in_set) {
@@ -157,8 +171,8 @@ Search find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& e
   return coincident ? Search::coincident : Search::none;
 }
 
-// Re-casts the kernel witnesses `kw` of some of row.unconfirmed: confirmed, coincident or false
-// witnesses (vis_compare.h); the extras without one stay unconfirmed. Keeps every list sorted.
+// Re-casts the kernel witnesses `kw` of some of row.unconfirmed: confirmed, coincident, tie or
+// false witnesses (vis_compare.h); the extras without one stay unconfirmed. Keeps every list sorted.
 void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<VisWitness> kw,
                         const std::vector<uint8_t>& in_theirs) {
   std::sort(kw.begin(), kw.end(),
@@ -175,7 +189,9 @@ void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<Vis
     w.from_kernel = true;
     const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, w.eye, w.dir);
     const double lambda = seen_depth(ctx, cr, t);
-    if (lambda < 0)
+    if (lambda < 0 && seen_at_tie(ctx, cr, t))
+      row.tie_witnesses.push_back(w);
+    else if (lambda < 0)
       row.false_witnesses.push_back(w);
     else if (set_at_depth(ctx, cr, lambda, in_theirs))
       row.coincident.push_back(t);
@@ -435,7 +451,7 @@ std::string vis_compare_json(const VisCompareResult& r) {
   using nlohmann::json;
   json rows = json::array();
   size_t ours = 0, theirs = 0, common = 0, confirmed = 0, unconfirmed = 0, coincident = 0,
-         lacks = 0, never = 0, false_witness = 0, rerun = 0, by_kernel = 0;
+         lacks = 0, never = 0, false_witness = 0, tie = 0, rerun = 0, by_kernel = 0;
   uint64_t rays = 0, our_misses = 0, their_misses = 0, their_never = 0, ambiguous = 0, no_hit = 0;
   json our_miss_leaves = json::array(), their_miss_leaves = json::array();
   for (const VisCompareLeaf& l : r.leaves) {
@@ -463,6 +479,7 @@ std::string vis_compare_json(const VisCompareResult& r) {
                     {"extras_unconfirmed", l.unconfirmed},
                     {"extras_coincident", l.coincident},
                     {"extras_false_witness", witnesses(l.false_witnesses)},
+                    {"extras_tie", witnesses(l.tie_witnesses)},
                     {"kernel_rerun", l.kernel_rerun},
                     {"ours_lacks", l.lacks},
                     {"sampled_rays", l.rays},
@@ -477,6 +494,7 @@ std::string vis_compare_json(const VisCompareResult& r) {
     confirmed += l.confirmed.size(), unconfirmed += l.unconfirmed.size();
     coincident += l.coincident.size(), lacks += l.lacks.size();
     false_witness += l.false_witnesses.size(), rerun += l.kernel_rerun;
+    tie += l.tie_witnesses.size();
     for (const VisWitness& v : l.confirmed) by_kernel += v.from_kernel;
     rays += l.rays, our_misses += l.our_misses, their_misses += l.their_misses;
     their_never += l.their_never_drawn, ambiguous += l.ambiguous, no_hit += l.no_hit;
@@ -498,6 +516,7 @@ std::string vis_compare_json(const VisCompareResult& r) {
               {"extras_unconfirmed", unconfirmed},
               {"extras_coincident", coincident},
               {"extras_false_witness", false_witness},
+              {"extras_tie", tie},
               {"extras_confirmed_by_kernel", by_kernel},
               {"kernel_rerun_leaves", rerun},
               {"ours_lacks", lacks},

@@ -18,8 +18,13 @@
 // are handed to it, which re-runs the cell's from-segment runs as the bake made them and returns
 // the kernel's own witness rays (an eye on a segment, the witness pixel's direction). Each is
 // re-cast under the seeing rule below: seen, with no triangle of theirs at its depth, it is
-// confirmed (source "kernel"); seen with one, coincident; not seen, a **false witness**: the
-// kernel called the triangle visible where the double-precision reference does not, an error of
+// confirmed (source "kernel"); seen with one, coincident. Not seen, but crossed within
+// kReferenceBarycentric of its edges with nothing opaque in front of it by more than eps_z, it is
+// a **tie**: the pixel ray runs through the triangle's edge (typically a corner where it meets
+// the surface in front at the same depth), where the re-cast cannot decide and the kernel's tie
+// rules do (docs/visibility-math.md §2.5 on-edge ties, §7 depth ties: both surfaces visible);
+// neither an error of ours nor a miss of theirs. Otherwise a **false witness**: the kernel called
+// the triangle visible where the double-precision reference sees it hidden or missed, an error of
 // ours. An extra the re-run does not see at all stays unconfirmed.
 //
 // The seeing rule (both the witness and the sampling): along a ray, triangle T is seen when the
@@ -85,6 +90,8 @@ struct VisCompareLeaf {
   std::vector<uint32_t> lacks;       // theirs \ ours, increasing
   // Kernel witnesses that the re-cast does not see (our errors), increasing id.
   std::vector<VisWitness> false_witnesses;
+  // Kernel witnesses seen only at a tie (file comment), increasing id.
+  std::vector<VisWitness> tie_witnesses;
   bool kernel_rerun = false;  // the cell's runs were re-run for kernel witnesses
   double inset = 0;           // of the view region (Quake units)
   // Sampling.

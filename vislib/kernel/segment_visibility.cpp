@@ -34,7 +34,8 @@
 
 namespace vislib {
 
-StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1) {
+StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1, const EdgeLines* lines,
+                                       uint32_t tri) {
   StaticTriangle st;
   const Vec3 delta = v1 - v0;
   Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (docs/visibility-math.md §6)
@@ -42,8 +43,13 @@ StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1) {
     int i = e, j = (e + 1) % 3;
     // Canonical orientation: P is the lexicographically smaller world endpoint (§2.5).
     bool forward = !lex_less(c[j], c[i]);
-    const Vec3& P = forward ? r[i] : r[j];
-    const Vec3& Q = forward ? r[j] : r[i];
+    Vec3 P = forward ? r[i] : r[j];
+    Vec3 Q = forward ? r[j] : r[i];
+    Vec3 LP, LQ;  // a T-junction's edges: their run's line, the same for all (§2.5)
+    if (lines && lines->line_of(tri, e, LP, LQ)) {
+      P = LP - v0;
+      Q = LQ - v0;
+    }
     Vec3 E = Q - P;
     st.KA[e] = cross(E, delta);
     st.KB[e] = cross(E, -P);
@@ -305,6 +311,12 @@ class StaticKind {
 #endif
     // The faces each triangle can reach; with a BVH, only the triangles its
     // walk reaches get bounds, so nothing is classified up front.
+    if (opt.edge_lines) {
+      lines_ = opt.edge_lines;
+    } else {
+      own_lines_ = build_edge_lines(scene, opt.state);
+      lines_ = &own_lines_;
+    }
     if (!opt.bvh)
       faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
     has_see_through_ = scene.has_see_through();
@@ -460,7 +472,7 @@ class StaticKind {
               const FaceAxes& axes) const {
     auto c = scene_.corners(item.id, opt_.state);
     Vec3 corners[3] = {c[0], c[1], c[2]};
-    b.st = prepare_static_triangle(corners, v0_, v1_);
+    b.st = prepare_static_triangle(corners, v0_, v1_, lines_, item.id);
     if (b.st.n == Vec3{0, 0, 0}) return false;  // degenerate: never covers (H5)
     b.y0 = std::max(rect.y0, box[2]);
     b.y1 = std::min(rect.y1, box[3]);
@@ -578,6 +590,8 @@ class StaticKind {
   Vec3 v0_, v1_;
   const SegmentOptions& opt_;
   std::vector<PieceList>* pieces_;
+  EdgeLines own_lines_;  // built for this call when the caller passes none
+  const EdgeLines* lines_ = nullptr;
   std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
   bool keep_ties_ = false;
   bool has_see_through_ = false;
@@ -613,6 +627,9 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
   if (opt.bvh && !opt.bvh->matches(scene, opt.state))
     throw std::invalid_argument(
         "the BVH given to segment_visibility was built for another scene or key state");
+  if (opt.edge_lines && !opt.edge_lines->matches(scene, opt.state))
+    throw std::invalid_argument(
+        "the edge lines given to segment_visibility were built for another scene or key state");
   auto start = std::chrono::steady_clock::now();
   const int N = opt.resolution;
   const int tiles_x = (N + opt.tile_size - 1) / opt.tile_size;

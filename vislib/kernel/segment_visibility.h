@@ -20,6 +20,7 @@
 
 #include "vislib/base/cubemap.h"
 #include "vislib/base/tolerances.h"
+#include "vislib/kernel/edge_lines.h"
 #include "vislib/kernel/general_depth.h"
 #include "vislib/kernel/interval_list.h"
 #include "vislib/kernel/triangle_bvh.h"
@@ -80,6 +81,11 @@ struct SegmentOptions {
   // bounds on every face. Null: no tree. The results are the same either way;
   // a tree built for another scene or state is refused (std::invalid_argument).
   const TriangleBvh* bvh = nullptr;
+  // Static scenes: the runs of collinear edges (build_edge_lines), so that T-junctions do not leak
+  // (edge_lines.h). Null: the kernel builds them for the call (the same results; callers running
+  // many segments on one scene build them once). Built for another scene or state: refused
+  // (std::invalid_argument).
+  const EdgeLines* edge_lines = nullptr;
 };
 
 constexpr size_t kMaxSplitParts = 8;

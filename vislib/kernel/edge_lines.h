@@ -1,0 +1,65 @@
+// edge_lines.h: one line per run of collinear edges, so that the edges of a T-junction compute
+// their coverage from the same two points (docs/visibility-math.md §2.5, "T-junctions").
+//
+// The static kernel decides which side of an edge a pixel ray passes from the edge's line alone
+// (the triangle is the intersection of three wedges; where an edge ends is its neighbours'
+// business). Two triangles sharing an edge compute bit-identical coefficients from the same two
+// points, so their coverage meets without crack. Two triangles whose edges lie on one line but end
+// at different points (a T-junction: a vertex of one on the edge of another, as map compilers and
+// CSG leave everywhere) compute them from different points, and where the exact value is zero
+// (the ray on that line over a stretch of the segment) rounding gives the two edges independent
+// signs: the ray leaks through a crack of zero width over a stretch of positive length, and
+// whatever lies behind is reported visible. Computing every edge of such a run from the run's two
+// extreme points makes the coefficients bit-identical again.
+//
+// A run: edges joined, through shared endpoints (equal positions), with edges collinear with them
+// (the cross product of their directions from the shared point is zero in double, with
+// -ffp-contract=off: exactly collinear inputs, and inputs within rounding of it). Collinear edges
+// that touch nowhere are not joined; nor are moving triangles (the dynamic kernel).
+//
+// Build it once per scene and key state and pass it in SegmentOptions::edge_lines to every run (a
+// bake does; `pvs segment` builds one for its run); without it the kernel builds one per call, so
+// the results never depend on whether it was passed.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "vislib/base/vec.h"
+#include "vislib/scene/scene.h"
+
+namespace vislib {
+
+struct EdgeLines {
+  // Per triangle, bit e (edge e from corner e to corner (e+1) % 3) when that edge takes its line
+  // from `lines`; empty when no edge of the scene does.
+  std::vector<uint8_t> mask;
+  // The edges that do, as 3 * triangle + e, ascending, each with its run's line: the run's two
+  // extreme points in lexicographic order (lex_less), P < Q.
+  std::vector<uint64_t> keys;
+  std::vector<uint32_t> line_index;        // per key, its line in `lines`
+  std::vector<std::array<Vec3, 2>> lines;  // one per run
+  size_t state = 0;           // the key state whose positions it was built from
+  size_t triangle_count = 0;  // of the scene it was built for
+  const Scene* scene = nullptr;
+
+  // True when it was built for `scene` in key state `state` (the kernel checks it and throws
+  // std::invalid_argument otherwise).
+  bool matches(const Scene& s, size_t st) const {
+    return scene == &s && state == st && triangle_count == s.triangle_count();
+  }
+  // The line of edge e of triangle `tri` when it has one (P < Q), else false.
+  bool line_of(uint32_t tri, int e, Vec3& P, Vec3& Q) const;
+  // Number of edges that take a run's line (all of them belong to runs of >= 2 distinct edges).
+  size_t edge_count() const { return keys.size(); }
+};
+
+// Deterministic; O(V log V + E + sum over vertices of (incident edges)^2, capped per vertex at
+// kEdgeLinesPairCap incident edges, beyond which only edges adjacent in direction order are
+// compared).
+constexpr size_t kEdgeLinesPairCap = 64;
+EdgeLines build_edge_lines(const Scene& scene, size_t state = 0);
+
+}  // namespace vislib
