@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <mutex>
 #include <stdexcept>
 
 #include "cli/commands.h"
@@ -145,6 +146,7 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   vislib::RegionOptions ro;
   vislib::TriangleBvh bvh;
   vislib::EdgeLines lines;
+  std::once_flag scene_built;
   // What the re-run needs from the metadata; the first key missing, if any.
   std::string missing;
   const nlohmann::json spacing = md.is_discarded() ? nullptr : find_key(md, "face_spacing");
@@ -182,11 +184,14 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
       throw vislib::InputError(a.pvs,
                                std::string("its cells are not the map's leaf cells: ") + e.what());
     }
-    bvh = vislib::build_triangle_bvh(scene);
-    ro.segment.bvh = &bvh;
-    lines = vislib::build_edge_lines(scene);
-    ro.segment.edge_lines = &lines;
     opt.kernel_witnesses = [&](uint32_t cell, const std::vector<uint32_t>& extras) {
+      // The tree and the edge lines the bake's runs used, built once the first leaf needs them.
+      std::call_once(scene_built, [&] {
+        bvh = vislib::build_triangle_bvh(scene);
+        ro.segment.bvh = &bvh;
+        lines = vislib::build_edge_lines(scene);
+        ro.segment.edge_lines = &lines;
+      });
       std::vector<vislib::VisWitness> out;
       for (const vislib::CellWitnessRay& w :
            vislib::cell_witness_rays(scene, cells, cell, ro, extras))

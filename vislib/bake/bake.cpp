@@ -282,7 +282,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
     return p;
   };
   if (progress) progress(state());
-  std::atomic<double> t_cells{0}, t_cells_cpu{0}, t_progress{0}, t_checkpoint{0}, t_writing{0};
+  std::atomic<double> t_cells{0}, t_cells_cpu{0};
   const double cpu_start = process_cpu_seconds();
   const size_t tokens = 4 * size_t(std::max(1, report.threads));
   uint32_t next = 0;
@@ -313,13 +313,11 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                   if (progress)
                     in_cell = [&, c](double fraction) {
                       PhaseScope reporting(Phase::Progress, &phases);
-                      const double w0 = wall_now();
                       std::lock_guard<std::mutex> guard(progress_mutex);
                       running += fraction - partial[c];
                       work_running += (fraction - partial[c]) * work[c];
                       partial[c] = fraction;
                       progress(state());
-                      add_to(&t_progress, wall_now() - w0);
                     };
                   const bool outer = g_cell_depth++ == 0;
                   const double nested_before = g_nested_cpu;
@@ -347,9 +345,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                   runs_done += cell_runs(cells, c, runs);
                   {
                     PhaseScope appending(Phase::Checkpoint, &phases);
-                    const double k0 = wall_now();
                     if (checkpoint) checkpoint->append(c, ids);
-                    add_to(&t_checkpoint, wall_now() - k0);
                   }
                   *set = std::move(ids);
                   report.cell_seconds[c] = seconds;
@@ -367,9 +363,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
             tbb::make_filter<std::shared_ptr<pvs::CellSet>, void>(
                 tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<pvs::CellSet>& set) {
                   PhaseScope encoding(Phase::Encode, &phases);
-                  const double w0 = wall_now();
                   with_memory_stage("writing " + files.output, [&] { writer.add(*set); });
-                  add_to(&t_writing, wall_now() - w0);
                 }));
   } catch (...) {
     // A bake that recorded nothing leaves no checkpoint behind.
@@ -378,9 +372,6 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
   }
   report.times.cells = t_cells;
   report.times.cells_cpu = t_cells_cpu;
-  report.times.progress = t_progress;
-  report.times.checkpoint = t_checkpoint;
-  report.times.writing = t_writing;
   {
     PhaseScope encoding(Phase::Encode, &phases);
     report.stats = writer.finish();

@@ -146,10 +146,7 @@ struct BakeTimes {
   // or a whole cell of another; a cell run inside another on the same thread is counted once.
   double cells = 0, cells_cpu = 0;
   double shared_wait = 0;  // of `cells`: in shared runs another cell was computing (wall)
-  double progress = 0;     // of `cells`: waiting for the progress lock and reporting (wall)
-  double checkpoint = 0;   // appending finished cells to the checkpoint (wall)
-  double writing = 0;      // in the writer stage, one cell at a time in cell order (wall)
-  BakePhases phases;       // the same time, phase by phase
+  BakePhases phases;       // the same time, phase by phase (progress, checkpoint, writing: there)
 };
 
 struct BakeReport {
