@@ -10,7 +10,7 @@ namespace vislib {
 
 bool EdgeLines::line_of(uint32_t tri, int e, Vec3& P, Vec3& Q) const {
   if (mask.empty() || !(mask[tri] >> e & 1)) return false;
-  const uint64_t k = uint64_t(tri) * 3 + uint64_t(e);
+  const uint32_t k = tri * 3 + uint32_t(e);
   const size_t i = size_t(std::lower_bound(keys.begin(), keys.end(), k) - keys.begin());
   const std::array<Vec3, 2>& l = lines[line_index[i]];
   P = l[0];
@@ -128,6 +128,8 @@ EdgeLines build_edge_lines(const Scene& scene, size_t state) {
       if (collinear(away(around[i - 1].second), away(around[i].second)))
         sets.unite(around[i - 1].second, around[i].second);
   }
+  std::vector<uint32_t>().swap(incident);  // freed before the runs' summaries
+  std::vector<uint32_t>().swap(start);
 
   // Per run: its extreme points, and whether it holds two distinct edges (a run of one edge, or of
   // copies of one shared edge, computes its coefficients from its own points already).

@@ -38,7 +38,7 @@ struct EdgeLines {
   std::vector<uint8_t> mask;
   // The edges that do, as 3 * triangle + e, ascending, each with its run's line: the run's two
   // extreme points in lexicographic order (lex_less), P < Q.
-  std::vector<uint64_t> keys;
+  std::vector<uint32_t> keys;
   std::vector<uint32_t> line_index;        // per key, its line in `lines`
   std::vector<std::array<Vec3, 2>> lines;  // one per run
   size_t state = 0;           // the key state whose positions it was built from
