@@ -3,8 +3,8 @@
 // files belong together, prints.
 #include <cmath>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 #include <mutex>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 
 #include "cli/commands.h"

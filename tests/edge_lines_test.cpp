@@ -1,5 +1,7 @@
 // Runs of collinear edges (vislib/kernel/edge_lines.h) and the leak they close: a T-junction
 // across a corner, seen along its line.
+#include "vislib/kernel/edge_lines.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -8,7 +10,6 @@
 
 #include "tests/scene_builders.h"
 #include "vislib/base/random.h"
-#include "vislib/kernel/edge_lines.h"
 #include "vislib/kernel/segment_visibility.h"
 
 using namespace vislib;

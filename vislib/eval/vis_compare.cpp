@@ -172,7 +172,8 @@ Search find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& e
 }
 
 // Re-casts the kernel witnesses `kw` of some of row.unconfirmed: confirmed, coincident, tie or
-// false witnesses (vis_compare.h); the extras without one stay unconfirmed. Keeps every list sorted.
+// false witnesses (vis_compare.h); the extras without one stay unconfirmed. Keeps every list
+// sorted.
 void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<VisWitness> kw,
                         const std::vector<uint8_t>& in_theirs) {
   std::sort(kw.begin(), kw.end(),

@@ -41,8 +41,8 @@ struct EdgeLines {
   std::vector<uint32_t> keys;
   std::vector<uint32_t> line_index;        // per key, its line in `lines`
   std::vector<std::array<Vec3, 2>> lines;  // one per run
-  size_t state = 0;           // the key state whose positions it was built from
-  size_t triangle_count = 0;  // of the scene it was built for
+  size_t state = 0;                        // the key state whose positions it was built from
+  size_t triangle_count = 0;               // of the scene it was built for
   const Scene* scene = nullptr;
 
   // True when it was built for `scene` in key state `state` (the kernel checks it and throws
