@@ -191,6 +191,24 @@ void insert_sorted(std::vector<uint32_t>& v, uint32_t t) {
   v.insert(std::lower_bound(v.begin(), v.end(), t), t);
 }
 
+// The slit room whose upper leaf's set also holds floor triangles 0 and 1 (seen only through the
+// slit), with the ray search held to one eye and one aim point, so that both are left to the
+// kernel witnesses a test supplies.
+struct FloorExtras {
+  MapCase m;
+  std::vector<std::vector<uint32_t>> sets;
+  VisCompareOptions o;
+};
+FloorExtras floor_extras(const std::string& name) {
+  FloorExtras f{room(temp_dir(name), false, {}, false, true), {}, fast(0)};
+  f.sets = their_sets(f.m);
+  insert_sorted(f.sets[1], 0);
+  insert_sorted(f.sets[1], 1);
+  f.o.witness_eyes = 1;
+  f.o.witness_targets = 1;
+  return f;
+}
+
 }  // namespace
 
 TEST(VisCompare, TheMapsOwnSetsHaveTightnessOneNoExtrasAndNoMisses) {
@@ -303,13 +321,10 @@ TEST(VisCompare, AnExtraSeenOnlyThroughASlitIsConfirmedByTheKernelsWitness) {
 // A kernel witness that the reference does not see (here a ray aimed up, away from the extra) is
 // a false witness, reported with its ray; an extra the re-run does not see stays unconfirmed.
 TEST(VisCompare, AKernelWitnessTheReferenceDoesNotSeeIsAFalseWitness) {
-  MapCase m = room(temp_dir("vis_compare_false"), false, {}, false, true);
-  auto sets = their_sets(m);
-  insert_sorted(sets[1], 0);
-  insert_sorted(sets[1], 1);
-  VisCompareOptions o = fast(0);
-  o.witness_eyes = 1;
-  o.witness_targets = 1;
+  FloorExtras f = floor_extras("vis_compare_false");
+  MapCase& m = f.m;
+  auto& sets = f.sets;
+  VisCompareOptions& o = f.o;
   o.kernel_witnesses = [&](uint32_t, const std::vector<uint32_t>& extras) {
     EXPECT_EQ(extras, (std::vector<uint32_t>{0, 1}));
     return std::vector<VisWitness>{
@@ -330,13 +345,10 @@ TEST(VisCompare, AKernelWitnessTheReferenceDoesNotSeeIsAFalseWitness) {
 // the slit to where the floor meets the wall x = 0, at the wall's depth), is decided by the
 // kernel's tie rules alone: a tie, neither confirmed nor a false witness.
 TEST(VisCompare, AKernelWitnessThroughTheExtrasEdgeAtAWallIsATieNotAFalseWitness) {
-  MapCase m = room(temp_dir("vis_compare_tie"), false, {}, false, true);
-  auto sets = their_sets(m);
-  insert_sorted(sets[1], 0);
-  insert_sorted(sets[1], 1);
-  VisCompareOptions o = fast(0);
-  o.witness_eyes = 1;
-  o.witness_targets = 1;
+  FloorExtras f = floor_extras("vis_compare_tie");
+  MapCase& m = f.m;
+  auto& sets = f.sets;
+  VisCompareOptions& o = f.o;
   const Vec3 eye = quake_to_scene({32, 42, 48});
   o.kernel_witnesses = [&](uint32_t, const std::vector<uint32_t>& extras) {
     EXPECT_EQ(extras, (std::vector<uint32_t>{0, 1}));
