@@ -46,7 +46,7 @@ TEST(EdgeLines, SharedEdgesAloneAndCollinearEdgesThatNeverTouchMakeNoRun) {
                   {Vec3{6, 0, 0}, {9, 0, 0}, {7, 2, 0}}});
   const EdgeLines el = build_edge_lines(s);
   EXPECT_EQ(el.edge_count(), 0u);
-  EXPECT_TRUE(el.mask.empty());
+  EXPECT_TRUE(el.edge_line.empty());
 }
 
 TEST(EdgeLines, KernelRefusesEdgeLinesOfAnotherScene) {

@@ -33,16 +33,15 @@
 namespace vislib {
 
 struct EdgeLines {
-  // Per triangle, bit e (edge e from corner e to corner (e+1) % 3) when that edge takes its line
-  // from `lines`; empty when no edge of the scene does.
-  std::vector<uint8_t> mask;
-  // The edges that do, as 3 * triangle + e, ascending, each with its run's line: the run's two
-  // extreme points in lexicographic order (lex_less), P < Q.
-  std::vector<uint32_t> keys;
-  std::vector<uint32_t> line_index;        // per key, its line in `lines`
-  std::vector<std::array<Vec3, 2>> lines;  // one per run
-  size_t state = 0;                        // the key state whose positions it was built from
-  size_t triangle_count = 0;               // of the scene it was built for
+  static constexpr uint32_t kNone = UINT32_MAX;
+  // Per edge 3 * triangle + e (edge e from corner e to corner (e+1) % 3), its run's line in
+  // `lines`, or kNone; empty when no edge of the scene belongs to a run (4 bytes an edge).
+  std::vector<uint32_t> edge_line;
+  // One per run of two or more distinct edges: its two extreme points in lexicographic order
+  // (lex_less), P < Q.
+  std::vector<std::array<Vec3, 2>> lines;
+  size_t state = 0;           // the key state whose positions it was built from
+  size_t triangle_count = 0;  // of the scene it was built for
   const Scene* scene = nullptr;
 
   // True when it was built for `scene` in key state `state` (the kernel checks it and throws
@@ -51,11 +50,20 @@ struct EdgeLines {
     return scene == &s && state == st && triangle_count == s.triangle_count();
   }
   // The line of edge e of triangle `tri` when it has one (P < Q), else false.
-  bool line_of(uint32_t tri, int e, Vec3& P, Vec3& Q) const;
-  // Number of edges that take a run's line (all of them belong to runs of >= 2 distinct edges).
-  size_t edge_count() const { return keys.size(); }
+  bool line_of(uint32_t tri, int e, Vec3& P, Vec3& Q) const {
+    if (edge_line.empty()) return false;
+    const uint32_t l = edge_line[size_t(tri) * 3 + size_t(e)];
+    if (l == kNone) return false;
+    P = lines[l][0];
+    Q = lines[l][1];
+    return true;
+  }
+  // Number of edges that take a run's line.
+  size_t edge_count() const;
 };
 
+// Peak memory while building: about 4 bytes per vertex, 28 per distinct point and 16 per edge,
+// plus 8 per edge that joins a run (the 1M-triangle city: measured in docs/performance.md).
 // Deterministic; O(V log V + E + sum over vertices of (incident edges)^2, capped per vertex at
 // kEdgeLinesPairCap incident edges, beyond which only edges adjacent in direction order are
 // compared).
