@@ -14,8 +14,9 @@
 //
 // A run: edges joined, through shared endpoints (equal positions), with edges collinear with them
 // (the cross product of their directions from the shared point is zero in double, with
-// -ffp-contract=off: exactly collinear inputs, and inputs within rounding of it). Collinear edges
-// that touch nowhere are not joined; nor are moving triangles (the dynamic kernel).
+// -ffp-contract=off: collinear points whose differences are exact, such as integer map
+// coordinates, and some within rounding of a line). Collinear edges that touch nowhere are not
+// joined; nor are moving triangles (the dynamic kernel).
 //
 // Build it once per scene and key state and pass it in SegmentOptions::edge_lines to every run (a
 // bake does; `pvs segment` builds one for its run); without it the kernel builds one per call, so
