@@ -20,7 +20,9 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,6 +38,7 @@
 #include "vislib/eval/render.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/import.h"
 #include "vislib/scene/scene.h"
 #include "vislib/scene/scene_fingerprint.h"
@@ -75,6 +78,20 @@ struct PyScene {
   std::string path;
   vislib::Scene scene;
   std::vector<std::string> warnings;
+
+  // The runs of collinear edges for key state `state`, built on first use and kept with the
+  // scene (which never changes once loaded), as a bake builds them once: without them every
+  // kernel call would rebuild its own (edge_lines.h).
+  const vislib::EdgeLines& edge_lines(size_t state) {
+    std::lock_guard<std::mutex> lock(lines_mutex);
+    std::unique_ptr<vislib::EdgeLines>& l = lines_by_state[state];
+    if (!l) l = std::make_unique<vislib::EdgeLines>(vislib::build_edge_lines(scene, state));
+    return *l;
+  }
+
+ private:
+  std::mutex lines_mutex;
+  std::map<size_t, std::unique_ptr<vislib::EdgeLines>> lines_by_state;
 };
 using ScenePtr = std::shared_ptr<PyScene>;
 
@@ -297,6 +314,7 @@ void bind_visibility(py::module_& m) {
         {
           py::gil_scoped_release release;
           auto limit = thread_limit(threads);
+          if (vislib::bvh_applies(scene->scene)) o.edge_lines = &scene->edge_lines(o.state);
           vislib::SegmentResult s = vislib::segment_visibility(scene->scene, v0, v1, o);
           r->visible = std::move(s.visible);
           r->visible_spheres = std::move(s.visible_spheres);
@@ -342,6 +360,8 @@ void bind_visibility(py::module_& m) {
         {
           py::gil_scoped_release release;
           auto limit = thread_limit(threads);
+          if (vislib::bvh_applies(scene->scene))
+            ro.segment.edge_lines = &scene->edge_lines(ro.segment.state);
           vislib::RegionResult s = vislib::region_visibility(scene->scene, box, ro);
           r->visible = std::move(s.visible);
           r->visible_spheres = std::move(s.visible_spheres);

@@ -23,6 +23,9 @@ def test_segment_visible_ids_equal_cli_segment_json(city, tmp_path):
     assert r.visible.tolist() == cli["visible"]
     assert 0 < len(r.visible) < scene.triangle_count
     assert r.stats["triangle_pixel_pairs"] == cli["counts"]["triangle_pixel_pairs"]
+    # A second call reuses the runs of collinear edges the scene built on the first: same set.
+    again = pyvislib.segment_visibility(scene, FROM, TO, resolution=64)
+    assert again.visible.tolist() == cli["visible"]
 
 
 def test_segment_options_reach_the_kernel(city, tmp_path):
