@@ -122,7 +122,7 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
 // not with the scene: several runs of a bake hold these at once. A new face hands the pages
 // back to the kernel (madvise MADV_DONTNEED: they read as zeros, stale stamps, when touched
 // again), so a run holds one face's entries, not the union of its six faces' (on the 1M-triangle
-// city at N = 512, an 8 m segment's six faces touch 6.6 MB of entries, one face at most 2.0 MB).
+// city at N = 512, an 8 m segment's six faces touch 6.6 MB of entries, one face at most 2.1 MB).
 // Callers call next_face only while no tile of the run reads the cache.
 class FaceBoundsCache {
   static_assert(std::is_trivially_default_constructible_v<std::atomic<uint32_t>>);
