@@ -145,7 +145,9 @@ class FaceBoundsCache {
         throw std::bad_alloc();
       }
     } else if (size_) {
-      discard(stamp_, stamp_bytes());
+      // box_ and zmin_ are read only under a ready stamp: discarding them only frees memory.
+      if (!discard(stamp_, stamp_bytes()))
+        for (size_t i = 0; i < size_; ++i) stamp_[i].store(kStale, std::memory_order_relaxed);
       discard(box_, box_bytes());
       discard(zmin_, zmin_bytes());
     }
@@ -188,8 +190,8 @@ class FaceBoundsCache {
     void* p = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     return p == MAP_FAILED ? nullptr : p;
   }
-  // Zero-filled on the next touch; a private anonymous mapping cannot fail to discard.
-  static void discard(void* p, size_t bytes) { madvise(p, bytes, MADV_DONTNEED); }
+  // Hands the pages back; zero-filled on the next touch. False if the system refused.
+  static bool discard(void* p, size_t bytes) { return madvise(p, bytes, MADV_DONTNEED) == 0; }
   static void unmap(void* p, size_t bytes) {
     if (p) munmap(p, bytes);
   }
