@@ -3,6 +3,7 @@
 #include "vislib/kernel/edge_lines.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include "tests/scene_builders.h"
 #include "vislib/base/random.h"
 #include "vislib/kernel/segment_visibility.h"
+#include "vislib/scene/generate.h"
 
 using namespace vislib;
 using vislib_test::soup;
@@ -36,6 +38,20 @@ TEST(EdgeLines, CollinearEdgesThroughSharedEndpointsShareTheRunsExtremePoints) {
   EXPECT_EQ(Q, (Vec3{448, 448, -1792}));
   EXPECT_FALSE(el.line_of(0, 1, P, Q));
   EXPECT_FALSE(el.line_of(3, 0, P, Q));
+}
+
+TEST(EdgeLines, TheRunsAreTheSameWhateverTheThreadCount) {
+  CityOptions o;
+  o.blocks_x = o.blocks_z = 3;
+  o.panel_size = 2;  // small panels: many collinear edges through shared corners
+  o.seed = 5;
+  const Scene s = generate_city(o);
+  EdgeLines one, many;
+  tbb::task_arena(1).execute([&] { one = build_edge_lines(s, 0); });
+  tbb::task_arena(4).execute([&] { many = build_edge_lines(s, 0); });
+  ASSERT_FALSE(one.lines.empty());
+  EXPECT_EQ(one.edge_line, many.edge_line);
+  EXPECT_EQ(one.lines, many.lines);
 }
 
 TEST(EdgeLines, SharedEdgesAloneAndCollinearEdgesThatNeverTouchMakeNoRun) {

@@ -759,8 +759,7 @@ TEST(QuakeBspLibreQuake, Lqdm1RaysFromEveryLeafHitOnlyTrianglesTheEngineDraws) {
 // counted and their textures printed, not bounded: these maps hold coplanar face pairs (a face on
 // each side of a sky or liquid boundary) that Embree may take either of.
 TEST(QuakeBspLibreQuake, LongRaysFromEveryLeafOfE1m2AndE2m3) {
-  const char* env = std::getenv("VISLIB_LONG_TESTS");
-  if (!env || std::string(env) != "1") GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1";
+  VISLIB_REQUIRE_LONG_TESTS();
   for (const char* name : {"e1m2.bsp", "e2m3.bsp"}) {
     auto path = librequake(name);
     if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
@@ -1070,8 +1069,7 @@ TEST(QuakeBakeLibreQuake, LeavesListAndStrideSelectThoseLeaves) {
 
 // The whole of lqdm1 (opt-in: VISLIB_LONG_TESTS=1; tens of minutes on the 2-core host).
 TEST(QuakeBakeLibreQuake, LongLqdm1WholeBakeHoldsItsRays) {
-  const char* env = std::getenv("VISLIB_LONG_TESTS");
-  if (!env || std::string(env) != "1") GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1";
+  VISLIB_REQUIRE_LONG_TESTS();
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "", 321, 4, 64);

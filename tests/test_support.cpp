@@ -91,4 +91,9 @@ std::string temp_dir(const std::string& name) {
   return dir.string();
 }
 
+bool long_tests_enabled() {
+  const char* env = std::getenv("VISLIB_LONG_TESTS");
+  return env && std::string(env) == "1";
+}
+
 }  // namespace vislib_test

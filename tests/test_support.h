@@ -25,6 +25,8 @@ int run_pvs_split(const std::string& args, std::string* out, std::string* err);
 pid_t spawn_pvs_quiet(const std::vector<std::string>& args);
 // A fresh empty temporary directory for one test.
 std::string temp_dir(const std::string& name);
+// True when VISLIB_LONG_TESTS=1: the opt-in tests that take tens of minutes (whole maps) run.
+bool long_tests_enabled();
 
 }  // namespace vislib_test
 
@@ -32,3 +34,7 @@ std::string temp_dir(const std::string& name);
   auto var##_opt = vislib_test::shared_dir();                           \
   if (!var##_opt) GTEST_SKIP() << "../shared is absent: skipping test"; \
   const std::string var = *var##_opt
+
+// Skips the test unless the long tests were asked for (long_tests_enabled).
+#define VISLIB_REQUIRE_LONG_TESTS() \
+  if (!vislib_test::long_tests_enabled()) GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1"

@@ -4,6 +4,7 @@
 #include "vislib/kernel/triangle_bvh.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstring>
@@ -51,10 +52,12 @@ Scene small_city() {
 }  // namespace
 
 TEST(TriangleBvh, EveryTriangleSitsInExactlyOneLeafInsideEveryNodeOnItsPath) {
-  const Scene s = random_soup(1000, 9);
+  // Large enough that the top ranges build their halves as parallel tasks.
+  const Scene s = random_soup(40000, 9);
   const TriangleBvh t = build_triangle_bvh(s);
   ASSERT_FALSE(t.nodes.empty());
   std::vector<int> seen(s.triangle_count(), 0);
+  size_t visited = 0;
   // Walk from the root keeping the path's boxes; each triangle's corners lie inside them all.
   struct Item {
     uint32_t node;
@@ -65,6 +68,7 @@ TEST(TriangleBvh, EveryTriangleSitsInExactlyOneLeafInsideEveryNodeOnItsPath) {
     Item it = stack.back();
     stack.pop_back();
     it.path.push_back(it.node);
+    ++visited;
     const TriangleBvh::Node& n = t.nodes[it.node];
     if (n.count == 0) {
       ASSERT_LT(n.first + 1, t.nodes.size());
@@ -85,6 +89,7 @@ TEST(TriangleBvh, EveryTriangleSitsInExactlyOneLeafInsideEveryNodeOnItsPath) {
     }
   }
   for (int c : seen) EXPECT_EQ(c, 1);
+  EXPECT_EQ(visited, t.nodes.size());  // no slot left out of the tree
   // Deterministic.
   const TriangleBvh u = build_triangle_bvh(s);
   EXPECT_EQ(u.order, t.order);
@@ -95,6 +100,18 @@ TEST(TriangleBvh, EveryTriangleSitsInExactlyOneLeafInsideEveryNodeOnItsPath) {
 // box_footprint_bounds must contain the footprint rectangle of every triangle inside the box and
 // lie below its nearest depth, or say "empty" only when the triangle's is empty, for boxes in
 // front of, around and behind the eye, under random orientations.
+TEST(TriangleBvh, TheTreeIsTheSameWhateverTheThreadCount) {
+  // Large enough that the top ranges build their halves as parallel tasks.
+  const Scene s = random_soup(50000, 21);
+  TriangleBvh one, many;
+  tbb::task_arena(1).execute([&] { one = build_triangle_bvh(s); });
+  tbb::task_arena(4).execute([&] { many = build_triangle_bvh(s); });
+  ASSERT_EQ(one.nodes.size(), many.nodes.size());
+  EXPECT_EQ(0, std::memcmp(one.nodes.data(), many.nodes.data(),
+                           one.nodes.size() * sizeof(TriangleBvh::Node)));
+  EXPECT_EQ(one.order, many.order);
+}
+
 TEST(TriangleBvh, BoxFootprintContainsTheFootprintOfEveryTriangleInside) {
   Rng rng(23);
   const int n = 64;

@@ -578,8 +578,7 @@ TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
 // e1m2 and e2m3 against their own sets (opt-in: VISLIB_LONG_TESTS=1): no extras, and every
 // sampled miss of theirs is one of ours (the same sets); prints the misses and where they are.
 TEST(VisCompareLibreQuake, LongOwnSetsOfE1m2AndE2m3) {
-  const char* env = std::getenv("VISLIB_LONG_TESTS");
-  if (!env || std::string(env) != "1") GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1";
+  VISLIB_REQUIRE_LONG_TESTS();
   auto shared = shared_dir();
   if (!shared) GTEST_SKIP() << "../shared is absent";
   for (const char* name : {"e1m2.bsp", "e2m3.bsp"}) {
@@ -672,11 +671,6 @@ void expect_every_extra_settled(const nlohmann::json& t, const std::string& map)
   EXPECT_EQ(t["extras_false_witness"], 0) << map;
 }
 
-bool long_tests_enabled() {
-  const char* env = std::getenv("VISLIB_LONG_TESTS");
-  return env && std::string(env) == "1";
-}
-
 }  // namespace
 
 // The whole of lqdm1 baked through the CLI at N = 64 (default face spacing, -j 2) and held
@@ -711,7 +705,7 @@ TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMiss
 // budget printed: about 3,600 CPU s, half an hour on two idle cores): every extra settled, and
 // no sampled ray (4 eyes a leaf, 126 million rays) sees a triangle missing from ours.
 TEST(VisCompareLibreQuake, LongLqdm1WholeSweptAt4UnitsHasNoSampledMiss) {
-  if (!long_tests_enabled()) GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1";
+  VISLIB_REQUIRE_LONG_TESTS();
   auto j =
       bake_and_compare("lqdm1.bsp", "--res 128 --face-spacing 4", "35 minutes on two idle cores");
   if (!j) GTEST_SKIP() << "../shared/scenes/librequake is absent";
@@ -730,7 +724,7 @@ TEST(VisCompareLibreQuake, LongLqdm1WholeSweptAt4UnitsHasNoSampledMiss) {
 // misses, the sweep's gaps at 16 units, are bounded at 1 ray in a million (measured: 7 of 24.8
 // million on e1m2, 1 of 18.5 million on e2m3); theirs are zero.
 TEST(VisCompareLibreQuake, LongE1m2AndE2m3SampleBakesSettleEveryExtra) {
-  if (!long_tests_enabled()) GTEST_SKIP() << "opt-in: set VISLIB_LONG_TESTS=1";
+  VISLIB_REQUIRE_LONG_TESTS();
   for (const char* map : {"e1m2.bsp", "e2m3.bsp"}) {
     auto j = bake_and_compare(map, "--bsp-liquids see-through --leaves 1-4000/40 --res 128",
                               "10 minutes a map on two idle cores");

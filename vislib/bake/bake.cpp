@@ -1,6 +1,7 @@
 // bake.cpp: parallel bake over view cells with checkpoint and shards (bake.h, docs/bake.md).
 #include "vislib/bake/bake.h"
 
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -397,14 +398,18 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
   report.threads = tbb::this_task_arena::max_concurrency();
   TriangleBvh tree;
   double w0 = wall_now(), c0 = process_cpu_seconds();
-  const TriangleBvh* bvh = bake_bvh(scene, requested, tree, report);
-  // The runs of collinear edges, once for every static run (the kernel would build them per run).
+  // The tree, and the runs of collinear edges once for every static run (the kernel would build
+  // them per run): independent, so built side by side.
+  const TriangleBvh* bvh = nullptr;
   EdgeLines own_lines;
   const EdgeLines* lines = requested.region.segment.edge_lines;
-  if (!lines && bvh_applies(scene)) {
-    own_lines = build_edge_lines(scene, requested.region.segment.state);
-    lines = &own_lines;
-  }
+  const bool own = !lines && bvh_applies(scene);
+  if (own) lines = &own_lines;
+  tbb::parallel_invoke([&] { bvh = bake_bvh(scene, requested, tree, report); },
+                       [&] {
+                         if (own)
+                           own_lines = build_edge_lines(scene, requested.region.segment.state);
+                       });
   report.times.phases.bvh = {wall_now() - w0, process_cpu_seconds() - c0};
   w0 = wall_now();
   c0 = process_cpu_seconds();

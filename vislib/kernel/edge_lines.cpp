@@ -1,6 +1,8 @@
 // edge_lines.cpp: runs of collinear edges joined through shared endpoints (edge_lines.h).
 #include "vislib/kernel/edge_lines.h"
 
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <numeric>
 #include <stdexcept>
@@ -65,7 +67,8 @@ EdgeLines build_edge_lines(const Scene& scene, size_t state) {
   {
     std::vector<uint32_t> by_pos(V);
     std::iota(by_pos.begin(), by_pos.end(), 0u);
-    std::sort(by_pos.begin(), by_pos.end(), [&](uint32_t a, uint32_t b) {
+    // A strict total order (ties by index): the parallel sort's result is the only one.
+    tbb::parallel_sort(by_pos.begin(), by_pos.end(), [&](uint32_t a, uint32_t b) {
       if (pos[a] != pos[b]) return lex_less(pos[a], pos[b]);
       return a < b;
     });
@@ -153,7 +156,7 @@ EdgeLines build_edge_lines(const Scene& scene, size_t state) {
       if (i == 0 || (members[i - 1] >> 32) != r) members.push_back(r << 32 | r);
     }
   }
-  std::sort(members.begin(), members.end());
+  tbb::parallel_sort(members.begin(), members.end());
   members.erase(std::unique(members.begin(), members.end()), members.end());
   for (size_t i = 0; i < members.size();) {
     const uint64_t r = members[i] >> 32;

@@ -1,8 +1,12 @@
 // triangle_bvh.cpp: see triangle_bvh.h.
 #include "vislib/kernel/triangle_bvh.h"
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 namespace vislib {
@@ -22,13 +26,32 @@ float up(double x) {
 // Splits on the triangles' centroids only (12 bytes a triangle while building); a leaf's bounds
 // come from its corners, an inner node's from its children's (the same floats as the union of
 // per-triangle bounds rounded outward: rounding outward is monotone).
+// Subtrees are built in parallel, into the slots a depth-first build would give them: a range's
+// subtree takes a number of nodes that depends on its size alone (`below`), so the layout, and
+// everything the kernel computes from it, is the same whatever the thread count.
 struct Builder {
   const Scene& scene;
   size_t state;
   std::vector<float> mid;  // per triangle: centre of its box, 3 each
   TriangleBvh& bvh;
+  std::map<uint32_t, uint32_t> below_size;  // filled by count_below before the build, then read
 
-  void build(uint32_t node, uint32_t begin, uint32_t end) {
+  // Ranges at least this large build their two halves as parallel tasks (triangles).
+  static constexpr uint32_t kParallelRange = 1u << 14;
+
+  // The nodes a range of `size` triangles allocates below its own node: two children and theirs.
+  uint32_t count_below(uint32_t size) {
+    if (size <= kBvhLeafSize) return 0;
+    if (auto it = below_size.find(size); it != below_size.end()) return it->second;
+    const uint32_t half = size / 2;
+    const uint32_t k = 2 + count_below(half) + count_below(size - half);
+    below_size.emplace(size, k);
+    return k;
+  }
+  uint32_t below(uint32_t size) const { return size <= kBvhLeafSize ? 0 : below_size.at(size); }
+
+  // Builds the range's subtree at `node`, its descendants in the slots from `next` on.
+  void build(uint32_t node, uint32_t begin, uint32_t end, uint32_t next) {
     TriangleBvh::Node n;
     if (end - begin <= kBvhLeafSize) {
       double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -64,10 +87,17 @@ struct Builder {
                        const float cx = mid[x * 3 + axis], cy = mid[y * 3 + axis];
                        return cx < cy || (cx == cy && x < y);
                      });
-    const uint32_t left = uint32_t(bvh.nodes.size());
-    bvh.nodes.resize(bvh.nodes.size() + 2);
-    build(left, begin, m);
-    build(left + 1, m, end);
+    const uint32_t left = next;
+    const uint32_t right_next = next + 2 + below(m - begin);
+    if (end - begin >= kParallelRange) {
+      tbb::task_group halves;
+      halves.run([&] { build(left, begin, m, next + 2); });
+      build(left + 1, m, end, right_next);
+      halves.wait();
+    } else {
+      build(left, begin, m, next + 2);
+      build(left + 1, m, end, right_next);
+    }
     const TriangleBvh::Node &l = bvh.nodes[left], &r = bvh.nodes[left + 1];
     for (int a = 0; a < 3; ++a) {
       n.lo[a] = std::min(l.lo[a], r.lo[a]);
@@ -91,21 +121,19 @@ TriangleBvh build_triangle_bvh(const Scene& scene, size_t state) {
   if (n >= (size_t(1) << 31)) throw std::invalid_argument("too many triangles for the BVH");
   if (state >= scene.positions.size())
     throw std::invalid_argument("BVH: key state " + std::to_string(state) + " out of range");
-  Builder b{scene, state, std::vector<float>(n * 3), bvh};
-  for (size_t t = 0; t < n; ++t) {
+  Builder b{scene, state, std::vector<float>(n * 3), bvh, {}};
+  tbb::parallel_for(size_t(0), n, [&](size_t t) {
     const auto c = scene.corners(uint32_t(t), state);
     for (int a = 0; a < 3; ++a) {
       const double l = std::min({c[0][a], c[1][a], c[2][a]});
       const double h = std::max({c[0][a], c[1][a], c[2][a]});
       b.mid[t * 3 + a] = float(0.5 * (l + h));
     }
-  }
+  });
   bvh.order.resize(n);
   for (size_t t = 0; t < n; ++t) bvh.order[t] = uint32_t(t);
-  bvh.nodes.reserve(n +
-                    2);  // leaves hold at least 2 triangles (or the one), so at most n + 2 nodes
-  bvh.nodes.resize(1);
-  b.build(0, 0, uint32_t(n));
+  bvh.nodes.resize(1 + size_t(b.count_below(uint32_t(n))));
+  b.build(0, 0, uint32_t(n), 1);
   return bvh;
 }
 
