@@ -91,3 +91,41 @@ TEST(PhaseTimes, ThreadsChargeTheirOwnScopesToOneSum) {
   EXPECT_GT(times.wall(Phase::SharedWait), 0);
   EXPECT_EQ(times.wall(Phase::Cell), 0);
 }
+
+TEST(PhaseTimes, AFallbackTimesThreadsOutsideAnyScopeAndOnlyWhileItLives) {
+  PhaseTimes bake, other;
+  {
+    PhaseFallback lent(&bake);
+    PhaseFallback second(&other);  // one at a time: installs nothing
+    EXPECT_FALSE(PhaseScope::open_on_this_thread());
+    std::thread helper([] {
+      PhaseScope tiles(Phase::Helping);  // no scope of its own: the fallback's times
+      EXPECT_TRUE(PhaseScope::open_on_this_thread());
+      until_the_clock_moves();
+    });
+    helper.join();
+    {
+      PhaseScope timed(Phase::Write, &other);  // an open scope wins over the fallback
+      PhaseScope run(Phase::Run);
+      until_the_clock_moves();
+    }
+  }
+  {
+    PhaseScope tiles(Phase::Helping);  // the fallback is gone: nothing to charge
+    EXPECT_FALSE(PhaseScope::open_on_this_thread());
+    until_the_clock_moves();
+  }
+  EXPECT_GT(bake.wall(Phase::Helping), 0);
+  EXPECT_EQ(bake.wall_total(), bake.wall(Phase::Helping));
+  EXPECT_EQ(other.wall(Phase::Helping), 0);
+  EXPECT_GT(other.wall(Phase::Run), 0);
+  // A fallback installed after the first is gone installs again.
+  PhaseTimes later;
+  PhaseFallback again(&later);
+  std::thread helper([] {
+    PhaseScope tiles(Phase::Helping);
+    until_the_clock_moves();
+  });
+  helper.join();
+  EXPECT_GT(later.wall(Phase::Helping), 0);
+}

@@ -234,6 +234,7 @@ void record_phases(const PhaseTimes& t, BakeReport& report) {
   p.checkpoint = get(Phase::Checkpoint);
   p.encode = get(Phase::Encode);
   p.write = get(Phase::Write);
+  p.helping = get(Phase::Helping);
   p.idle.wall = std::max(0.0, double(report.threads) * report.seconds - t.wall_total());
   p.idle.cpu = std::max(0.0, report.times.process_cpu - t.cpu_total());
 }
@@ -287,6 +288,8 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
   const double cpu_start = process_cpu_seconds();
   const size_t tokens = 4 * size_t(std::max(1, report.threads));
   uint32_t next = 0;
+  // Threads with no cell of their own that the scheduler lends to a run are timed too (helping).
+  PhaseFallback lent_threads(&phases);
   try {
     tbb::parallel_pipeline(
         tokens,

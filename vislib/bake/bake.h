@@ -130,9 +130,11 @@ struct BakePhases {
   PhaseSeconds checkpoint;    // appending finished cells to the checkpoint
   PhaseSeconds encode;        // encoding blocks in cell order, and the index at the end
   PhaseSeconds write;         // writing the bytes, the final fsync and rename
-  // The rest: wall, threads x BakeReport::seconds less every phase (threads with no cell or
-  // block to work on, or running tiles of a run another thread computes outside any cell of
-  // their own); CPU, process_cpu less every phase (those tiles, and the scheduler's spinning).
+  PhaseSeconds helping;       // tiles of a run another thread computes, taken by a thread with
+                              // no cell of its own (the scheduler lends it to that run)
+  // The rest: wall, threads x BakeReport::seconds less every phase (threads with no cell, block
+  // or tile to work on); CPU, process_cpu less every phase (the scheduler's spinning while it
+  // looks for work).
   PhaseSeconds idle;
 };
 

@@ -47,7 +47,7 @@ json phases_json(const BakePhases& p) {
       {"merge", &p.merge},       {"cell", &p.cell},
       {"progress", &p.progress}, {"checkpoint", &p.checkpoint},
       {"encode", &p.encode},     {"write", &p.write},
-      {"idle", &p.idle}};
+      {"helping", &p.helping},   {"idle", &p.idle}};
   json j = json::object();
   for (const auto& [name, s] : phases)
     j[name] = {{"wall_seconds", s->wall}, {"cpu_seconds", s->cpu}};

@@ -12,6 +12,8 @@ namespace {
 
 // The innermost open scope of the calling thread.
 thread_local PhaseScope* t_innermost = nullptr;
+// The PhaseFallback alive's PhaseTimes, or null.
+std::atomic<PhaseTimes*> g_fallback{nullptr};
 
 double wall_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -56,7 +58,7 @@ double PhaseTimes::cpu_total() const {
 PhaseScope::PhaseScope(Phase phase, PhaseTimes* times)
     : times_(times         ? times
              : t_innermost ? t_innermost->times_
-                           : nullptr),
+                           : g_fallback.load(std::memory_order_acquire)),
       phase_(phase) {
   if (!times_) return;
   const double wall = wall_seconds(), cpu = thread_cpu_seconds();
@@ -78,10 +80,24 @@ PhaseScope::~PhaseScope() {
   }
 }
 
+bool PhaseScope::open_on_this_thread() {
+  return t_innermost != nullptr;
+}
+
 void PhaseScope::charge(double wall, double cpu) {
   if (times_) times_->add(phase_, wall - last_wall_, cpu - last_cpu_);
   last_wall_ = wall;
   last_cpu_ = cpu;
+}
+
+PhaseFallback::PhaseFallback(PhaseTimes* times) {
+  PhaseTimes* none = nullptr;
+  if (times && g_fallback.compare_exchange_strong(none, times, std::memory_order_acq_rel))
+    installed_ = times;
+}
+
+PhaseFallback::~PhaseFallback() {
+  if (installed_) g_fallback.store(nullptr, std::memory_order_release);
 }
 
 }  // namespace vislib

@@ -25,8 +25,9 @@ enum class Phase : int {
   Checkpoint,  // appending a finished cell to the checkpoint
   Encode,      // encoding a cell's block in the writer stage
   Write,       // writing the encoded bytes to the file
+  Helping,     // tiles of another thread's run, taken by a thread outside any phase of its own
 };
-constexpr int kPhaseCount = 10;
+constexpr int kPhaseCount = 11;
 
 // Wall and CPU seconds per phase, summed over threads. Thread-safe.
 class PhaseTimes {
@@ -43,13 +44,16 @@ class PhaseTimes {
 
 // Charges the calling thread's time from construction to destruction to `phase` of `times`,
 // less the scopes opened inside it on this thread (which resume it when they close). With
-// `times` null the scope charges the PhaseTimes of the innermost scope open on this thread, and
-// does nothing when none is: library code can mark its phases (a run, a merge) without knowing
-// whether anyone times it. Scopes must close in reverse order on each thread (automatic storage).
+// `times` null the scope charges the PhaseTimes of the innermost scope open on this thread, or,
+// when none is, that of the PhaseFallback alive, and does nothing when there is neither: library
+// code can mark its phases (a run, a merge, tiles) without knowing whether anyone times it.
+// Scopes must close in reverse order on each thread (automatic storage).
 class PhaseScope {
  public:
   explicit PhaseScope(Phase phase, PhaseTimes* times = nullptr);
   ~PhaseScope();
+  // True when the calling thread is inside a scope that charges a PhaseTimes.
+  static bool open_on_this_thread();
   PhaseScope(const PhaseScope&) = delete;
   PhaseScope& operator=(const PhaseScope&) = delete;
 
@@ -59,6 +63,20 @@ class PhaseScope {
   Phase phase_;
   PhaseScope* outer_ = nullptr;
   double last_wall_ = 0, last_cpu_ = 0;
+};
+
+// While it lives, scopes opened with `times` null on threads with no open scope charge `times`:
+// the threads a scheduler lends to a timed computation (work stealing) outside any scope of their
+// own are timed too. One at a time in a process: while one lives, a second installs nothing.
+class PhaseFallback {
+ public:
+  explicit PhaseFallback(PhaseTimes* times);
+  ~PhaseFallback();
+  PhaseFallback(const PhaseFallback&) = delete;
+  PhaseFallback& operator=(const PhaseFallback&) = delete;
+
+ private:
+  PhaseTimes* installed_ = nullptr;  // `times` if this one installed it
 };
 
 // The calling thread's CPU seconds (CLOCK_THREAD_CPUTIME_ID) and the process's (user + system,

@@ -65,10 +65,12 @@
 #include <cstring>
 #include <memory>
 #include <new>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
 #include "vislib/base/cubemap.h"
+#include "vislib/base/phase_times.h"
 #include "vislib/kernel/footprint.h"
 #include "vislib/kernel/kernel_support.h"
 #include "vislib/kernel/segment_visibility.h"
@@ -467,6 +469,10 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
     // (3) tiles in parallel.
     tbb::parallel_for(tbb::blocked_range<int>(0, tile_count, 1),
                       [&](const tbb::blocked_range<int>& r) {
+                        // A thread lent to this run from outside any phase of its own (a
+                        // bake's thread with no cell) times its tiles as helping.
+                        std::optional<PhaseScope> helping;
+                        if (!PhaseScope::open_on_this_thread()) helping.emplace(Phase::Helping);
                         auto work = take_work();  // this thread's scratch and walk queue
                         auto& sc = work->sc;
                         size_t held = 0;
