@@ -97,9 +97,6 @@ TEST(TriangleBvh, EveryTriangleSitsInExactlyOneLeafInsideEveryNodeOnItsPath) {
   EXPECT_EQ(std::memcmp(u.nodes.data(), t.nodes.data(), t.nodes.size() * sizeof(t.nodes[0])), 0);
 }
 
-// box_footprint_bounds must contain the footprint rectangle of every triangle inside the box and
-// lie below its nearest depth, or say "empty" only when the triangle's is empty, for boxes in
-// front of, around and behind the eye, under random orientations.
 TEST(TriangleBvh, TheTreeIsTheSameWhateverTheThreadCount) {
   // Large enough that the top ranges build their halves as parallel tasks.
   const Scene s = random_soup(50000, 21);
@@ -112,6 +109,9 @@ TEST(TriangleBvh, TheTreeIsTheSameWhateverTheThreadCount) {
   EXPECT_EQ(one.order, many.order);
 }
 
+// box_footprint_bounds must contain the footprint rectangle of every triangle inside the box and
+// lie below its nearest depth, or say "empty" only when the triangle's is empty, for boxes in
+// front of, around and behind the eye, under random orientations.
 TEST(TriangleBvh, BoxFootprintContainsTheFootprintOfEveryTriangleInside) {
   Rng rng(23);
   const int n = 64;
