@@ -172,10 +172,10 @@ TEST(IntervalList, ThousandsOfDisjointPiecesAreAllKeptInOrder) {
 }
 
 TEST(IntervalList, SearchFromTheGuessFindsTheIndexOfABinarySearch) {
-  // detail::first_ending_after gallops from the index s would have in equal pieces; the oracle is
-  // std::upper_bound over the whole list. Lists of every length around the scan/search switch up
-  // to deep ones, with pieces bunched at one end (the guess far off) or even, queried at every
-  // piece end, inside pieces, in gaps and outside [0, 1].
+  // detail::first_ending_after scans from the index s would have in equal pieces and bisects
+  // beyond kGuessScan pieces; the oracle is std::upper_bound over the whole list. Lists of every
+  // length around the scan/search switch up to deep ones, with pieces bunched at one end (the
+  // guess far off) or even, queried at every piece end, inside pieces, in gaps and outside [0, 1].
   Rng rng(11);
   for (int n : {0, 1, 15, 16, 17, 18, 31, 64, 200, 1000}) {
     for (int shape = 0; shape < 3; ++shape) {
