@@ -379,10 +379,13 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
 // Working memory a thread keeps between tiles, in MB: the tile scratch of a kind (its pixels'
 // lists, ties and pools) and the BVH walk's queue. One set per thread, whatever the runs in flight
 // (a thread runs one tile at a time; TBB hands it tiles of whichever run waits), reused by every
-// run of every segment on that thread. A set that ends a tile holding more than this is freed
-// rather than kept, so a deep tile costs its memory only while it runs. 0.75 MB held on the 2 m
-// street of the 300K-triangle city at N = 512 with 32-pixel tiles; see docs/performance.md,
-// "Memory per thread".
+// run of every segment on that thread. A set that ends a tile holding more than this is kept
+// only for the rest of that run: the thread frees it when it next takes a tile of another run.
+// So a run of deep tiles costs its memory only while it runs, and its tiles reuse the lists'
+// capacity instead of growing them again one tile after another (freeing the set after every
+// such tile cost the deep case of the speed suite about 12%: a 32-pixel tile there holds up to
+// 25 MB). 0.75 MB held on the 2 m street of the 300K-triangle city at N = 512 with 32-pixel
+// tiles; see docs/performance.md, "Memory per thread".
 constexpr double kThreadTileMemoryBudgetMB = 8.0;
 
 // The tile scratch and walk queue of one thread (see kThreadTileMemoryBudgetMB).
@@ -390,26 +393,36 @@ template <class Scratch>
 struct TileWork {
   Scratch sc;
   std::vector<QueueItem> queue;
+  uint64_t over_budget_run = 0;  // the run (next_tile_run) that left it over budget; 0: within
 };
 
+// A number for each run of the tile driver, never 0, so that a thread can tell its runs apart.
+inline uint64_t next_tile_run() {
+  static std::atomic<uint64_t> last{0};
+  return ++last;
+}
+
 // Hands out the calling thread's TileWork for `Scratch` (made by `make` when the thread has none,
-// or when its own was made for another tile size, or is in use further up the stack) and takes it
-// back after the tile.
+// or when its own was made for another tile size, or was left over budget by another run, or is
+// in use further up the stack) and takes it back after the tile.
 template <class Scratch>
 class ThreadTileWork {
  public:
   template <class Make>
-  static std::unique_ptr<TileWork<Scratch>> take(int tile_size, Make make) {
+  static std::unique_ptr<TileWork<Scratch>> take(int tile_size, uint64_t run, Make make) {
     std::unique_ptr<TileWork<Scratch>> w = std::move(slot());
-    if (!w || w->sc.lists.size() != size_t(tile_size) * size_t(tile_size))
-      w.reset(new TileWork<Scratch>{make(), {}});
+    if (!w || w->sc.lists.size() != size_t(tile_size) * size_t(tile_size) ||
+        (w->over_budget_run != 0 && w->over_budget_run != run))
+      w.reset(new TileWork<Scratch>{make(), {}, 0});
     return w;
   }
-  // `bytes`: what the scratch holds (the peak_tile_bytes of its tile).
-  static void give_back(std::unique_ptr<TileWork<Scratch>> w, size_t bytes) {
+  // `bytes`: what the scratch holds (the peak_tile_bytes of its tile); `run`: the tile's run.
+  static void give_back(std::unique_ptr<TileWork<Scratch>> w, size_t bytes, uint64_t run) {
+    if (slot()) return;  // a set further up the stack came back first: this one is freed
     const size_t queue_bytes = w->queue.capacity() * sizeof(QueueItem);
-    if (double(bytes + queue_bytes) <= kThreadTileMemoryBudgetMB * 1e6 && !slot())
-      slot() = std::move(w);
+    const bool over = double(bytes + queue_bytes) > kThreadTileMemoryBudgetMB * 1e6;
+    w->over_budget_run = over ? run : 0;
+    slot() = std::move(w);
   }
 
  private:
@@ -429,7 +442,10 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
   const size_t count = kind.count();
   using Work = ThreadTileWork<typename Kind::Scratch>;
-  auto take_work = [&kind, TS] { return Work::take(TS, [&] { return kind.make_scratch(TS); }); };
+  const uint64_t run = next_tile_run();
+  auto take_work = [&kind, TS, run] {
+    return Work::take(TS, run, [&] { return kind.make_scratch(TS); });
+  };
   const TriangleBvh* bvh = nullptr;
   if constexpr (Kind::kHasBvh) bvh = kind.bvh();
   std::vector<int> bbox(bvh ? 0 : count * 4);
@@ -538,7 +554,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                           stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
                           held = std::max(held, bytes);
                         }
-                        Work::give_back(std::move(work), held);
+                        Work::give_back(std::move(work), held, run);
                       });
   }
 }
