@@ -383,9 +383,10 @@ void walk_tile(Kind& kind, const TriangleBvh& bvh, int face, const FaceAxes& axe
 // only for the rest of that run: the thread frees it when it next takes a tile of another run.
 // So a run of deep tiles costs its memory only while it runs, and its tiles reuse the lists'
 // capacity instead of growing them again one tile after another (freeing the set after every
-// such tile cost the deep case of the speed suite about 12%: a 32-pixel tile there holds up to
-// 25 MB). 0.75 MB held on the 2 m street of the 300K-triangle city at N = 512 with 32-pixel
-// tiles; see docs/performance.md, "Memory per thread".
+// such tile cost the speed suite's deep case, alone in its process, 15%: a 32-pixel tile there
+// holds up to 25 MB, and the freed pages were faulted in again). 0.75 MB held on the 2 m street
+// of the 300K-triangle city at N = 512 with 32-pixel tiles; see docs/performance.md, "Memory per
+// thread".
 constexpr double kThreadTileMemoryBudgetMB = 8.0;
 
 // The tile scratch and walk queue of one thread (see kThreadTileMemoryBudgetMB).
