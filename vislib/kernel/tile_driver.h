@@ -495,7 +495,10 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                         size_t held = 0;
                         FoundMarks& found = found_by_thread.local();
                         for (int tile = r.begin(); tile != r.end(); ++tile) {
-                          SegmentStats& stats = tile_stats[size_t(face) * tile_count + tile];
+                          // Counted apart, added once at the tile's end: the entries of
+                          // neighbouring tiles share cache lines, and another thread may be
+                          // running the next tile.
+                          SegmentStats stats;
                           TileRect rect;
                           rect.x0 = (tile % tiles_x) * TS;
                           rect.y0 = (tile / tiles_x) * TS;
@@ -554,6 +557,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                             }
                           stats.peak_tile_bytes = std::max(stats.peak_tile_bytes, double(bytes));
                           held = std::max(held, bytes);
+                          tile_stats[size_t(face) * tile_count + tile].add(stats);
                         }
                         Work::give_back(std::move(work), held, run);
                       });
