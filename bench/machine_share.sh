@@ -8,12 +8,14 @@
 # CPU seconds (user + system, from wait4): alone (both runs), and with K at once (median, least,
 # most). In COMMAND, '@' is replaced by the copy's number (0 for the runs alone), so the copies
 # can write to files of their own. The share is the K copies' mean CPU seconds over the mean of
-# the runs alone; K / share bounds the speed-up at -j K of any CPU-bound work on this machine
-# (clock, shared caches, memory bandwidth, and on a virtual machine whatever the host shares).
-# Exits 2 on bad usage, 1 when a run fails.
+# the runs alone; K / share is the speed-up K workers reach with that work on this machine when
+# they share nothing but the machine, the reference for a speed-up at -j K. The share is the
+# machine's (clock, shared caches, memory bandwidth, on a virtual machine whatever the host
+# shares) as the work meets it: work with less memory traffic may lose less. Exits 2 on bad
+# usage, 1 when a run fails.
 set -euo pipefail
 if [ $# -lt 2 ] || ! [[ $1 =~ ^[1-9][0-9]*$ ]]; then
-  sed -n '2,13p' "$0"
+  sed -n '2,14p' "$0"
   exit 2
 fi
 exec python3 - "$@" <<'EOF'
@@ -47,5 +49,5 @@ share = mean / alone
 print(f"alone: {alone1[0]:.2f} and {alone2[0]:.2f} CPU s")
 print(f"{k} at once: median {together[k // 2]:.2f}, least {together[0]:.2f}, "
       f"most {together[-1]:.2f} CPU s per copy ({wall:.1f} s wall)")
-print(f"share {share:.3f}: the speed-up at -j {k} of CPU-bound work is at most {k / share:.1f}x")
+print(f"share {share:.3f}: {k} workers sharing nothing but the machine reach {k / share:.1f}x")
 EOF
