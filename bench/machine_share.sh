@@ -26,14 +26,15 @@ k, command = int(sys.argv[1]), sys.argv[2:]
 
 def run(copies):
     """CPU seconds of each of `copies` processes started at once, and the wall seconds."""
-    start, running, cpu = time.time(), {}, []
+    start, running, cpu = time.time(), set(), []
     for i in range(copies):
         args = [a.replace("@", str(i)) for a in command]
-        running[subprocess.Popen(args).pid] = i
+        running.add(subprocess.Popen(args).pid)
     while running:
         pid, status, usage = os.wait4(-1, 0)
-        if running.pop(pid, None) is None:
+        if pid not in running:
             continue
+        running.remove(pid)
         if status != 0:
             sys.exit(f"machine_share.sh: {' '.join(command)} failed (wait status {status})")
         cpu.append(usage.ru_utime + usage.ru_stime)
