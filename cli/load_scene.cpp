@@ -65,8 +65,13 @@ void add_import_options(CLI::App* cmd, ImportArgs& args) {
   cmd->add_option("--see-through", args.see_through,
                   "Objects whose names match these shell patterns (comma-separated; a literal * "
                   "is [*]) are see-through: seen, never hiding anything (static scenes; glTF "
-                  "objects with BLEND or MASK materials are see-through already; "
-                  "docs/scene-model.md)")
+                  "objects with BLEND materials, or MASK ones whose alpha can fall below the "
+                  "cutoff, are see-through already; docs/scene-model.md)")
+      ->delimiter(',');
+  cmd->add_option("--opaque", args.opaque,
+                  "Objects or glTF materials whose names match these shell patterns "
+                  "(comma-separated) are kept opaque whatever their alpha mode (a cutout kept "
+                  "opaque hides what is seen through its holes; docs/scene-model.md)")
       ->delimiter(',');
 }
 
@@ -89,10 +94,18 @@ vislib::Scene load_scene_for_cli(const std::string& path, int states, const Impo
   const auto t0 = std::chrono::steady_clock::now();
   vislib::Scene scene = vislib::load_scene(path, options, &warnings);
   for (const auto& w : warnings) warn(w);
+  const std::vector<size_t> kept = vislib::keep_opaque(scene, import.opaque);
+  for (size_t i = 0; i < kept.size(); ++i)
+    if (kept[i] == 0)
+      throw CLI::ValidationError("--opaque", "pattern '" + import.opaque[i] +
+                                                 "' matches no object or see-through material of " +
+                                                 path);
   for (const std::string& p : import.see_through)
     if (vislib::mark_see_through(scene, {p}) == 0)
       throw CLI::ValidationError("--see-through",
                                  "pattern '" + p + "' matches no object of " + path);
+  const std::string see_through = vislib::see_through_warning(scene, path);
+  if (!see_through.empty()) warn(see_through);
   char buf[256];
   std::snprintf(buf, sizeof buf,
                 "loaded %s: %zu triangles, %zu objects, %zu spheres, %zu key states in %.2f s",

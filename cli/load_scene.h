@@ -16,8 +16,9 @@ struct ImportArgs {
   std::string bsp_models = "world";      // world | all
   std::string bsp_liquids = "opaque";    // opaque | omit | see-through
   std::vector<std::string> see_through;  // --see-through: object name patterns
+  std::vector<std::string> opaque;       // --opaque: object or material name patterns
 };
-// Adds --bsp-models, --bsp-liquids and --see-through to `cmd`.
+// Adds --bsp-models, --bsp-liquids, --see-through and --opaque to `cmd`.
 void add_import_options(CLI::App* cmd, ImportArgs& args);
 
 // --scale S, --rotate DEG,AX,AY,AZ, --translate X,Y,Z: the similarity x' = S * (R x) + T (R: DEG
@@ -41,9 +42,12 @@ std::string matrix_text(const vislib::Mat3& m);
 vislib::LoadOptions load_options_of(const ImportArgs& import, int states = 1);
 
 // Loads `path` with `states` key states (throws CLI::ValidationError naming --states if < 1;
-// InputError from the importer passes through). Importer warnings go to stderr. Objects whose
-// names match one of `import.see_through` (vislib::mark_see_through) become see-through; a
-// pattern that matches no object is an error naming it (CLI::ValidationError, exit 2).
+// InputError from the importer passes through). Importer warnings go to stderr. First the
+// objects and materials named by `import.opaque` are kept opaque (vislib::keep_opaque), then the
+// objects whose names match one of `import.see_through` become see-through
+// (vislib::mark_see_through); a pattern of either that matches nothing is an error naming it
+// (CLI::ValidationError, exit 2). A scene left mostly see-through is warned about
+// (vislib::see_through_warning).
 vislib::Scene load_scene_for_cli(const std::string& path, int states = 1,
                                  const ImportArgs& import = {});
 

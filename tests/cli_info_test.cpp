@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "tests/import_test_files.h"
 #include "tests/test_support.h"
@@ -76,23 +77,27 @@ TEST(CliInfo, JsonReportsCountsAndBox) {
 
 TEST(CliInfo, CountsSeeThroughFromBlendAndMaskMaterialsAndNamePatterns) {
   std::string dir = temp_dir("cli_see_through");
-  for (const char* mode : {"OPAQUE", "BLEND", "MASK"}) {
+  // A MASK material without a texture or vertex colours has its factor's alpha (1) everywhere,
+  // above the cutoff: no hole, opaque. With a texture its alpha may fall below: see-through.
+  for (const auto& [mode, textured, expect] :
+       {std::tuple{"OPAQUE", false, 0}, std::tuple{"BLEND", false, 1}, std::tuple{"MASK", false, 0},
+        std::tuple{"MASK", true, 1}}) {
     GltfSpec g = triangle();
     g.alpha_mode = mode;
+    g.base_color_texture = textured;
     std::string out;
-    ASSERT_EQ(run_pvs("info --json '" + write_gltf(dir + "/" + mode + ".gltf", g) + "'", &out), 0)
-        << out;
-    json j = json::parse(out);
-    const int expect = std::string(mode) == "OPAQUE" ? 0 : 1;
-    EXPECT_EQ(j["see_through_triangles"], expect) << mode;
-    EXPECT_EQ(j["see_through_objects"], expect) << mode;
+    const std::string path = write_gltf(dir + "/" + mode + (textured ? "_tex" : "") + ".gltf", g);
+    ASSERT_EQ(run_pvs("info --json '" + path + "'", &out), 0) << out;
+    json j = json::parse(out.substr(out.find('{')));
+    EXPECT_EQ(j["see_through_triangles"], expect) << mode << textured;
+    EXPECT_EQ(j["see_through_objects"], expect) << mode << textured;
   }
   const std::string obj = write_text(dir + "/groups.obj",
                                      "v 0 0 0\nv 1 0 0\nv 0 1 0\no glass_a\nf 1 2 3\nf 1 3 2\n"
                                      "o wall\nf 1 2 3\no *water\nf 2 3 1\n");
   std::string out;
   ASSERT_EQ(run_pvs("info --json --see-through 'glass*,[*]*' '" + obj + "'", &out), 0) << out;
-  json j = json::parse(out);
+  json j = json::parse(out.substr(out.find('{')));
   EXPECT_EQ(j["see_through_triangles"], 3);
   EXPECT_EQ(j["see_through_objects"], 2);
   ASSERT_EQ(run_pvs("info --see-through glass_a '" + obj + "'", &out), 0) << out;
@@ -100,6 +105,38 @@ TEST(CliInfo, CountsSeeThroughFromBlendAndMaskMaterialsAndNamePatterns) {
   // A pattern that matches nothing is an error naming it.
   EXPECT_EQ(run_pvs("info --see-through 'nothing*' '" + obj + "'", &out), 2) << out;
   EXPECT_NE(out.find("nothing*"), std::string::npos) << out;
+}
+
+// A model whose every triangle is see-through (one BLEND material, as many exports are) is
+// warned about, naming the share, the material and the option; --opaque by material or by
+// object name keeps it opaque and silences the warning; a pattern matching nothing is an error.
+TEST(CliInfo, MostlySeeThroughSceneWarnsAndOpaqueKeepsItOpaque) {
+  std::string dir = temp_dir("cli_opaque");
+  GltfSpec g = triangle();
+  g.alpha_mode = "BLEND";
+  g.nodes = json::array({{{"mesh", 0}, {"name", "diorama"}}});
+  const std::string path = write_gltf(dir + "/blend.gltf", g);
+  std::string out;
+  ASSERT_EQ(run_pvs("info '" + path + "'", &out), 0) << out;
+  EXPECT_NE(out.find("1 of 1 triangles (100.0%) are see-through"), std::string::npos) << out;
+  EXPECT_NE(out.find("'mat0'"), std::string::npos) << out;
+  EXPECT_NE(out.find("--opaque"), std::string::npos) << out;
+  for (const char* pattern : {"mat0", "dio*"}) {
+    ASSERT_EQ(run_pvs("info --json --opaque '" + std::string(pattern) + "' '" + path + "'", &out),
+              0)
+        << out;
+    EXPECT_EQ(out.find("see-through, by"), std::string::npos) << out;
+    EXPECT_EQ(json::parse(out.substr(out.find('{')))["see_through_triangles"], 0) << pattern;
+  }
+  EXPECT_EQ(run_pvs("info --opaque 'nothing*' '" + path + "'", &out), 2) << out;
+  EXPECT_NE(out.find("nothing*"), std::string::npos) << out;
+  // The bake says it too.
+  ASSERT_EQ(
+      run_pvs("bake '" + path + "' --box 0,0,0,1,1,1 --grid 1,1,1 --res 8 -o '" + dir + "/b.pvs'",
+              &out),
+      0)
+      << out;
+  EXPECT_NE(out.find("are see-through"), std::string::npos) << out;
 }
 
 TEST(CliInfo, SharedScenesReportTheReadmeTriangleCounts) {

@@ -58,7 +58,8 @@ struct GltfSpec {
   size_t view_length_extra = 0;
   int position_component_type = 5126;
   size_t position_count_override = 0;
-  std::string alpha_mode;  // non-empty: the primitive uses material 0 with this alphaMode
+  std::string alpha_mode;           // non-empty: the primitive uses material 0 with this alphaMode
+  bool base_color_texture = false;  // material 0 has a base-colour texture (an image not loaded)
 };
 
 inline std::string write_gltf(const std::string& path, const GltfSpec& g) {
@@ -91,6 +92,11 @@ inline std::string write_gltf(const std::string& path, const GltfSpec& g) {
   if (!g.alpha_mode.empty()) {
     doc["materials"] = json::array({{{"name", "mat0"}, {"alphaMode", g.alpha_mode}}});
     prim["material"] = 0;
+    if (g.base_color_texture) {
+      doc["materials"][0]["pbrMetallicRoughness"] = {{"baseColorTexture", {{"index", 0}}}};
+      doc["textures"] = json::array({{{"source", 0}}});
+      doc["images"] = json::array({{{"uri", "data:image/png;base64,AAAA"}}});
+    }
   }
   doc["meshes"] = json::array({{{"name", "mesh0"}, {"primitives", json::array({prim})}}});
   doc["nodes"] = g.nodes;

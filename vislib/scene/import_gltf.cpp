@@ -101,19 +101,39 @@ Mat4 to_matrix(const Trs& x) {
   return m;
 }
 
-// True when a triangle primitive of mesh `m` uses a material whose alphaMode is BLEND or MASK:
-// its node's object is see-through (docs/scene-model.md "See-through objects"). One such
-// primitive makes the whole object see-through, the direction that never hides what is behind
-// it.
-bool see_through_mesh(const tinygltf::Model& model, int m) {
+// True when every fragment of `prim` drawn with `mat` (alphaMode MASK) passes the alpha test, so
+// the cutout has no hole: the alpha is the base colour factor's, with no base-colour texture and
+// no vertex colour (COLOR_0) of four components to lower it, and it is at least alphaCutoff.
+bool mask_never_cuts(const tinygltf::Model& model, const tinygltf::Primitive& prim,
+                     const tinygltf::Material& mat) {
+  const auto& pbr = mat.pbrMetallicRoughness;
+  if (pbr.baseColorTexture.index >= 0) return false;
+  auto color = prim.attributes.find("COLOR_0");
+  if (color != prim.attributes.end() &&
+      (color->second < 0 || size_t(color->second) >= model.accessors.size() ||
+       model.accessors[size_t(color->second)].type != TINYGLTF_TYPE_VEC3))
+    return false;
+  const double alpha = pbr.baseColorFactor.size() == 4 ? pbr.baseColorFactor[3] : 1.0;
+  return alpha >= mat.alphaCutoff;
+}
+
+// The materials of mesh `m`'s triangle primitives that make its node's object see-through
+// (docs/scene-model.md "See-through objects"), by name ("material N" when unnamed), each once, in
+// primitive order: alphaMode BLEND, and MASK unless mask_never_cuts. One such primitive makes the
+// whole object see-through, the direction that never hides what is behind it.
+std::vector<std::string> see_through_materials(const tinygltf::Model& model, int m) {
+  std::vector<std::string> names;
   for (const auto& prim : model.meshes[size_t(m)].primitives) {
     const bool triangles = prim.mode == 4 || prim.mode == 5 || prim.mode == 6 || prim.mode == -1;
     if (!triangles || prim.material < 0 || size_t(prim.material) >= model.materials.size())
       continue;
-    const std::string& mode = model.materials[size_t(prim.material)].alphaMode;
-    if (mode == "BLEND" || mode == "MASK") return true;
+    const tinygltf::Material& mat = model.materials[size_t(prim.material)];
+    if (mat.alphaMode != "BLEND" && (mat.alphaMode != "MASK" || mask_never_cuts(model, prim, mat)))
+      continue;
+    std::string name = mat.name.empty() ? "material " + std::to_string(prim.material) : mat.name;
+    if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
   }
-  return false;
+  return names;
 }
 
 // The inverse transpose of the linear part of `a` applied to `n` (a normal), not normalised.
@@ -611,7 +631,8 @@ Scene load_gltf(const std::string& path, const LoadOptions& options,
                                                              : "node" + std::to_string(n);
     uint32_t obj = uint32_t(scene.objects.size());
     scene.objects.push_back({name});
-    scene.objects.back().see_through = see_through_mesh(model, nd.mesh);
+    scene.objects.back().alpha_materials = see_through_materials(model, nd.mesh);
+    scene.objects.back().see_through = !scene.objects.back().alpha_materials.empty();
     const std::vector<std::vector<Mat4>> joint_m = joint_matrices(ctx, n, poses);
     std::vector<Vec3> morphed;
     for (const Prim& p : mesh_cache[nd.mesh]) {

@@ -40,6 +40,32 @@ size_t mark_see_through(Scene& scene, const std::vector<std::string>& patterns) 
   return marked;
 }
 
+std::vector<size_t> keep_opaque(Scene& scene, const std::vector<std::string>& patterns) {
+  std::vector<size_t> matched(patterns.size(), 0);
+  auto matches = [&](const std::string& name) {
+    bool any = false;
+    for (size_t p = 0; p < patterns.size(); ++p)
+      if (fnmatch(patterns[p].c_str(), name.c_str(), 0) == 0) {
+        ++matched[p];
+        any = true;
+      }
+    return any;
+  };
+  for (Object& o : scene.objects) {
+    const bool by_name = matches(o.name);
+    const bool by_material = !o.alpha_materials.empty();
+    std::vector<std::string> kept;
+    for (const std::string& m : o.alpha_materials)
+      if (!matches(m)) kept.push_back(m);
+    o.alpha_materials = std::move(kept);
+    if (by_name || (by_material && o.alpha_materials.empty())) {
+      o.see_through = false;
+      o.alpha_materials.clear();
+    }
+  }
+  return matched;
+}
+
 namespace {
 // Maps tau in [0,1] to (state interval k, local parameter s).
 void locate(size_t states, double tau, size_t& k, double& s) {

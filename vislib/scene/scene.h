@@ -33,6 +33,10 @@ namespace vislib {
 struct Object {
   std::string name;          // glTF node/mesh name, OBJ group/object name, or generated name
   bool see_through = false;  // its triangles are seen but do not occlude
+  // The materials whose alpha mode made the object see-through on import (glTF BLEND, or MASK
+  // whose alpha can fall below its cutoff: docs/scene-model.md "See-through objects"), by name
+  // ("material N" when unnamed), in primitive order, each once. Empty for every other object.
+  std::vector<std::string> alpha_materials = {};
 };
 
 struct Scene {
@@ -89,5 +93,12 @@ void append_scene(Scene& scene, const Scene& other);
 // command-line option makes; an importer that knows its materials may set Object::see_through
 // itself.
 size_t mark_see_through(Scene& scene, const std::vector<std::string>& patterns);
+
+// Keeps opaque, whatever their alpha mode, the objects whose name matches one of `patterns`
+// (shell globs as in mark_see_through) and the materials whose name matches one: a matched
+// material leaves every object's alpha_materials, and an object becomes opaque when its name
+// matched or when it was see-through by its alpha materials and none is left. Returns, for each
+// pattern in order, how many object names and alpha materials (once per object) it matched.
+std::vector<size_t> keep_opaque(Scene& scene, const std::vector<std::string>& patterns);
 
 }  // namespace vislib

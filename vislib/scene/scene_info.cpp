@@ -1,6 +1,8 @@
 #include "vislib/scene/scene_info.h"
 
+#include <algorithm>
 #include <array>
+#include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
 #include <unordered_set>
@@ -32,6 +34,39 @@ bool far_from_origin(const Box3& b) {
   if (b.empty()) return false;
   double offset = length((b.min + b.max) * 0.5), diagonal = length(b.max - b.min);
   return offset > kFarFromOriginUnits && offset > kFarFromOriginDiagonals * diagonal;
+}
+
+std::string see_through_warning(const Scene& scene, const std::string& name) {
+  const size_t see = scene.see_through_triangle_count(), all = scene.triangle_count();
+  if (all == 0 || double(see) <= kSeeThroughWarnShare * double(all)) return "";
+  constexpr size_t kNamesShown = 4;  // of each kind; the rest are counted
+  std::vector<std::string> materials, objects;
+  auto add = [](std::vector<std::string>& list, const std::string& n) {
+    if (std::find(list.begin(), list.end(), n) == list.end()) list.push_back(n);
+  };
+  for (const Object& o : scene.objects) {
+    if (!o.see_through) continue;
+    if (o.alpha_materials.empty()) add(objects, o.name);
+    for (const std::string& m : o.alpha_materials) add(materials, m);
+  }
+  auto listed = [](const std::vector<std::string>& list) {
+    std::string t;
+    for (size_t i = 0; i < list.size() && i < kNamesShown; ++i)
+      t += (i ? ", '" : "'") + list[i] + "'";
+    if (list.size() > kNamesShown)
+      t += " and " + std::to_string(list.size() - kNamesShown) + " more";
+    return t;
+  };
+  char share[96];
+  std::snprintf(share, sizeof share, "%zu of %zu triangles (%.1f%%)", see, all,
+                100.0 * double(see) / double(all));
+  std::string why;
+  if (!materials.empty()) why += "materials " + listed(materials) + " (alpha mode BLEND or MASK)";
+  if (!objects.empty()) why += (why.empty() ? "objects " : " and objects ") + listed(objects);
+  return name + ": " + share + " are see-through, by " + why +
+         ": they hide nothing, so every view cell sees through them; keep the solid ones opaque "
+         "with --opaque PATTERNS (object or material names; docs/scene-model.md \"See-through "
+         "objects\")";
 }
 
 SceneInfo scene_info(const Scene& s) {

@@ -38,6 +38,18 @@ constexpr double kFarFromOriginDiagonals = 10;
 constexpr double kFarFromOriginUnits = 1e4;
 bool far_from_origin(const Box3& bbox);
 
+// A scene of which more than this share of the triangles is see-through (unitless, in [0, 1]) is
+// warned about (see_through_warning): a cell sees through them all, so an exported model whose
+// every material is BLEND or MASK bakes to nearly the whole scene in every cell. Errs towards
+// warning; windows, water and foliage of a real level stay well below it.
+constexpr double kSeeThroughWarnShare = 0.10;
+
+// Empty, or a warning (one line, naming the scene as `name`) when more than
+// kSeeThroughWarnShare of the scene's triangles are see-through: the share, the materials
+// (Object::alpha_materials) and the objects marked by name that make them so (the first few of
+// each), and the option that keeps them opaque (--opaque PATTERNS).
+std::string see_through_warning(const Scene& scene, const std::string& name);
+
 // Computes the statistics. Works on any Scene, even one that breaks the scene.h contract
 // (out-of-range indices are counted, never followed). Deterministic; O(V + T) expected time.
 SceneInfo scene_info(const Scene& scene);
