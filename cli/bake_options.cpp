@@ -154,7 +154,8 @@ std::vector<uint32_t> parse_leaves(const std::string& text, const std::vector<ui
 
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   if (a.cells != "bsp-leaves") {
-    for (const char* o : {"--face-spacing", "--leaves"})
+    for (const char* o :
+         {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     return;
   }
@@ -174,6 +175,12 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     const vislib::QuakeBsp bsp = vislib::read_quake_bsp(a.scene);
     vislib::BspCellOptions o;
     o.face_spacing = a.face_spacing;
+    o.near = a.near;
+    if (a.face_sweep == "adaptive") {
+      if (!(a.chords.floor <= a.chords.coarse))
+        throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
+      o.adaptive = a.chords;
+    }
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
     o.scene = load_options_of(a.import);
     return vislib::bsp_leaf_cells(bsp, o);
@@ -244,6 +251,21 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "bsp-leaves: sweep each face of a leaf's view region with parallel segments at "
                   "most this far apart (Quake units; 0 = the faces' edges only)")
       ->check(in_range(0.0, 1e6))
+      ->capture_default_str();
+  cmd->add_option("--face-sweep", a.face_sweep,
+                  "bsp-leaves: 'even' (chords --face-spacing apart) or 'adaptive' (coarse chords, "
+                  "one inserted between two neighbours while it sees ids neither sees, down to "
+                  "--chord-floor; docs/quake.md)")
+      ->check(CLI::IsMember({"even", "adaptive"}))
+      ->capture_default_str();
+  cmd->add_option("--chord-coarse", a.chords.coarse,
+                  "bsp-leaves, adaptive: the first chords at most this far apart (Quake units)")
+      ->check(in_range(1e-3, 1e6))
+      ->capture_default_str();
+  cmd->add_option("--chord-floor", a.chords.floor,
+                  "bsp-leaves, adaptive: no chord is inserted closer than this to a neighbour "
+                  "(Quake units, at most --chord-coarse)")
+      ->check(in_range(1e-3, 1e6))
       ->capture_default_str();
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "

@@ -35,6 +35,8 @@ struct BakeArgs {
   std::string cells;                              // --cells: "" (grid or walkable) or bsp-leaves
   double face_spacing = vislib::kBspFaceSpacing;  // --face-spacing (bsp-leaves), Quake units
   std::string leaves;                             // --leaves A-B (bsp-leaves)
+  std::string face_sweep = "even";                // --face-sweep even|adaptive (bsp-leaves)
+  vislib::AdaptiveSpacing chords;                 // --chord-coarse, --chord-floor (adaptive)
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).

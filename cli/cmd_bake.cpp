@@ -117,8 +117,10 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
   // One bake per output at a time (the checkpoint has its own lock too): taken before looking
   // at the checkpoint, so a second bake is told that the first is running (exit 2).
   std::unique_ptr<vislib::FileLock> lock;
-  if (!a.dry_run)
+  if (!a.dry_run) {
     lock = std::make_unique<vislib::FileLock>(a.output + ".lock", "the output " + a.output);
+    vislib::remove_dead_writers_temps(a.output);  // a killed bake's: none of its writers lives
+  }
   if (!a.resume && file_exists(checkpoint)) {
     std::fprintf(stderr,
                  "pvs: error: %s: a checkpoint of an interrupted bake exists: pass --resume to "

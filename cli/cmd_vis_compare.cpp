@@ -161,10 +161,20 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   if (rerun) {
     vislib::BspCellOptions co;
     co.face_spacing = spacing.get<double>();
+    const nlohmann::json sweep = find_key(md, "face_sweep");
+    if (sweep.is_string() && sweep.get<std::string>() == "adaptive") {
+      const nlohmann::json coarse = find_key(md, "chord_coarse"),
+                           floor = find_key(md, "chord_floor");
+      if (!coarse.is_number() || !floor.is_number() || !(floor.get<double>() > 0) ||
+          !(floor.get<double>() <= coarse.get<double>()))
+        throw vislib::InputError(a.pvs, "metadata holds an invalid chord_coarse or chord_floor");
+      co.adaptive = vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>()};
+    }
     co.leaves = cell_leaf;
     co.scene = lo;
     ro.segment.resolution = md["resolution"].get<int>();
     ro.segment.near = md["near"].get<double>();
+    co.near = ro.segment.near;
     ro.segment.eps_len = md["eps_len"].get<double>();
     ro.segment.eps_z = md["eps_z"].get<double>();
     ro.runs = md["runs"].get<int>();

@@ -92,6 +92,23 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
   EXPECT_FALSE(std::filesystem::exists(target)) << "a killed bake must not leave an output file";
   int saved = checkpoint_records(target + ".ckpt");
   ASSERT_GE(saved, 3);
+  // The killed writer's temporary, and one of a writer whose pid runs now (pid 1: a pid reused
+  // after a kill) touched just now: the resume holds the output's lock, so neither writer can be
+  // alive, and both go. Another file's temporary stays.
+  const std::string planted = dir + "/.killed.pvs.1.AbCdEfGh1234.tmp";
+  const std::string other = dir + "/.whole.pvs.1.AbCdEfGh1234.tmp";
+  vislib::write_file_atomic(planted, "x");
+  vislib::write_file_atomic(other, "x");
+  auto temps_of_target = [&] {
+    int n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) {
+      const std::string f = e.path().filename().string();
+      n += f.rfind(".killed.pvs.", 0) == 0 && f.size() > 4 &&
+           f.compare(f.size() - 4, 4, ".tmp") == 0;
+    }
+    return n;
+  };
+  EXPECT_GE(temps_of_target(), 1);
 
   // Without --resume the checkpoint is protected.
   ASSERT_EQ(run_pvs(grid_bake(target), &out), 2) << out;
@@ -104,6 +121,8 @@ TEST(CliBake, KilledBakeResumesToTheSameBytes) {
   EXPECT_EQ(std::stoi(m[1]) + std::stoi(m[2]), 16);
   EXPECT_EQ(vislib::read_file(target), vislib::read_file(dir + "/whole.pvs"));
   EXPECT_FALSE(std::filesystem::exists(target + ".ckpt"));
+  EXPECT_EQ(temps_of_target(), 0) << "the resume left the killed bake's temporaries";
+  EXPECT_TRUE(std::filesystem::exists(other));
 }
 
 TEST(CliBake, ShardsMergeByteIdenticallyAndThreadsDoNotMatter) {

@@ -321,30 +321,44 @@ TEST(QuakeBsp, LeafVolumesAreTheBoundsClippedByThePathPlanes) {
 }
 
 // The view region keeps kBspLeafInset from every plane: the tiny map's leaves are 64 x 96 x 16
-// boxes, so their regions are 62 x 94 x 14; a slab 1/16 unit thick is too thin for the full inset
-// and takes the largest halving that leaves a volume (1/64: 1/32 would leave exactly none).
-TEST(QuakeBsp, ViewRegionIsTheLeafInsetOrTheLargestHalvingThatLeavesAVolume) {
+// boxes, so their regions are 62 x 94 x 14. A slab 1/16 unit thick is too thin for the full inset
+// and takes the largest halving that leaves a volume and keeps the near clearance (1/32 would
+// leave exactly none, 1/64 is nearer the walls than sqrt(3) near), else the clearance itself. A
+// sheet 1/64 thick, thinner than twice the clearance, is inset by half its largest inset (its
+// half thickness) and clips its near distance so that its eyes still clear the walls.
+TEST(QuakeBsp, ViewRegionKeepsTheNearClearanceFromTheLeafsWalls) {
   QuakeBsp m = parse_quake_bsp("map.bsp", encode_bsp(tiny_map()));
   const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(m);
-  const BspViewRegion r = bsp_leaf_view_region(pieces[0].volume);
+  const BspViewRegion r = bsp_leaf_view_region(pieces[0].volume, kDefaultNear);
   EXPECT_EQ(r.inset, kBspLeafInset);
+  EXPECT_EQ(r.near_limit, std::numeric_limits<double>::infinity());
   EXPECT_NEAR(r.volume.volume(), 62.0 * 94 * 14, 1e-6);
   const Box3 b = r.volume.bounds();
   EXPECT_NEAR(b.min.z, 17, 1e-9);
   EXPECT_NEAR(b.max.z, 31, 1e-9);
 
+  const double clearance = kNearClearanceFactor * kDefaultNear;
   std::vector<HalfSpace> slab = {{{1, 0, 0}, 10}, {{-1, 0, 0}, 0},     {{0, 1, 0}, 10},
                                  {{0, -1, 0}, 0}, {{0, 0, 1}, 0.0625}, {{0, 0, -1}, 0}};
   ConvexPolytope thin = inset_polytope(ConvexPolytope{slab, {}}, 0);
   ASSERT_FALSE(thin.empty());
-  const BspViewRegion t = bsp_leaf_view_region(thin);
-  EXPECT_EQ(t.inset, 1.0 / 64);
-  EXPECT_NEAR(t.volume.volume(), (10 - 2.0 / 64) * (10 - 2.0 / 64) * (0.0625 - 2.0 / 64), 1e-9);
+  const BspViewRegion t = bsp_leaf_view_region(thin, kDefaultNear);
+  EXPECT_EQ(t.inset, clearance);
+  EXPECT_EQ(t.near_limit, std::numeric_limits<double>::infinity());
+  EXPECT_NEAR(t.volume.volume(),
+              (10 - 2 * clearance) * (10 - 2 * clearance) * (0.0625 - 2 * clearance), 1e-9);
+  // A larger near distance takes a larger clearance: the slab is then too thin for it.
+  EXPECT_LT(bsp_leaf_view_region(thin, 0.02).near_limit, 0.02);
   std::vector<HalfSpace> sheet = slab;
-  sheet[4].offset = 1.0 / 64;  // thinner than twice the smallest inset: the volume itself
-  const BspViewRegion z = bsp_leaf_view_region(inset_polytope(ConvexPolytope{sheet, {}}, 0));
-  EXPECT_EQ(z.inset, 0);
-  EXPECT_FALSE(z.volume.empty());
+  sheet[4].offset = 1.0 / 64;
+  const BspViewRegion z =
+      bsp_leaf_view_region(inset_polytope(ConvexPolytope{sheet, {}}, 0), kDefaultNear);
+  EXPECT_NEAR(z.inset, 1.0 / 256, 1e-12);
+  EXPECT_NEAR(z.near_limit, z.inset / kNearClearanceFactor, 1e-15);
+  EXPECT_LT(z.near_limit, kDefaultNear);
+  const Box3 zb = z.volume.bounds();
+  EXPECT_GE(zb.min.z, z.inset - 1e-12);
+  EXPECT_LE(zb.max.z, 1.0 / 64 - z.inset + 1e-12);
 }
 
 TEST(QuakeBsp, BadFilesNameTheLumpAndTheByte) {
@@ -807,7 +821,8 @@ std::vector<ConvexPolytope> cell_regions(const QuakeBsp& m, const ViewCells& cel
   std::vector<ConvexPolytope> out(cells.layout.cell_count());
   for (const BspLeafPiece& p : bsp_leaf_pieces(m)) {
     const uint32_t c = cells.layout.leaf_cell[p.leaf];
-    if (c != pvs::kNoCell && !p.volume.empty()) out[c] = bsp_leaf_view_region(p.volume).volume;
+    if (c != pvs::kNoCell && !p.volume.empty())
+      out[c] = bsp_leaf_view_region(p.volume, kDefaultNear).volume;
   }
   return out;
 }
@@ -867,6 +882,92 @@ TEST(QuakeBake, RegionSegmentsAreEdgesOnceThenChordsAtMostTheSpacingApart) {
   EXPECT_EQ(bsp_region_segments(box, 8).size(), 12u + 2 * 3 + 2 * 1 + 2 * 1);
   // Spacing 10 over a width of 32: 4 equal steps of 8 (at most 10 apart), 3 chords.
   EXPECT_EQ(bsp_region_segments(box, 10).size(), 12u + 2 * 3 + 2 * 1 + 2 * 1);
+}
+
+// A leaf thinner than twice the near clearance (a slab 0.015 units thick over the tiny map's
+// floor) with a face 10 units under the floor: no eye of the leaf's region may see it, since the
+// floor lies between. Before its region kept the clearance, the slab was its own region, its eyes
+// lay on the floor's plane, the near plane cut the floor away and the bake saw the face under it.
+TEST(QuakeBake, EyesOfALeafThinnerThanTheNearDistanceDoNotSeeThroughItsFloor) {
+  QuakeBsp m = tiny_map();
+  m.models[0].maxs = {64, 64, 0.015f};
+  m.vertices[9] = {16, 16, -10};
+  m.vertices[10] = {48, 16, -10};
+  m.vertices[11] = {48, 48, -10};
+  m.vertices[12] = {16, 48, -10};
+  m.faces[3] = m.faces[0];  // replaced below: the door's quad becomes the face under the floor
+  m.faces.pop_back();
+  add_face(m, {9, 10, 11, 12}, 0, false);
+  m.models[0].face_count = 4;
+  m.models.pop_back();  // no door model
+  const std::string dir = temp_dir("quake_thin_leaf");
+  const std::string path = write_map(dir, "thin.bsp", encode_bsp(m));
+  const QuakeBsp parsed = read_quake_bsp(path);
+  const Scene scene = load_scene(path);
+  ASSERT_EQ(scene.triangle_count(), 2u + 3 + 1 + 2);  // floor, water, sky, the face under
+  BspCellOptions o;
+  o.leaves = {1};
+  const ViewCells cells = bsp_leaf_cells(parsed, o);
+  EXPECT_EQ(cells.near_limit.size(), 1u);
+  const double limit = cells.near_limit.empty() ? kDefaultNear : cells.near_limit[0];
+  EXPECT_LT(limit, kDefaultNear);
+  EXPECT_EQ(nlohmann::json::parse(cells.description)["leaves_near_clipped"], 1);
+  for (const Segment& seg : cells.segments[0])
+    for (const Vec3& p : {seg.from, seg.to}) {
+      const double z = scene_to_quake(p).z;
+      EXPECT_GE(z, kNearClearanceFactor * limit - 1e-12);
+      EXPECT_LE(z, 0.015 - kNearClearanceFactor * limit + 1e-7);
+    }
+  BakeSettings s;
+  s.region.segment.resolution = 32;
+  s.region.runs = 1;
+  pvs::Reader r = pvs::Reader::from_memory(bake_file(scene, cells, s, dir + "/thin.pvs", 1));
+  const std::vector<uint32_t> seen = r.read_cell(0);
+  EXPECT_FALSE(seen.empty());
+  for (uint32_t t = 6; t < 8; ++t)
+    EXPECT_FALSE(std::binary_search(seen.begin(), seen.end(), t))
+        << "triangle " << t << " under the floor is seen from the leaf";
+}
+
+// The adaptive face sweep: the cells' segments are the regions' edges, every face is swept, the
+// metadata records the rule, the bytes do not depend on the thread count, and each set holds what
+// the edges alone see.
+TEST(QuakeBake, AdaptiveFaceSweepIsRecordedDeterministicAndHoldsTheEdgesSets) {
+  const std::string dir = temp_dir("quake_adaptive");
+  const std::string path = write_map(dir, "tiny.bsp", encode_bsp(tiny_map()));
+  const QuakeBsp m = read_quake_bsp(path);
+  const Scene scene = load_scene(path);
+  BspCellOptions o;
+  o.adaptive = AdaptiveSpacing{32, 4};
+  const ViewCells cells = bsp_leaf_cells(m, o);
+  ASSERT_EQ(cells.sweeps.size(), 2u);
+  EXPECT_EQ(cells.sweeps[0].size(), 6u);  // a box region: six faces
+  BspCellOptions edges_only;
+  edges_only.face_spacing = 0;
+  const ViewCells edges = bsp_leaf_cells(m, edges_only);
+  ASSERT_EQ(cells.segments.size(), edges.segments.size());
+  for (size_t c = 0; c < cells.segments.size(); ++c) {
+    ASSERT_EQ(cells.segments[c].size(), edges.segments[c].size());
+    for (size_t i = 0; i < cells.segments[c].size(); ++i)
+      EXPECT_TRUE(cells.segments[c][i].from == edges.segments[c][i].from &&
+                  cells.segments[c][i].to == edges.segments[c][i].to);
+  }
+  const nlohmann::json d = nlohmann::json::parse(cells.description);
+  EXPECT_EQ(d["face_sweep"], "adaptive");
+  EXPECT_EQ(d["chord_coarse"], 32);
+  EXPECT_EQ(d["chord_floor"], 4);
+  BakeSettings s;
+  s.region.segment.resolution = 32;
+  const std::string one = bake_file(scene, cells, s, dir + "/one.pvs", 1);
+  EXPECT_EQ(one, bake_file(scene, cells, s, dir + "/two.pvs", 2));
+  pvs::Reader r = pvs::Reader::from_memory(one);
+  for (uint32_t c = 0; c < 2; ++c) {
+    const std::vector<uint32_t> all = r.read_cell(c), base = bake_cell(scene, edges, c, s);
+    EXPECT_TRUE(std::includes(all.begin(), all.end(), base.begin(), base.end())) << c;
+    uint64_t run = 0;
+    EXPECT_EQ(bake_cell(scene, cells, c, s, nullptr, {}, &run), all);
+    EXPECT_GT(run, edges.segments[c].size());
+  }
 }
 
 // One cell per empty or liquid leaf in leaf order, the leaf recorded in the layout, every segment

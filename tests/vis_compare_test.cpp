@@ -538,11 +538,13 @@ TEST(VisCompareLibreQuake, Lqdm1OwnSetsAHiddenExtraAndARemovedTriangle) {
   }
   ASSERT_NE(hidden, kNoHit);
   insert_sorted(one, hidden);
-  const BspViewRegion region = bsp_leaf_view_region([&] {
-    for (const BspLeafPiece& p : bsp_leaf_pieces(m.bsp))
-      if (p.leaf == m.cell_leaf[cell]) return p.volume;
-    return ConvexPolytope{};
-  }());
+  const BspViewRegion region = bsp_leaf_view_region(
+      [&] {
+        for (const BspLeafPiece& p : bsp_leaf_pieces(m.bsp))
+          if (p.leaf == m.cell_leaf[cell]) return p.volume;
+        return ConvexPolytope{};
+      }(),
+      kDefaultNear);
   Vec3 mid{0, 0, 0};
   size_t k = 0;
   for (const auto& f : region.volume.faces)

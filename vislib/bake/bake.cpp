@@ -88,21 +88,16 @@ std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layou
 
 std::vector<uint32_t> bake_cell(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                 const BakeSettings& settings, double* seconds,
-                                const std::function<void(double)>& progress) {
+                                const std::function<void(double)>& progress,
+                                uint64_t* segments_run) {
   CellVisibility v = cell_visibility(scene, cells, cell, settings.region, progress);
   if (seconds) *seconds = v.seconds;
+  if (segments_run) *segments_run = v.segments.size();
   PhaseScope merging(Phase::Merge);
   return ids_of(scene, settings.granularity, v.triangles, v.spheres);
 }
 
 namespace {
-
-// The from-segment runs of one cell: K per segment of each of its groups.
-uint64_t cell_runs(const ViewCells& cells, uint32_t cell, int runs) {
-  uint64_t segments = 0;
-  for (const std::vector<Segment>& g : cell_segment_groups(cells, cell)) segments += g.size();
-  return segments * uint64_t(runs);
-}
 
 // Run 0's segment of every segment of every cell, in cell order.
 std::vector<SegmentEnds> all_edges(const ViewCells& cells) {
@@ -113,12 +108,21 @@ std::vector<SegmentEnds> all_edges(const ViewCells& cells) {
   return all;
 }
 
-// Every cell's segments, its groups in order (expected_cell_work).
+// Every cell's segments, its groups in order (expected_cell_work); for an adaptive sweep, the
+// chords its first two rounds run whatever the scene (the even chords at half the coarse
+// spacing), the least it costs.
 std::vector<std::vector<Segment>> all_cell_segments(const ViewCells& cells) {
   std::vector<std::vector<Segment>> out(cells.layout.cell_count());
-  for (uint32_t c = 0; c < cells.layout.cell_count(); ++c)
+  for (uint32_t c = 0; c < cells.layout.cell_count(); ++c) {
     for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
       out[c].insert(out[c].end(), g.begin(), g.end());
+    if (!cells.sweeps.empty())
+      for (const FaceSweep& f : cells.sweeps[c]) {
+        const std::vector<Segment> first =
+            even_chords(f, 0.5 * cells.sweep_spacing.coarse, kSweepMinChord);
+        out[c].insert(out[c].end(), first.begin(), first.end());
+      }
+  }
   return out;
 }
 
@@ -313,6 +317,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                     return set;
                   }
                   double seconds = 0;
+                  uint64_t segments_run = 0;
                   std::function<void(double)> in_cell;  // progress inside the cell
                   if (progress)
                     in_cell = [&, c](double fraction) {
@@ -331,7 +336,8 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                   try {
                     ids = with_memory_stage(
                         "baking cell " + std::to_string(c) + " of " + std::to_string(n), [&] {
-                          return bake_cell(scene, cells, c, run_settings, &seconds, in_cell);
+                          return bake_cell(scene, cells, c, run_settings, &seconds, in_cell,
+                                           &segments_run);
                         });
                   } catch (...) {
                     --g_cell_depth;
@@ -346,7 +352,7 @@ void stream_cells(const Scene& scene, const ViewCells& cells, const pvs::FileInf
                     add_to(&t_cells, wall_now() - w0);
                     add_to(&t_cells_cpu, cpu);
                   }
-                  runs_done += cell_runs(cells, c, runs);
+                  runs_done += segments_run * uint64_t(runs);
                   {
                     PhaseScope appending(Phase::Checkpoint, &phases);
                     if (checkpoint) checkpoint->append(c, ids);
@@ -395,8 +401,10 @@ BakeReport bake(const Scene& scene, const ViewCells& cells, const BakeSettings& 
                 Shard shard, const BakeFiles& files, const BakeProgressFn& progress) {
   assert(shard.count >= 1 && shard.index < shard.count);
   std::unique_ptr<FileLock> lock;
-  if (files.lock)
+  if (files.lock) {
     lock = std::make_unique<FileLock>(files.output + ".lock", "the output " + files.output);
+    remove_dead_writers_temps(files.output);  // a killed bake's, now that none can be alive
+  }
   BakeReport report;
   report.threads = tbb::this_task_arena::max_concurrency();
   TriangleBvh tree;

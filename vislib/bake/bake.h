@@ -73,11 +73,14 @@ uint64_t bake_key(const pvs::FileInfo& info, Shard shard);
 std::vector<uint32_t> bake_cell(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,
                                 const BakeSettings& settings, double* seconds = nullptr,
                                 const std::function<void(double)>& progress = {});
-// The same for cells that may carry their own segments (ViewCells::segments): what bake() stores.
-// BSP leaf cells (bsp_cells.h) must use this one; the layout overload asserts a box layout.
+// The same for cells that may carry their own segments (ViewCells::segments) and sweeps: what
+// bake() stores. BSP leaf cells (bsp_cells.h) must use this one; the layout overload asserts a
+// box layout. `segments_run` receives the number of segments run (each `runs` times), the chords
+// an adaptive sweep inserted among them.
 std::vector<uint32_t> bake_cell(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                 const BakeSettings& settings, double* seconds = nullptr,
-                                const std::function<void(double)>& progress = {});
+                                const std::function<void(double)>& progress = {},
+                                uint64_t* segments_run = nullptr);
 
 struct BakeProgress {
   uint32_t done = 0;     // cells of the shard finished, resumed ones included

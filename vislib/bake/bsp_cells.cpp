@@ -5,6 +5,7 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -113,58 +114,31 @@ bool share_face(const std::vector<PlanarFace>& a, const std::vector<PlanarFace>&
 
 // Segment end points closer than this (Quake units) are one point: an edge of two faces of one
 // polytope is computed once per face and agrees to about 1e-12 units; shorter segments are dropped.
-constexpr double kBspSameEndpoint = 1e-6;
+constexpr double kBspSameEndpoint = kSweepMinChord;
 
 bool same_segment(const Segment& s, Vec3 a, Vec3 b) {
   auto near = [](Vec3 p, Vec3 q) { return length(p - q) <= kBspSameEndpoint; };
   return (near(s.from, a) && near(s.to, b)) || (near(s.from, b) && near(s.to, a));
 }
 
-// The chords of convex polygon `poly` (normal `n`) parallel to its longest edge, at equal steps of
-// at most `spacing` across it, strictly between its extreme vertices.
-void face_chords(const std::vector<Vec3>& poly, Vec3 n, double spacing, std::vector<Segment>& out) {
-  const size_t m = poly.size();
-  size_t longest = 0;
-  for (size_t i = 1; i < m; ++i)
-    if (length(poly[(i + 1) % m] - poly[i]) > length(poly[(longest + 1) % m] - poly[longest]))
-      longest = i;
-  Vec3 d = poly[(longest + 1) % m] - poly[longest];
-  if (length(d) <= kBspSameEndpoint) return;
-  d = d * (1.0 / length(d));
-  Vec3 w = cross(n, d);
-  w = w * (1.0 / length(w));
-  double lo = dot(w, poly[0]), hi = lo;
-  for (const Vec3& p : poly) {
-    lo = std::min(lo, dot(w, p));
-    hi = std::max(hi, dot(w, p));
+// The sweep of each face of `region` (face_sweep_of), in face order (Quake coordinates).
+std::vector<FaceSweep> region_sweeps(const ConvexPolytope& region) {
+  std::vector<FaceSweep> out;
+  for (const std::vector<Vec3>& f : region.faces) {
+    if (f.size() < 3) continue;
+    const PlanarFace pf = planar(f);
+    if (!std::isfinite(pf.normal.x)) continue;
+    if (auto s = face_sweep_of(f, pf.normal, kBspSameEndpoint)) out.push_back(std::move(*s));
   }
-  const double width = hi - lo;
-  if (!(width > spacing)) return;
-  const int steps = int(std::ceil(width / spacing));
-  for (int k = 1; k < steps; ++k) {
-    const double h = lo + width * double(k) / double(steps);
-    bool any = false;
-    Vec3 a{}, b{};
-    double ta = 0, tb = 0;
-    for (size_t i = 0; i < m; ++i) {
-      const Vec3& u = poly[i];
-      const Vec3& v = poly[(i + 1) % m];
-      const double hu = dot(w, u), hv = dot(w, v);
-      if (hu == hv || h < std::min(hu, hv) || h > std::max(hu, hv)) continue;
-      const Vec3 p = u + (v - u) * ((h - hu) / (hv - hu));
-      const double t = dot(d, p);
-      if (!any || t < ta) {
-        a = p;
-        ta = t;
-      }
-      if (!any || t > tb) {
-        b = p;
-        tb = t;
-      }
-      any = true;
-    }
-    if (any && length(b - a) > kBspSameEndpoint) out.push_back({a, b});
-  }
+  return out;
+}
+
+// `s` in scene coordinates (quake_to_scene is a rotation: positions along and across keep).
+FaceSweep scene_sweep(FaceSweep s) {
+  for (Vec3& v : s.face) v = quake_to_scene(v);
+  s.along = quake_to_scene(s.along);
+  s.across = quake_to_scene(s.across);
+  return s;
 }
 
 bool boxes_touch(const Box3& a, const Box3& b) {
@@ -287,11 +261,9 @@ std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double sp
       if (!seen) quake.push_back({a, b});
     }
   if (spacing > 0)
-    for (const std::vector<Vec3>& f : region.faces) {
-      if (f.size() < 3) continue;
-      const PlanarFace pf = planar(f);
-      if (!std::isfinite(pf.normal.x)) continue;
-      face_chords(f, pf.normal, spacing, quake);
+    for (const FaceSweep& sweep : region_sweeps(region)) {
+      const std::vector<Segment> c = even_chords(sweep, spacing, kBspSameEndpoint);
+      quake.insert(quake.end(), c.begin(), c.end());
     }
   std::vector<Segment> out;
   out.reserve(quake.size());
@@ -311,16 +283,29 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
   ViewCells cells;
   cells.layout = bsp_leaf_layout(bsp, leaves);
   cells.segments.resize(leaves.size());
-  uint32_t thin = 0, uninset = 0;
+  uint32_t thin = 0, uninset = 0, clipped = 0;
+  std::vector<double> near_limit(leaves.size(), std::numeric_limits<double>::infinity());
   for (const BspLeafPiece& piece : bsp_leaf_pieces(bsp)) {
     const uint32_t c = cells.layout.leaf_cell[piece.leaf];
     if (c == pvs::kNoCell || piece.volume.empty()) continue;
-    const BspViewRegion region = bsp_leaf_view_region(piece.volume);
+    const BspViewRegion region = bsp_leaf_view_region(piece.volume, options.near);
     if (region.inset < kBspLeafInset) ++thin;
     if (region.inset == 0) ++uninset;
-    std::vector<Segment> s = bsp_region_segments(region.volume, options.face_spacing);
+    if (region.near_limit < options.near) {
+      ++clipped;
+      near_limit[c] = std::min(near_limit[c], region.near_limit);
+    }
+    std::vector<Segment> s =
+        bsp_region_segments(region.volume, options.adaptive ? 0.0 : options.face_spacing);
     cells.segments[c].insert(cells.segments[c].end(), s.begin(), s.end());
+    if (options.adaptive) {
+      cells.sweeps.resize(leaves.size());
+      for (const FaceSweep& f : region_sweeps(region.volume))
+        cells.sweeps[c].push_back(scene_sweep(f));
+    }
   }
+  if (options.adaptive) cells.sweep_spacing = *options.adaptive;
+  if (clipped > 0) cells.near_limit = std::move(near_limit);
   const char* liquids = options.scene.bsp_liquids == BspLiquids::omit          ? "omit"
                         : options.scene.bsp_liquids == BspLiquids::see_through ? "see-through"
                                                                                : "opaque";
@@ -329,17 +314,26 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
       {"leaves", leaves.size()},
       {"leaf_subset", !options.leaves.empty()},
       {"face_spacing", options.face_spacing},
+      {"face_sweep", options.adaptive ? "adaptive" : "even"},
       {"face_spacing_units", "quake"},
       {"region",
-       "leaf volume inset by inset units (halved down to min_inset for thin leaves, else 0); "
-       "its edges and chords of each face parallel to its longest edge at most face_spacing "
-       "apart"},
+       "leaf volume inset by inset units (halved down to the larger of min_inset and "
+       "clearance for thin leaves, then clearance; a leaf thinner than twice the clearance by "
+       "half its largest inset, its near distance clipped to that over clearance_factor); its "
+       "edges and chords of each face parallel to its longest edge at most face_spacing apart"},
       {"inset", kBspLeafInset},
       {"min_inset", kBspLeafMinInset},
+      {"clearance_factor", kNearClearanceFactor},
+      {"clearance", kNearClearanceFactor * options.near},
       {"leaves_inset_less", thin},
       {"leaves_not_inset", uninset},
+      {"leaves_near_clipped", clipped},
       {"bsp_models", options.scene.bsp_models == BspModels::all ? "all" : "world"},
       {"bsp_liquids", liquids}};
+  if (options.adaptive) {
+    d["chord_coarse"] = options.adaptive->coarse;
+    d["chord_floor"] = options.adaptive->floor;
+  }
   cells.description = d.dump();
   return cells;
 }

@@ -11,10 +11,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/view_cells.h"
+#include "vislib/base/tolerances.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/import.h"
 #include "vislib/scene/quake_bsp.h"
@@ -58,12 +60,21 @@ struct BspCellOptions {
   // The import options the scene was loaded with (bsp_models, bsp_liquids), recorded in the
   // description so that a reader knows what the triangle ids index.
   LoadOptions scene;
+  // Set: each face of a leaf's region is swept adaptively (face_sweep.h: coarse chords, one
+  // inserted between two neighbours while it sees ids neither sees, down to the floor spacing;
+  // Quake units), and face_spacing is not used; the cell's segments are the region's edges.
+  std::optional<AdaptiveSpacing> adaptive = std::nullopt;
+  // The bake's near distance (Quake units, > 0): each view region keeps its eyes clear of the
+  // leaf's surfaces by kNearClearanceFactor times it (bsp_leaf_view_region).
+  double near = kDefaultNear;
 };
 
 // The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
-// bsp_region_segments(bsp_leaf_view_region(volume of its leaf), face_spacing), and a description
-// (JSON) recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
-// kBspLeafMinInset, the count of leaves inset less than kBspLeafInset) and the scene options.
+// bsp_region_segments(bsp_leaf_view_region(volume of its leaf, near), face_spacing), the cells'
+// near_limit (only when some leaf's region clips the near distance), and a description (JSON)
+// recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
+// kBspLeafMinInset, the clearance, the counts of leaves inset less than kBspLeafInset, not inset
+// and with a clipped near distance) and the scene options.
 // Throws std::invalid_argument for leaves that are not an increasing subset of bsp_cell_leaves.
 // Deterministic.
 ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options);

@@ -6,6 +6,7 @@
 #include <cassert>
 #include <iterator>
 
+#include "vislib/bake/face_sweep.h"
 #include "vislib/base/cubemap.h"
 #include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
@@ -52,36 +53,100 @@ RegionOptions group_options(const RegionOptions& options, uint64_t cell_seed, si
   return o;
 }
 
-// The union of segments_visibility over `groups`, each with group_options.
-CellVisibility groups_visibility(const Scene& scene,
+// `options` for cell `cell` of `cells`: its near distance clipped to the cell's near_limit.
+RegionOptions cell_options(const ViewCells& cells, uint32_t cell, const RegionOptions& options) {
+  RegionOptions o = options;
+  if (!cells.near_limit.empty())
+    o.segment.near = std::min(o.segment.near, cells.near_limit.at(cell));
+  return o;
+}
+
+// Runs cell `cell`'s groups in order, each a segments_visibility call with its own seed
+// (group_options), and hands each to `consume(segments, result, options)`, which returns whether
+// more groups are wanted (a cell without sweeps then stops; a sweep's rounds need every round
+// before them, so an adaptive cell runs on): the cell's fixed
+// groups (cell_segment_groups), then, for a cell with adaptive face sweeps (ViewCells::sweeps),
+// the sweep's rounds (face_sweep.h), round r seeded as group (fixed groups + r), whose neighbours
+// at a face's ends see what the fixed groups saw. Ids of spheres count after the triangles in
+// the sweep's comparisons. `progress(fraction)` as in cell_visibility: for an adaptive cell the
+// fraction of the fixed groups and each round is an estimate (the rounds to come are unknown),
+// never decreasing.
+void run_cell_groups(const Scene& scene, const ViewCells* cells,
+                     const std::vector<std::vector<Segment>>& groups, uint32_t cell,
+                     const RegionOptions& options, const std::function<void(double)>& progress,
+                     const std::function<bool(const std::vector<Segment>&, const RegionResult&,
+                                              const RegionOptions&)>& consume) {
+  const bool adaptive = cells && !cells->sweeps.empty() && !cells->sweeps.at(cell).empty();
+  const uint64_t seed = cell_seed(options.seed, cell);
+  const size_t fixed = groups.size();
+  // The share of the progress bar the fixed groups take when rounds follow, and each round's
+  // share of what is left (an estimate: rounds shrink as intervals close).
+  constexpr double kFixedShare = 0.5, kRoundShare = 0.5;
+  double done_before = 0, share = adaptive ? kFixedShare / double(std::max<size_t>(1, fixed)) : 0;
+  if (!adaptive) share = 1.0 / double(std::max<size_t>(1, fixed));
+  bool wanted = true;
+  auto run_group = [&](const std::vector<Segment>& segs, size_t g) {
+    const RegionOptions o = group_options(options, seed, g);
+    std::function<void(size_t, size_t)> run_done;
+    if (progress)
+      run_done = [&](size_t done, size_t total) {
+        progress(done_before + share * double(done) / double(std::max<size_t>(1, total)));
+      };
+    RegionResult rr = segments_visibility(scene, segs, o, run_done);
+    done_before += share;
+    wanted = consume(segs, rr, o) && wanted;
+    return rr;
+  };
+  std::vector<uint32_t> base;
+  const uint32_t tris = uint32_t(scene.triangle_count());
+  auto ids_of_run = [&](const RunRecord& r, std::vector<uint32_t>& out) {
+    std::vector<uint32_t> merged;
+    std::set_union(out.begin(), out.end(), r.visible.begin(), r.visible.end(),
+                   std::back_inserter(merged));
+    for (uint32_t sp : r.visible_spheres)
+      if (merged.empty() || merged.back() < tris + sp) merged.push_back(tris + sp);
+    out = std::move(merged);
+  };
+  for (size_t g = 0; g < fixed && (wanted || adaptive); ++g) {
+    const RegionResult rr = run_group(groups[g], g);
+    if (adaptive)
+      for (const RunRecord& r : rr.runs) ids_of_run(r, base);
+  }
+  if (!adaptive) return;
+  size_t round = 0;
+  adaptive_sweep(cells->sweeps[cell], cells->sweep_spacing, base, kSweepMinChord,
+                 [&](const std::vector<Segment>& segs) {
+                   share = (1.0 - done_before) * kRoundShare;
+                   const RegionResult rr = run_group(segs, fixed + round++);
+                   std::vector<std::vector<uint32_t>> seen(segs.size());
+                   for (const RunRecord& r : rr.runs) ids_of_run(r, seen.at(r.segment));
+                   return seen;
+                 });
+}
+
+// The union of the cell's groups (run_cell_groups).
+CellVisibility groups_visibility(const Scene& scene, const ViewCells* cells,
                                  const std::vector<std::vector<Segment>>& groups, uint32_t cell,
                                  const RegionOptions& options,
                                  const std::function<void(double)>& progress) {
   CellVisibility out;
-  for (const std::vector<Segment>& g : groups)
-    out.segments.insert(out.segments.end(), g.begin(), g.end());
-  const int count = int(groups.size());
-  const uint64_t seed = cell_seed(options.seed, cell);
-  for (int r = 0; r < count; ++r) {
-    const RegionOptions o = group_options(options, seed, size_t(r));
-    std::function<void(size_t, size_t)> run_done;
-    if (progress)
-      run_done = [&](size_t done, size_t total) {
-        progress((double(r) + double(done) / double(std::max<size_t>(1, total))) / double(count));
-      };
-    RegionResult rr = segments_visibility(scene, groups[r], o, run_done);
-    PhaseScope merging(Phase::Merge);
-    std::vector<uint32_t> merged;
-    merged.reserve(out.triangles.size() + rr.visible.size());
-    std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(), rr.visible.end(),
-                   std::back_inserter(merged));
-    out.triangles = std::move(merged);
-    merged.clear();
-    std::set_union(out.spheres.begin(), out.spheres.end(), rr.visible_spheres.begin(),
-                   rr.visible_spheres.end(), std::back_inserter(merged));
-    out.spheres = std::move(merged);
-    out.seconds += rr.seconds;
-  }
+  run_cell_groups(
+      scene, cells, groups, cell, options, progress,
+      [&](const std::vector<Segment>& segs, const RegionResult& rr, const RegionOptions&) {
+        out.segments.insert(out.segments.end(), segs.begin(), segs.end());
+        PhaseScope merging(Phase::Merge);
+        std::vector<uint32_t> merged;
+        merged.reserve(out.triangles.size() + rr.visible.size());
+        std::set_union(out.triangles.begin(), out.triangles.end(), rr.visible.begin(),
+                       rr.visible.end(), std::back_inserter(merged));
+        out.triangles = std::move(merged);
+        merged.clear();
+        std::set_union(out.spheres.begin(), out.spheres.end(), rr.visible_spheres.begin(),
+                       rr.visible_spheres.end(), std::back_inserter(merged));
+        out.spheres = std::move(merged);
+        out.seconds += rr.seconds;
+        return true;
+      });
   return out;
 }
 
@@ -102,44 +167,45 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
   assert(layout.kind != pvs::LayoutKind::BspTree);  // BSP leaf cells: pass their ViewCells
-  return groups_visibility(scene, rectangle_groups(layout, cell), cell, options, progress);
+  return groups_visibility(scene, nullptr, rectangle_groups(layout, cell), cell, options, progress);
 }
 
 CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
-  return groups_visibility(scene, cell_segment_groups(cells, cell), cell, options, progress);
+  return groups_visibility(scene, &cells, cell_segment_groups(cells, cell), cell,
+                           cell_options(cells, cell, options), progress);
 }
 
 std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,
                                               uint32_t cell, const RegionOptions& options,
                                               const std::vector<uint32_t>& wanted) {
   assert(options.shared_runs == nullptr);
-  const std::vector<std::vector<Segment>> groups = cell_segment_groups(cells, cell);
-  const uint64_t seed = cell_seed(options.seed, cell);
+  RegionOptions with_witnesses = cell_options(cells, cell, options);
+  with_witnesses.segment.want_witnesses = true;
   const int n = options.segment.resolution;
   std::vector<CellWitnessRay> out;
   std::vector<uint8_t> found(wanted.size(), 0);
   size_t left = wanted.size(), first_segment = 0;
-  for (size_t r = 0; r < groups.size() && left > 0; ++r) {
-    RegionOptions o = group_options(options, seed, r);
-    o.segment.want_witnesses = true;
-    const RegionResult rr = segments_visibility(scene, groups[r], o);
-    for (size_t i = 0; i < rr.visible.size(); ++i) {
-      const auto it = std::lower_bound(wanted.begin(), wanted.end(), rr.visible[i]);
-      if (it == wanted.end() || *it != rr.visible[i] || found[size_t(it - wanted.begin())])
-        continue;
-      found[size_t(it - wanted.begin())] = 1;
-      --left;
-      const RegionWitness& w = rr.witnesses[i];
-      const Segment& s = groups[r][w.segment];
-      const Mat3& R = rr.runs[w.segment * size_t(o.runs) + size_t(w.run)].orientation;
-      const Vec3 d = pixel_direction(face_axes(w.witness.face, R), w.witness.x, w.witness.y, n);
-      out.push_back({rr.visible[i], s.from + (s.to - s.from) * w.witness.t, d * (1.0 / length(d)),
-                     first_segment + w.segment, w.run, w.witness.t});
-    }
-    first_segment += groups[r].size();
-  }
+  run_cell_groups(
+      scene, &cells, cell_segment_groups(cells, cell), cell, with_witnesses, {},
+      [&](const std::vector<Segment>& segs, const RegionResult& rr, const RegionOptions& o) {
+        for (size_t i = 0; i < rr.visible.size() && left > 0; ++i) {
+          const auto it = std::lower_bound(wanted.begin(), wanted.end(), rr.visible[i]);
+          if (it == wanted.end() || *it != rr.visible[i] || found[size_t(it - wanted.begin())])
+            continue;
+          found[size_t(it - wanted.begin())] = 1;
+          --left;
+          const RegionWitness& w = rr.witnesses[i];
+          const Segment& s = segs[w.segment];
+          const Mat3& R = rr.runs[w.segment * size_t(o.runs) + size_t(w.run)].orientation;
+          const Vec3 d = pixel_direction(face_axes(w.witness.face, R), w.witness.x, w.witness.y, n);
+          out.push_back({rr.visible[i], s.from + (s.to - s.from) * w.witness.t,
+                         d * (1.0 / length(d)), first_segment + w.segment, w.run, w.witness.t});
+        }
+        first_segment += segs.size();
+        return left > 0;
+      });
   std::sort(out.begin(), out.end(),
             [](const CellWitnessRay& a, const CellWitnessRay& b) { return a.tri < b.tri; });
   return out;

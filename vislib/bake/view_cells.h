@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/face_sweep.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/scene.h"
 
@@ -38,6 +39,15 @@ struct ViewCells {
   // the perimeters of its view region's rectangles (cell_visibility.h), for cells whose region
   // is not a box (BSP leaves: bsp_cells.h). Scene coordinates.
   std::vector<std::vector<Segment>> segments;
+  // Empty, or one value per cell: the largest near distance (scene units) at which the cell's
+  // eyes see no surface cut by the near plane (a BSP leaf thinner than twice the clearance,
+  // quake_bsp_volumes.h); the cell's runs use the smaller of it and the bake's near.
+  std::vector<double> near_limit;
+  // Empty, or one list per cell: faces of the cell's view region swept by chords inserted where
+  // the visible set changes (face_sweep.h: adaptive_sweep at sweep_spacing), run after the cell's
+  // segments, which then hold the region's edges (cell_visibility.h).
+  std::vector<std::vector<FaceSweep>> sweeps;
+  AdaptiveSpacing sweep_spacing;
 };
 
 pvs::Box to_pvs_box(const Box3& b);

@@ -95,23 +95,30 @@ long temp_owner(const std::string& entry, const std::string& name) {
   return digits(pid) ? std::atol(pid.c_str()) : 0;
 }
 
-// Removes temporaries of `name` in `dir` whose writer no longer runs here and which have not been
-// touched for 10 minutes. Best effort: errors are ignored.
-void remove_stale_temps(const std::string& dir, const std::string& name) {
+// A temporary whose writer may still be running is kept for this long after its last change
+// (seconds): a pid that does not run here now may belong to another machine sharing the folder.
+constexpr time_t kStaleTempAge = 600;
+
+// Removes the regular files among the temporaries of `name` in `dir` (temp_owner) that another
+// process left: with `writers_may_live`, only those whose writer no longer runs here and which
+// have not been touched for kStaleTempAge; without, all of them (the caller holds the lock every
+// writer holds, so none of their writers is alive). This process's own are kept. Best effort:
+// errors are ignored.
+void remove_others_temps(const std::string& dir, const std::string& name, bool writers_may_live) {
   DIR* d = ::opendir(dir.c_str());
   if (!d) return;
   const time_t now = ::time(nullptr);
   while (dirent* e = ::readdir(d)) {
     std::string entry = e->d_name;
     long pid = temp_owner(entry, name);
-    if (pid <= 0) continue;
-    if (pid == ::getpid() || ::kill(pid_t(pid), 0) == 0 || errno != ESRCH)
+    if (pid <= 0 || pid == ::getpid()) continue;
+    if (writers_may_live && (::kill(pid_t(pid), 0) == 0 || errno != ESRCH))
       continue;  // alive (or unknown)
     std::string full = dir + "/" + entry;
     struct stat st;
     if (::lstat(full.c_str(), &st) != 0 || !S_ISREG(st.st_mode))
       continue;  // never a link or folder
-    if (now - st.st_mtime < 600) continue;
+    if (writers_may_live && now - st.st_mtime < kStaleTempAge) continue;
     ::unlink(full.c_str());
   }
   ::closedir(d);
@@ -129,7 +136,7 @@ void fsync_folder(const std::string& dir) {
 AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   std::string dir, name;
   split_path(path, dir, name);
-  remove_stale_temps(dir, name);
+  remove_others_temps(dir, name, true);
   for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
     tmp_ = (dir == "/" ? "" : dir) + "/." + name + "." + std::to_string(::getpid()) + "." +
            random_suffix() + ".tmp";
@@ -173,6 +180,12 @@ void AtomicFile::commit() {
     io_fail(path_, "cannot rename " + tmp_ + " into place", errno);
   committed_ = true;
   fsync_folder_of(path_);
+}
+
+void remove_dead_writers_temps(const std::string& path) {
+  std::string dir, name;
+  split_path(path, dir, name);
+  remove_others_temps(dir, name, false);
 }
 
 void write_file_atomic(const std::string& path, const std::string& bytes) {

@@ -45,6 +45,13 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+// Removes every temporary of AtomicFile's naming left for `path` by another process, whatever its
+// age and whether or not its pid runs now (a pid may have been reused), and keeps this process's
+// own. Only for a caller that holds the lock every writer of `path` takes (pvs bake's
+// OUTPUT.lock, FileLock below): holding it proves that no other writer of `path` is alive, so a
+// killed bake's temporaries go at once instead of after AtomicFile's ten minutes. Best effort.
+void remove_dead_writers_temps(const std::string& path);
+
 // Writes `bytes` to `path` through an AtomicFile (see above).
 void write_file_atomic(const std::string& path, const std::string& bytes);
 

@@ -30,10 +30,10 @@ struct Context {
   const QuakeBsp& bsp;
   const Scene& scene;
   const EmbreeScene& embree;
-  const VisCompareOptions& opt;
-  std::vector<uint32_t> tri_plane;   // map plane of each triangle's face (kNoPlane: none)
-  std::vector<uint8_t> degenerate;   // per triangle
-  std::vector<uint8_t> never_drawn;  // per triangle: its face is in no marksurfaces
+  const VisCompareOptions& opt;             // z_near: the cell's (its leaf's near_limit applied)
+  const std::vector<uint32_t>& tri_plane;   // map plane of each triangle's face (kNoPlane: none)
+  const std::vector<uint8_t>& degenerate;   // per triangle
+  const std::vector<uint8_t>& never_drawn;  // per triangle: its face is in no marksurfaces
 };
 
 bool inside(const ConvexPolytope& p, Vec3 q) {
@@ -324,29 +324,24 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
       marked[bsp.marksurfaces[l.first_marksurface + i]] = 1;
   const Box3 bounds = scene.bounds();
   const EmbreeScene embree(scene, 0, tris ? (bounds.min + bounds.max) * 0.5 : Vec3{0, 0, 0});
-  Context ctx{bsp,
-              scene,
-              embree,
-              options,
-              std::vector<uint32_t>(tris, kNoPlane),
-              std::vector<uint8_t>(tris, 0),
-              std::vector<uint8_t>(tris, 0)};
+  std::vector<uint32_t> tri_plane(tris, kNoPlane);
+  std::vector<uint8_t> degenerate(tris, 0), never_drawn(tris, 0);
   for (uint32_t f = 0; f < faces.size(); ++f) {
     const BspFaceTriangles& ft = faces[f];
     if (!ft.imported || ft.triangle_count == 0) continue;
     if (!marked[f]) ++result.never_drawn_faces;
     for (uint32_t t = ft.first_triangle; t < ft.first_triangle + ft.triangle_count; ++t) {
-      ctx.tri_plane[t] = bsp.faces[f].plane;
-      ctx.never_drawn[t] = !marked[f];
+      tri_plane[t] = bsp.faces[f].plane;
+      never_drawn[t] = !marked[f];
     }
   }
   for (size_t t = 0; t < tris; ++t) {
     const auto& v = scene.triangles[t];
     const Vec3 p0 = scene.positions[0][v[0]];
     const Vec3 n = cross(scene.positions[0][v[1]] - p0, scene.positions[0][v[2]] - p0);
-    ctx.degenerate[t] = n.x == 0 && n.y == 0 && n.z == 0;
-    result.degenerate_triangles += ctx.degenerate[t];
-    result.never_drawn_triangles += ctx.never_drawn[t] && !ctx.degenerate[t];
+    degenerate[t] = n.x == 0 && n.y == 0 && n.z == 0;
+    result.degenerate_triangles += degenerate[t];
+    result.never_drawn_triangles += never_drawn[t] && !degenerate[t];
   }
 
   std::vector<int64_t> piece_of(bsp.leaves.size(), -1);
@@ -366,8 +361,8 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
     for (uint32_t t : ours[c]) in_ours[t] = 1;
     for (uint32_t t : theirs) in_theirs[t] = 1;
     for (uint32_t t : ours[c]) {
-      if (ctx.degenerate[t]) continue;
-      if (ctx.never_drawn[t]) {
+      if (degenerate[t]) continue;
+      if (never_drawn[t]) {
         ++row.never_drawn;
         continue;
       }
@@ -375,7 +370,7 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
       if (in_theirs[t]) ++row.common;
     }
     for (uint32_t t : theirs)
-      if (!ctx.degenerate[t]) {
+      if (!degenerate[t]) {
         ++row.theirs;
         if (!in_ours[t]) row.lacks.push_back(t);
       }
@@ -383,11 +378,14 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
     Rng witness_rng(Rng::derive(options.seed, 2 * uint64_t(c)));
     Rng sample_rng(Rng::derive(options.seed, 2 * uint64_t(c) + 1));
     ConvexPolytope region;
+    VisCompareOptions cell_options = options;
     if (piece_of[leaf] >= 0) {
-      BspViewRegion r = bsp_leaf_view_region(pieces[size_t(piece_of[leaf])].volume);
+      BspViewRegion r = bsp_leaf_view_region(pieces[size_t(piece_of[leaf])].volume, options.z_near);
       region = std::move(r.volume);
       row.inset = r.inset;
+      cell_options.z_near = std::min(options.z_near, r.near_limit);
     }
+    const Context ctx{bsp, scene, embree, cell_options, tri_plane, degenerate, never_drawn};
     const std::vector<Vec3> region_corners = corners(region);
     std::vector<Vec3> eyes;  // scene coordinates
     if (!region_corners.empty()) {

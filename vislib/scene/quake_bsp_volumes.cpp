@@ -3,6 +3,8 @@
 // construction of the Quake map compilers).
 #include "vislib/scene/quake_bsp_volumes.h"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace vislib {
@@ -83,11 +85,28 @@ ConvexPolytope inset_polytope(const ConvexPolytope& p, double distance) {
   return make_polytope(hs, size);
 }
 
-BspViewRegion bsp_leaf_view_region(const ConvexPolytope& leaf_volume) {
-  for (double d = kBspLeafInset; d >= kBspLeafMinInset; d /= 2) {
+BspViewRegion bsp_leaf_view_region(const ConvexPolytope& leaf_volume, double near) {
+  assert(near > 0);
+  const double clearance = kNearClearanceFactor * near;
+  const double smallest = std::max(kBspLeafMinInset, clearance);
+  for (double d = std::max(kBspLeafInset, clearance); d >= smallest; d /= 2) {
     ConvexPolytope v = inset_polytope(leaf_volume, d);
     if (!v.empty()) return {std::move(v), d};
   }
+  if (ConvexPolytope v = inset_polytope(leaf_volume, clearance); !v.empty())
+    return {std::move(v), clearance};
+  // Thinner than twice the clearance: the largest inset that leaves a volume, by bisection
+  // (emptiness grows with the inset), then half of it.
+  constexpr int kBisections = 64;
+  double lo = 0, hi = clearance;
+  for (int i = 0; i < kBisections; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (inset_polytope(leaf_volume, mid).empty() ? hi : lo) = mid;
+  }
+  const double d = 0.5 * lo;
+  if (d > 0)
+    if (ConvexPolytope v = inset_polytope(leaf_volume, d); !v.empty())
+      return {std::move(v), d, d / kNearClearanceFactor};
   return {leaf_volume, 0};
 }
 

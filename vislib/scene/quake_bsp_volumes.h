@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "vislib/base/vec.h"
@@ -59,14 +60,30 @@ constexpr double kBspLeafInset = 1.0;
 // The smallest inset tried for a leaf too thin for kBspLeafInset (Quake units).
 constexpr double kBspLeafMinInset = 1.0 / 64;
 
-// The view region of a leaf whose volume is `leaf_volume` (not empty): the volume inset by
-// kBspLeafInset; a leaf too thin for that (nothing left) is inset by the largest of
-// kBspLeafInset / 2^k, k = 1, 2, ..., down to kBspLeafMinInset, that leaves a volume, and by 0
-// (the volume itself) when none does. `inset` is the distance used.
+// An eye must lie at least this many near distances from every surface (unitless): a point at
+// distance r from the eye has view-space depth at least r / sqrt(3) on the cube-map face it
+// projects to (its largest coordinate in any orthonormal frame is at least r / sqrt(3)), so a
+// surface that far or farther is never cut by the near plane, and never seen through
+// (docs/visibility-math.md "The near plane and the view region").
+constexpr double kNearClearanceFactor = 1.7320508075688772;
+
+// The view region of a leaf whose volume is `leaf_volume` (not empty), for a bake whose near
+// distance is `near` (> 0, Quake units). Its boundary faces hold the world's surfaces, so every eye
+// of the region keeps a clearance c = kNearClearanceFactor * near from every plane of the volume:
+//  - the volume inset by the largest of max(kBspLeafInset, c) / 2^k, k = 0, 1, ..., that is at
+//    least max(kBspLeafMinInset, c) and leaves a volume, else by exactly c if that leaves one;
+//  - a leaf thinner than 2c (nothing is left at c) is inset by half of the largest inset that
+//    leaves a volume (found by bisection), and the near distance of its runs is clipped to
+//    near_limit = inset / kNearClearanceFactor, so that its eyes still see no surface cut by the
+//    near plane;
+//  - a volume that leaves nothing at any inset tried (none of positive volume does) is its own
+//    region with inset 0 and no limit.
+// `inset` is the distance used; near_limit is +infinity unless the near distance is clipped.
 struct BspViewRegion {
   ConvexPolytope volume;
   double inset = 0;
+  double near_limit = std::numeric_limits<double>::infinity();
 };
-BspViewRegion bsp_leaf_view_region(const ConvexPolytope& leaf_volume);
+BspViewRegion bsp_leaf_view_region(const ConvexPolytope& leaf_volume, double near);
 
 }  // namespace vislib

@@ -1,0 +1,110 @@
+// Tests of the face sweeps (vislib/bake/face_sweep.h): the even chords are the ones the BSP leaf
+// bake always ran, and the adaptive sweep inserts chords only where the set changes, down to its
+// floor, and finds what only a chord between two coarse ones sees.
+#include "vislib/bake/face_sweep.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+namespace vislib {
+namespace {
+
+// A 100 x 10 rectangle in the z = 0 plane, swept across y (chords parallel to x, its long edge).
+FaceSweep rectangle() {
+  const std::vector<Vec3> face = {{0, 0, 0}, {100, 0, 0}, {100, 10, 0}, {0, 10, 0}};
+  auto s = face_sweep_of(face, {0, 0, 1}, kSweepMinChord);
+  EXPECT_TRUE(s.has_value());
+  return *s;
+}
+
+// A 10 x 100 rectangle swept across x: chords parallel to y at x = h.
+FaceSweep wide() {
+  const std::vector<Vec3> face = {{0, 0, 0}, {0, 100, 0}, {100, 100, 0}, {100, 0, 0}};
+  auto s = face_sweep_of(face, {0, 0, -1}, kSweepMinChord);
+  EXPECT_TRUE(s.has_value());
+  return *s;
+}
+
+TEST(FaceSweep, EvenChordsLieAcrossTheFaceAtMostTheSpacingApart) {
+  const FaceSweep s = rectangle();
+  EXPECT_NEAR(std::fabs(s.along.x), 1, 1e-15);
+  EXPECT_NEAR(s.hi - s.lo, 10, 1e-12);
+  const std::vector<Segment> c = even_chords(s, 4, kSweepMinChord);
+  ASSERT_EQ(c.size(), 2u);  // ceil(10 / 4) = 3 steps: y = 10/3, 20/3
+  for (const Segment& seg : c) {
+    EXPECT_NEAR(std::fabs(seg.to.x - seg.from.x), 100, 1e-9);
+    EXPECT_NEAR(seg.from.y, seg.to.y, 1e-12);
+  }
+  EXPECT_TRUE(even_chords(s, 10, kSweepMinChord).empty());  // not wider than the spacing
+}
+
+// The chord position of a segment of wide(): its x.
+double position(const Segment& s) {
+  return s.from.x;
+}
+
+// A fake round: what a chord at x sees is `see(x)`; records every position run, by round.
+struct FakeScene {
+  std::function<std::vector<uint32_t>(double)> see;
+  std::vector<std::vector<double>> rounds;
+  ChordRound round() {
+    return [this](const std::vector<Segment>& chords) {
+      rounds.emplace_back();
+      std::vector<std::vector<uint32_t>> out;
+      for (const Segment& c : chords) {
+        rounds.back().push_back(position(c));
+        out.push_back(see(position(c)));
+      }
+      return out;
+    };
+  }
+};
+
+// Over a flat wall (every chord sees what the edges see) the sweep runs the coarse chords and one
+// probe between each two neighbours, and stops: far fewer than an even sweep at the floor.
+TEST(FaceSweep, AdaptiveSweepOverAFlatWallStopsAfterTheFirstProbes) {
+  FakeScene flat{[](double) { return std::vector<uint32_t>{1, 2}; }, {}};
+  const size_t run = adaptive_sweep({wide()}, {32, 4}, {1, 2}, kSweepMinChord, flat.round());
+  ASSERT_EQ(flat.rounds.size(), 2u);
+  EXPECT_EQ(flat.rounds[0].size(), 3u);  // ceil(100 / 32) = 4 intervals: 3 coarse chords
+  EXPECT_EQ(flat.rounds[1].size(), 4u);  // one probe in each interval
+  EXPECT_EQ(run, 7u);
+  EXPECT_LT(run, even_chords(wide(), 4, kSweepMinChord).size());
+}
+
+// A slit seen only from 44.5 < x < 45.5, inside a stretch 20 < x < 60 where every chord sees an id
+// of its own (the view changes there): the sweep keeps inserting chords around the change and
+// finds the slit once its floor allows a chord there; the coarse chords alone, and a floor too
+// wide, do not.
+TEST(FaceSweep, AdaptiveSweepInsertsChordsWhereTheSetChangesAndFindsASlit) {
+  auto see = [](double x) {
+    std::vector<uint32_t> ids = {1};
+    if (x > 20 && x < 60) ids.push_back(100 + uint32_t(std::lround(x)));
+    if (x > 44.5 && x < 45.5) ids.push_back(2);
+    return ids;
+  };
+  auto found_slit = [&](const AdaptiveSpacing& spacing, size_t* runs) {
+    FakeScene scene{see, {}};
+    *runs = adaptive_sweep({wide()}, spacing, {1}, kSweepMinChord, scene.round());
+    std::set<double> all;
+    for (const auto& r : scene.rounds) all.insert(r.begin(), r.end());
+    bool slit = false;
+    for (double x : all) slit = slit || (x > 44.5 && x < 45.5);
+    return slit;
+  };
+  size_t fine = 0, coarse_only = 0;
+  EXPECT_TRUE(found_slit({64, 1}, &fine));
+  EXPECT_FALSE(found_slit({64, 4}, &coarse_only));
+  // Fewer chords than an even sweep fine enough to hit the slit (1 apart), though the view
+  // changes over 40 of the 100 units.
+  EXPECT_LT(fine, even_chords(wide(), 1, kSweepMinChord).size());
+  // Deterministic.
+  size_t again = 0;
+  found_slit({64, 1}, &again);
+  EXPECT_EQ(again, fine);
+}
+
+}  // namespace
+}  // namespace vislib

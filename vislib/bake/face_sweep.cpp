@@ -1,0 +1,166 @@
+// face_sweep.cpp: even and adaptive chord sweeps of a face (face_sweep.h).
+#include "vislib/bake/face_sweep.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <iterator>
+
+namespace vislib {
+
+std::optional<FaceSweep> face_sweep_of(const std::vector<Vec3>& face, Vec3 normal,
+                                       double min_length) {
+  const size_t m = face.size();
+  if (m < 3) return std::nullopt;
+  size_t longest = 0;
+  for (size_t i = 1; i < m; ++i)
+    if (length(face[(i + 1) % m] - face[i]) > length(face[(longest + 1) % m] - face[longest]))
+      longest = i;
+  Vec3 d = face[(longest + 1) % m] - face[longest];
+  if (length(d) <= min_length) return std::nullopt;
+  d = d * (1.0 / length(d));
+  Vec3 w = cross(normal, d);
+  if (!(length(w) > 0)) return std::nullopt;
+  w = w * (1.0 / length(w));
+  FaceSweep s{face, d, w, dot(w, face[0]), dot(w, face[0])};
+  for (const Vec3& p : face) {
+    s.lo = std::min(s.lo, dot(w, p));
+    s.hi = std::max(s.hi, dot(w, p));
+  }
+  if (!(s.hi - s.lo > min_length)) return std::nullopt;
+  return s;
+}
+
+std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_length) {
+  const std::vector<Vec3>& poly = sweep.face;
+  const size_t m = poly.size();
+  bool any = false;
+  Vec3 a{}, b{};
+  double ta = 0, tb = 0;
+  for (size_t i = 0; i < m; ++i) {
+    const Vec3& u = poly[i];
+    const Vec3& v = poly[(i + 1) % m];
+    const double hu = dot(sweep.across, u), hv = dot(sweep.across, v);
+    if (hu == hv || h < std::min(hu, hv) || h > std::max(hu, hv)) continue;
+    const Vec3 p = u + (v - u) * ((h - hu) / (hv - hu));
+    const double t = dot(sweep.along, p);
+    if (!any || t < ta) {
+      a = p;
+      ta = t;
+    }
+    if (!any || t > tb) {
+      b = p;
+      tb = t;
+    }
+    any = true;
+  }
+  if (!any || !(length(b - a) > min_length)) return std::nullopt;
+  return Segment{a, b};
+}
+
+namespace {
+
+// The even grid's interval count over the sweep's width at most `spacing` apart (>= 1).
+int even_steps(const FaceSweep& sweep, double spacing) {
+  const double width = sweep.hi - sweep.lo;
+  return width > spacing ? int(std::ceil(width / spacing)) : 1;
+}
+
+double even_position(const FaceSweep& sweep, int k, int steps) {
+  return sweep.lo + (sweep.hi - sweep.lo) * double(k) / double(steps);
+}
+
+}  // namespace
+
+std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double min_length) {
+  assert(spacing > 0);
+  std::vector<Segment> out;
+  const int steps = even_steps(sweep, spacing);
+  for (int k = 1; k < steps; ++k)
+    if (auto c = face_chord(sweep, even_position(sweep, k, steps), min_length)) out.push_back(*c);
+  return out;
+}
+
+size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
+                      const std::vector<uint32_t>& base, double min_length,
+                      const ChordRound& run_round) {
+  assert(spacing.floor > 0 && spacing.floor <= spacing.coarse);
+  // Every position's set, by index (0: `base`, what a face's extreme positions and a degenerate
+  // chord see); an open interval is one whose midpoint the next round probes.
+  std::vector<std::vector<uint32_t>> sets = {base};
+  struct Interval {
+    size_t face;
+    double a, b;
+    size_t set_a, set_b;
+  };
+  std::vector<Interval> open;
+  // Round 0: the coarse grid.
+  std::vector<Segment> chords;
+  struct Probe {
+    size_t face;
+    double h;
+  };
+  std::vector<Probe> probes;
+  std::vector<std::vector<double>> grid(sweeps.size());
+  for (size_t f = 0; f < sweeps.size(); ++f) {
+    const int steps = even_steps(sweeps[f], spacing.coarse);
+    for (int k = 0; k <= steps; ++k) grid[f].push_back(even_position(sweeps[f], k, steps));
+    for (int k = 1; k < steps; ++k) probes.push_back({f, grid[f][size_t(k)]});
+  }
+  // Runs `probes` as one round; returns the set index of each (0 for a degenerate chord).
+  size_t run = 0;
+  auto run_probes = [&]() {
+    std::vector<Segment> segs;
+    std::vector<size_t> which;
+    for (size_t i = 0; i < probes.size(); ++i)
+      if (auto c = face_chord(sweeps[probes[i].face], probes[i].h, min_length)) {
+        segs.push_back(*c);
+        which.push_back(i);
+      }
+    std::vector<size_t> index(probes.size(), 0);
+    if (segs.empty()) return index;
+    std::vector<std::vector<uint32_t>> seen = run_round(segs);
+    assert(seen.size() == segs.size());
+    run += segs.size();
+    for (size_t j = 0; j < which.size(); ++j) {
+      index[which[j]] = sets.size();
+      sets.push_back(std::move(seen[j]));
+    }
+    return index;
+  };
+  {
+    const std::vector<size_t> index = run_probes();
+    size_t p = 0;
+    for (size_t f = 0; f < sweeps.size(); ++f) {
+      std::vector<size_t> at(grid[f].size(), 0);
+      for (size_t k = 1; k + 1 < grid[f].size(); ++k) at[k] = index[p++];
+      for (size_t k = 0; k + 1 < grid[f].size(); ++k)
+        if (grid[f][k + 1] - grid[f][k] > spacing.floor)
+          open.push_back({f, grid[f][k], grid[f][k + 1], at[k], at[k + 1]});
+    }
+  }
+  while (!open.empty()) {
+    probes.clear();
+    for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b)});
+    const std::vector<size_t> index = run_probes();
+    std::vector<Interval> next;
+    std::vector<uint32_t> both;
+    for (size_t k = 0; k < open.size(); ++k) {
+      const Interval& i = open[k];
+      const double m = probes[k].h;
+      both.clear();
+      std::set_union(sets[i.set_a].begin(), sets[i.set_a].end(), sets[i.set_b].begin(),
+                     sets[i.set_b].end(), std::back_inserter(both));
+      const std::vector<uint32_t>& s = sets[index[k]];
+      if (std::includes(both.begin(), both.end(), s.begin(), s.end())) continue;
+      if (m - i.a > spacing.floor) {
+        next.push_back({i.face, i.a, m, i.set_a, index[k]});
+        next.push_back({i.face, m, i.b, index[k], i.set_b});
+      }
+    }
+    open = std::move(next);
+  }
+  return run;
+}
+
+}  // namespace vislib

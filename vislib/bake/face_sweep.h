@@ -1,0 +1,75 @@
+// face_sweep.h: a face of a view region swept by parallel chords, evenly or where the visible set
+// changes.
+//
+// What an eye inside a convex region that holds no geometry sees is seen from the region's
+// boundary, and the boundary's faces are sampled by chords: segments across a face, parallel to
+// one direction. The even sweep places them at equal steps; the adaptive sweep (docs/quake.md
+// "Chords where the set changes") starts coarse and inserts a chord between two neighbours only
+// while the new chord sees ids that neither neighbour sees, down to a floor spacing: a flat wall
+// costs a few chords, a doorway as many as it needs.
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <vector>
+
+#include "vislib/base/vec.h"
+#include "vislib/kernel/region_visibility.h"
+
+namespace vislib {
+
+// A convex planar face (its vertices in order, any winding) swept by the chords
+// face ∩ {x : dot(across, x) = h} for lo < h < hi, where [lo, hi] is the face's extent along the
+// unit vector `across` (which lies in the face's plane, perpendicular to the chords, whose unit
+// direction is `along`).
+struct FaceSweep {
+  std::vector<Vec3> face;
+  Vec3 along, across;
+  double lo = 0, hi = 0;
+};
+
+// Chords shorter than this (scene units) are points and are not run (a chord at a face's vertex);
+// the faces of BSP leaf volumes agree to about 1e-12 units.
+constexpr double kSweepMinChord = 1e-6;
+
+// The sweep of `face` (convex, planar, normal `normal`) by chords parallel to its longest edge
+// (the first such edge in vertex order); nothing when that edge or the face's width is shorter
+// than `min_length`.
+std::optional<FaceSweep> face_sweep_of(const std::vector<Vec3>& face, Vec3 normal,
+                                       double min_length);
+
+// The chord of `sweep` at h (lo <= h <= hi): from the face's boundary point with the smallest to
+// the one with the largest coordinate along the chords. Nothing when it is shorter than
+// `min_length` (at a vertex of the face, say).
+std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_length);
+
+// The even sweep: chords at h = lo + k (hi - lo) / n, k = 1 .. n - 1, with n = ceil((hi - lo) /
+// spacing) (at most `spacing` apart), in increasing k; none when the width is not larger than
+// spacing. `spacing` > 0.
+std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double min_length);
+
+// The spacings of the adaptive sweep (the sweeps' units): the first chords lie at most `coarse`
+// apart (the even sweep's positions); a chord is inserted midway between two neighbours (a face's
+// own extreme positions count as neighbours that see `base`, below) whose distance is larger
+// than `floor`, and kept on the grid of halvings, while the last one inserted there saw an id
+// that neither neighbour saw. 0 < floor <= coarse.
+struct AdaptiveSpacing {
+  double coarse = 64;
+  double floor = 4;
+};
+
+// Sees one round of chords: `chords` (run as one group of segments) and, for each chord, the
+// sorted ids it saw (triangles, then spheres offset by the triangle count: any sorted id space
+// does). Called once per round, in round order; returns the per-chord sets.
+using ChordRound = std::function<std::vector<std::vector<uint32_t>>(const std::vector<Segment>&)>;
+
+// Runs the adaptive sweep of `sweeps` together, round by round: round 0 holds every face's even
+// chords at `spacing.coarse`, round r + 1 the midpoints of the intervals that round r (or, for
+// round 1, the coarse grid with its ends) left open. `base` (sorted) is what the face's extreme
+// positions see (the region's edges). Deterministic: the chords of each round are in face order,
+// then increasing position. Returns the number of chords run.
+size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
+                      const std::vector<uint32_t>& base, double min_length,
+                      const ChordRound& run_round);
+
+}  // namespace vislib
