@@ -8,12 +8,23 @@
 #                     [--png DIR --png-frames 0,4,9] [--size WxH] [--fov DEG] [--bare]
 #                     [--popping K] [--near-far r1,r2 [--centre x,y,z] [--env-size N]
 #                      [--lookup eye|cylinder] [--clovr]] [--prefetch MARGIN]
+#                     [--mode ods|stereo] [--ods-size W] [--ipd M] [--units-per-metre S]
+#                     [--pole-merge s,e,x[:s,e,x]] [--tessellation dynamic|K] [--reps N]
+#                     [--dominant left|right] [--patch yoro|median|none|render]
+#                     [--compare multiview|two]
+# --mode ods: each path point is the centre of an ODS pair (WebGPU; docs/web.md): the PNGs are
+# the W x W top-bottom pairs, --reps N renders each N more times (ms: the median); the page shows
+# the pair through a read-back (display=2d: presenting a WebGPU canvas loses the device in
+# headless chromium's SwiftShader).
+# --mode stereo: single-render stereo (render the dominant eye, reproject, patch); the PNGs are
+# left | right side by side at --size per eye.
 # --popping K: the popping meter every K frames (popping_pixels per measured frame).
 # --clovr: the near region grows by the CloVR scheduler on entering a cell (per frame: clovr).
 # --bare: the frames without the overlays (to compare with pvs inspect --render's frames).
 # --near-far without --centre: each cell's centre is pvs view's (pvs export --centres); per frame
 # `centre` and `centre_source`.
-# Exit: 0 done, 1 the page failed, 2 bad arguments or missing build, 77 chromium cannot start.
+# Exit: 0 done, 1 the page failed, 2 bad arguments or missing build, 77 chromium cannot start (or
+# offers no WebGPU for --mode ods|stereo).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 usage() { sed -n 's/^# Usage: //p;s/^#   *\(\[--png.*\)/\1/p' "$0" >&2; exit 2; }
@@ -46,6 +57,16 @@ while [[ $# -gt 0 ]]; do
     --env-size) extra+="&envsize=$2" ;;
     --lookup) extra+="&lookup=$2" ;;
     --prefetch) extra+="&prefetch=$2" ;;
+    --mode) extra+="&mode=$2"; [[ $2 == ods ]] && extra+="&display=2d" ;;
+    --ods-size) extra+="&odssize=$2" ;;
+    --ipd) extra+="&ipd=$2" ;;
+    --units-per-metre) extra+="&upm=$2" ;;
+    --pole-merge) extra+="&polemerge=$2" ;;
+    --tessellation) extra+="&tess=$2" ;;
+    --reps) extra+="&reps=$2" ;;
+    --dominant) extra+="&dominant=$2" ;;
+    --patch) extra+="&patch=$2" ;;
+    --compare) extra+="&compare=$2" ;;
     *) echo "web-check: unknown option $1" >&2; usage ;;
   esac
   shift 2
