@@ -95,6 +95,60 @@ precision highp float;
 flat in vec4 vC;
 out vec4 o;
 void main() { o = vec4(vC.rgb, 1.0); }`;
+// The same splatting as a gather, for parallel eyes with one projection (the eyes here): a source
+// pixel of view depth z moves by d = D / z pixels along the row (D = f_px * IPD), towards -x in
+// the right eye; target pixel xt takes, of the source pixels xs = xt + s k (k = 0..R) whose
+// landing point xs + 1/2 - s d lies in it, the one of largest disparity (the nearest: as the
+// z-buffer of the points), R the largest disparity of the source blocks it can come from
+// (BLOCK_FS, at most MAX_DISPARITY pixels: nearer surfaces are lost to the holes).
+const BLOCK = 64, MAX_DISPARITY = 255;
+const DEPTH_GLSL = `
+uniform float near, far, D;
+float viewDepth(highp sampler2D depth, ivec2 p) {
+  float z = texelFetch(depth, p, 0).r;
+  if (z >= 1.0) return 1e30;
+  float n = 2.0 * z - 1.0;
+  return 2.0 * near * far / (far + near - n * (far - near));
+}`;
+const BLOCK_FS = `#version 300 es
+precision highp float;
+uniform highp sampler2D srcDepth;
+${DEPTH_GLSL}
+out vec4 o;
+void main() {
+  ivec2 b = ivec2(gl_FragCoord.xy);
+  int w = textureSize(srcDepth, 0).x;
+  float m = 0.0;
+  for (int x = b.x * ${BLOCK}; x < min(w, (b.x + 1) * ${BLOCK}); ++x)
+    m = max(m, D / viewDepth(srcDepth, ivec2(x, b.y)));
+  o = vec4(min(ceil(m) + 1.0, ${MAX_DISPARITY}.0) / 255.0, 0.0, 0.0, 1.0);
+}`;
+const GATHER_FS = `#version 300 es
+precision highp float;
+uniform highp sampler2D srcColour, srcDepth, blocks;
+uniform float side;  // +1: the target is right of the source, -1: left
+${DEPTH_GLSL}
+out vec4 o;
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  int w = textureSize(srcDepth, 0).x;
+  int s = int(side);
+  int lo = s > 0 ? p.x : max(0, p.x - ${MAX_DISPARITY});
+  int hi = s > 0 ? min(w - 1, p.x + ${MAX_DISPARITY}) : p.x;
+  int r = 0;
+  for (int b = lo / ${BLOCK}; b <= hi / ${BLOCK}; ++b)
+    r = max(r, int(round(texelFetch(blocks, ivec2(b, p.y), 0).r * 255.0)));
+  for (int k = r; k >= 0; --k) {  // largest disparity first: the first hit is the nearest
+    int xs = p.x + s * k;
+    if (xs < 0 || xs >= w) continue;
+    float d = D / viewDepth(srcDepth, ivec2(xs, p.y));
+    if (int(floor(float(xs) + 0.5 - side * d)) != p.x) continue;
+    o = vec4(texelFetch(srcColour, ivec2(xs, p.y), 0).rgb, 1.0);
+    gl_FragDepth = texelFetch(srcDepth, ivec2(xs, p.y), 0).r;
+    return;
+  }
+  discard;
+}`;
 const FILL_FS = `#version 300 es
 precision highp float;
 uniform vec3 colour;
@@ -259,6 +313,8 @@ export class StereoViewer {
     this.patch = params.get("patch") || "yoro";
     if (!["yoro", "render", "none"].includes(this.patch)) throw new Error(`patch=${this.patch}: yoro, render or none`);
     this.reps = Number(params.get("reps") || 0);
+    this.reproject = params.get("reproject") || "gather";
+    if (!["gather", "points"].includes(this.reproject)) throw new Error(`reproject=${this.reproject}: gather or points`);
     this.client = new PvsClient();
     const [glb, opened] = await Promise.all([
       fetch(sceneUrl).then((r) => { if (!r.ok) throw new Error(`${sceneUrl}: HTTP ${r.status}`); return r.arrayBuffer(); }),
@@ -289,6 +345,14 @@ export class StereoViewer {
     this.prog = compile(gl, SCENE_VS, SCENE_FS);
     this.mvProg = this.multiview ? compile(gl, SCENE_VS, SCENE_FS, "#define MULTIVIEW 1") : null;
     this.splat = compile(gl, SPLAT_VS, SPLAT_FS);
+    this.blockProg = compile(gl, QUAD_VS, BLOCK_FS);
+    this.gatherProg = compile(gl, QUAD_VS, GATHER_FS);
+    this.blocks = {fb: gl.createFramebuffer(), tex: gl.createTexture()};
+    gl.bindTexture(gl.TEXTURE_2D, this.blocks.tex);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, Math.ceil(w / BLOCK), h);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.blocks.fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.blocks.tex, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     this.patchProg = compile(gl, QUAD_VS, PATCH_FS);
     this.fillProg = compile(gl, QUAD_VS, FILL_FS);
     this.empty = gl.createVertexArray();
@@ -425,20 +489,50 @@ export class StereoViewer {
     gl.enable(gl.STENCIL_TEST);
     gl.stencilFunc(gl.ALWAYS, 1, 0xff);
     gl.stencilOp(gl.KEEP, gl.KEEP, gl.REPLACE);
-    const S = this.splat;
-    gl.useProgram(S.p);
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, src.colour);
     gl.activeTexture(gl.TEXTURE1);
     gl.bindTexture(gl.TEXTURE_2D, src.depth);
-    gl.uniform1i(S.u.srcColour, 0);
-    gl.uniform1i(S.u.srcDepth, 1);
-    gl.uniformMatrix4fv(S.u.srcInverse, false, invert(cs.viewProj));
-    gl.uniformMatrix4fv(S.u.dstViewProj, false, cd.viewProj);
-    gl.uniform3fv(S.u.srcEye, cs.eye);
-    gl.uniform1i(S.u.width, this.W);
     gl.bindVertexArray(this.empty);
-    gl.drawArrays(gl.POINTS, 0, this.W * this.H);
+    if (this.reproject === "points") {
+      const S = this.splat;
+      gl.useProgram(S.p);
+      gl.uniform1i(S.u.srcColour, 0);
+      gl.uniform1i(S.u.srcDepth, 1);
+      gl.uniformMatrix4fv(S.u.srcInverse, false, invert(cs.viewProj));
+      gl.uniformMatrix4fv(S.u.dstViewProj, false, cd.viewProj);
+      gl.uniform3fv(S.u.srcEye, cs.eye);
+      gl.uniform1i(S.u.width, this.W);
+      gl.drawArrays(gl.POINTS, 0, this.W * this.H);
+    } else {
+      const D = (this.H / 2) / Math.tan((this.fov * Math.PI) / 360) * this.ipd;
+      const set = (P) => {
+        gl.useProgram(P.p);
+        gl.uniform1i(P.u.srcDepth, 1);
+        gl.uniform1f(P.u.near, NEAR);
+        gl.uniform1f(P.u.far, this.far);
+        gl.uniform1f(P.u.D, D);
+      };
+      gl.disable(gl.STENCIL_TEST);
+      gl.disable(gl.DEPTH_TEST);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, this.blocks.fb);
+      gl.viewport(0, 0, Math.ceil(this.W / BLOCK), this.H);
+      set(this.blockProg);
+      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      gl.bindFramebuffer(gl.FRAMEBUFFER, this.targets.splat.fb);
+      gl.viewport(0, 0, this.W, this.H);
+      gl.enable(gl.STENCIL_TEST);
+      gl.enable(gl.DEPTH_TEST);
+      gl.depthFunc(gl.ALWAYS);
+      set(this.gatherProg);
+      gl.activeTexture(gl.TEXTURE2);
+      gl.bindTexture(gl.TEXTURE_2D, this.blocks.tex);
+      gl.uniform1i(this.gatherProg.u.srcColour, 0);
+      gl.uniform1i(this.gatherProg.u.blocks, 2);
+      gl.uniform1f(this.gatherProg.u.side, dot3(sub3(cd.eye, cs.eye), cs.r) > 0 ? 1 : -1);
+      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      gl.depthFunc(gl.LEQUAL);
+    }
     gl.disable(gl.STENCIL_TEST);
     if (this.patch === "render") {
       // The holes: the background colour, then the set drawn from the target eye, where the
@@ -520,6 +614,12 @@ export class StereoViewer {
     const msTwo = timed(() => { this.renderEye(T.left, cams[0]); this.renderEye(T.right, cams[1]); });
     const truth = [this.read(T.left), this.read(T.right)];
     const msMultiview = this.multiview ? timed(() => this.renderMultiview(cams)) : null;
+    // The parts: one render, and render + reprojection without patching.
+    const msOne = timed(() => this.renderEye(src, cams[d]));
+    const patchMode = this.patch;
+    this.patch = "none";
+    const msNoPatch = timed(() => this.single(src, T.patched, cams[d], cams[o]));
+    this.patch = patchMode;
     let produced;
     const msSingle = timed(() => { produced = this.single(src, T.patched, cams[d], cams[o]); });
     const other = this.read(produced);
@@ -538,7 +638,7 @@ export class StereoViewer {
                  size: [this.W, this.H], ipd: this.ipd, dominant: this.dominant, patch: this.patch,
                  hole_pixels: holes, hole_share: holes / (this.W * this.H),
                  psnr: q.psnr, off_by_8_share: q.offShare,
-                 ms_single: msSingle, ms_two_renders: msTwo, ms_multiview: msMultiview,
+                 ms_single: msSingle, ms_one_render: msOne, ms_unpatched: msNoPatch, ms_two_renders: msTwo, ms_multiview: msMultiview,
                  ratio_single_to_two: msSingle / msTwo,
                  ratio_single_to_multiview: msMultiview ? msSingle / msMultiview : null,
                  reps: Math.max(1, this.reps), multiview: !!this.multiview};
