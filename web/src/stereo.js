@@ -99,8 +99,9 @@ void main() { o = vec4(vC.rgb, 1.0); }`;
 // pixel of view depth z moves by d = D / z pixels along the row (D = f_px * IPD), towards -x in
 // the right eye; target pixel xt takes, of the source pixels xs = xt + s k (k = 0..R) whose
 // landing point xs + 1/2 - s d lies in it, the one of largest disparity (the nearest: as the
-// z-buffer of the points), R the largest disparity of the source blocks it can come from
-// (BLOCK_FS, at most MAX_DISPARITY pixels: nearer surfaces are lost to the holes).
+// z-buffer of the points), k between the smallest and the largest disparity of the source blocks
+// it can come from (BLOCK_FS, at most MAX_DISPARITY pixels: nearer surfaces are lost to the
+// holes); a row of a level view through a horizontal floor has one depth, so k spans little.
 const BLOCK = 64, MAX_DISPARITY = 255;
 const DEPTH_GLSL = `
 uniform float near, far, D;
@@ -118,10 +119,13 @@ out vec4 o;
 void main() {
   ivec2 b = ivec2(gl_FragCoord.xy);
   int w = textureSize(srcDepth, 0).x;
-  float m = 0.0;
-  for (int x = b.x * ${BLOCK}; x < min(w, (b.x + 1) * ${BLOCK}); ++x)
-    m = max(m, D / viewDepth(srcDepth, ivec2(x, b.y)));
-  o = vec4(min(ceil(m) + 1.0, ${MAX_DISPARITY}.0) / 255.0, 0.0, 0.0, 1.0);
+  float m = 0.0, l = 1e30;
+  for (int x = b.x * ${BLOCK}; x < min(w, (b.x + 1) * ${BLOCK}); ++x) {
+    float d = D / viewDepth(srcDepth, ivec2(x, b.y));
+    m = max(m, d);
+    l = min(l, d);
+  }
+  o = vec4(min(ceil(m) + 1.0, ${MAX_DISPARITY}.0) / 255.0, max(floor(l) - 1.0, 0.0) / 255.0, 0.0, 1.0);
 }`;
 const GATHER_FS = `#version 300 es
 precision highp float;
@@ -135,10 +139,13 @@ void main() {
   int s = int(side);
   int lo = s > 0 ? p.x : max(0, p.x - ${MAX_DISPARITY});
   int hi = s > 0 ? min(w - 1, p.x + ${MAX_DISPARITY}) : p.x;
-  int r = 0;
-  for (int b = lo / ${BLOCK}; b <= hi / ${BLOCK}; ++b)
-    r = max(r, int(round(texelFetch(blocks, ivec2(b, p.y), 0).r * 255.0)));
-  for (int k = r; k >= 0; --k) {  // largest disparity first: the first hit is the nearest
+  int r = 0, r0 = ${MAX_DISPARITY};
+  for (int b = lo / ${BLOCK}; b <= hi / ${BLOCK}; ++b) {
+    vec2 m = texelFetch(blocks, ivec2(b, p.y), 0).rg * 255.0;
+    r = max(r, int(round(m.r)));
+    r0 = min(r0, int(round(m.g)));
+  }
+  for (int k = r; k >= r0; --k) {  // largest disparity first: the first hit is the nearest
     int xs = p.x + s * k;
     if (xs < 0 || xs >= w) continue;
     float d = D / viewDepth(srcDepth, ivec2(xs, p.y));
