@@ -10,9 +10,9 @@
 // 6, degrees from the pole: as pvs view --pole-merge), tess=dynamic|K (K = 1: none), reps=N
 // (each frame rendered N more times; the record's ms is their median), plus scene, pvs, at,
 // path, overlay=0 as in the walking mode.
-import {parseGlb, objectColour} from "./glb.js";
+import {objectColour} from "./glb.js";
 import {parsePath, vec3} from "./path.js";
-import {PvsClient} from "./pvs_client.js";
+import {loadScene} from "./scene_load.js";
 import {OdsGpu, odsDevice} from "./ods_gpu.js";
 
 // pvs view's --pole-merge syntax: "s,e,x" for both poles or "s,e,x:s,e,x" top:bottom.
@@ -84,8 +84,6 @@ export class OdsViewer {
 
   async init() {
     const params = this.params;
-    const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
-    if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
     if (params.get("overlay") === "0")
       for (const id of ["overlay", "map", "help"]) document.getElementById(id).style.display = "none";
     document.getElementById("map").style.display = "none";
@@ -104,19 +102,7 @@ export class OdsViewer {
                      tessellation: tess === "dynamic" ? 0 : Number(tess)};
     this.tessName = tess;
     this.reps = Number(params.get("reps") || 0);
-    this.client = new PvsClient();
-    const [glb, opened] = await Promise.all([
-      fetch(sceneUrl).then((r) => {
-        if (!r.ok) throw new Error(`${sceneUrl}: HTTP ${r.status}`);
-        return r.arrayBuffer();
-      }),
-      this.client.open(pvsUrl)]);
-    this.scene = parseGlb(glb);
-    this.sceneBytes = glb.byteLength;
-    this.pvs = opened;
-    this.total = this.scene.triangleObject.length;
-    if (opened.info.universe !== this.total || opened.info.granularity !== 0)
-      throw new Error(`the PVS has ${opened.info.universe} ids, the scene ${this.total} triangles: not this scene's triangle PVS`);
+    Object.assign(this, await loadScene(params));
     this.ods = new OdsGpu(this.device, this.scene, triangleColours(this.scene), this.width);
     this.path = params.get("path") ? parsePath(params.get("path")) : null;
     this.centre = params.get("at") ? vec3(params.get("at")) : this.path ? this.path[0].eye : [0, 1.6, 0];

@@ -30,6 +30,8 @@
 // as r_h falls to h, instead of the CPU raster's bisection to the visibility boundary; such
 // vertices are counted (`inside_circle`). Arithmetic is f32 on positions relative to C.
 
+import {diagonal} from "./scene_load.js";
+
 const WGSL_COMMON = /* wgsl */ `
 const PI = 3.14159265358979;
 struct Params {
@@ -366,13 +368,7 @@ export class OdsGpu {
     };
     this.pos = storage(scene.positions);
     this.colours = storage(colours);
-    let r = 0;
-    const p = scene.positions;
-    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-    for (let i = 0; i < p.length; i += 3)
-      for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], p[i + k]); hi[k] = Math.max(hi[k], p[i + k]); }
-    for (let k = 0; k < 3; ++k) r += (hi[k] - lo[k]) ** 2;
-    this.maxRange = 4 * Math.sqrt(r) + 1;  // > any range from a centre near the scene
+    this.maxRange = 4 * diagonal(scene.positions) + 1;  // > any range from a centre near the scene
     this.params = [0, 1].map(() => d.createBuffer({size: 80, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST}));
     this.draw = d.createBuffer({size: 32, usage: GPUBufferUsage.STORAGE | GPUBufferUsage.INDIRECT | GPUBufferUsage.COPY_SRC | GPUBufferUsage.COPY_DST});
     this.drawRead = d.createBuffer({size: 32, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST});

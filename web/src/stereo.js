@@ -26,9 +26,8 @@
 // URL parameters: size=WxH (an eye), fov, ipd (metres, default 0.064), upm, dominant=left|right
 // (default left), patch=yoro|render|none (default yoro), reps=N, plus scene, pvs, path (points
 // EYE@LOOK: EYE is the point between the eyes) and overlay=0.
-import {parseGlb} from "./glb.js";
 import {parsePath, vec3} from "./path.js";
-import {PvsClient} from "./pvs_client.js";
+import {loadScene, diagonal} from "./scene_load.js";
 import {triangleColours} from "./ods.js";
 
 const NEAR = 0.01;  // kDefaultNear
@@ -306,8 +305,6 @@ export class StereoViewer {
 
   async init() {
     const params = this.params;
-    const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
-    if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
     for (const id of params.get("overlay") === "0" ? ["overlay", "map", "help"] : ["map"])
       document.getElementById(id).style.display = "none";
     const [w, h] = (params.get("size") || "640x480").split("x").map(Number);
@@ -322,16 +319,7 @@ export class StereoViewer {
     this.reps = Number(params.get("reps") || 0);
     this.reproject = params.get("reproject") || "gather";
     if (!["gather", "points"].includes(this.reproject)) throw new Error(`reproject=${this.reproject}: gather or points`);
-    this.client = new PvsClient();
-    const [glb, opened] = await Promise.all([
-      fetch(sceneUrl).then((r) => { if (!r.ok) throw new Error(`${sceneUrl}: HTTP ${r.status}`); return r.arrayBuffer(); }),
-      this.client.open(pvsUrl)]);
-    this.scene = parseGlb(glb);
-    this.sceneBytes = glb.byteLength;
-    this.pvs = opened;
-    this.total = this.scene.triangleObject.length;
-    if (opened.info.universe !== this.total || opened.info.granularity !== 0)
-      throw new Error(`the PVS has ${opened.info.universe} ids, the scene ${this.total} triangles: not this scene's triangle PVS`);
+    Object.assign(this, await loadScene(params));
     this.setup();
     this.path = params.get("path") ? parsePath(params.get("path")) : null;
     return this;
@@ -376,10 +364,7 @@ export class StereoViewer {
       const c = [albedo[t] & 255, (albedo[t] >> 8) & 255, (albedo[t] >> 16) & 255].map((v) => v / 255);
       for (let k = 0; k < 3; ++k) { normals.set(n, o + 3 * k); colours.set(c, o + 3 * k); }
     }
-    let lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-    for (let i = 0; i < p.length; i += 3)
-      for (let k = 0; k < 3; ++k) { lo[k] = Math.min(lo[k], p[i + k]); hi[k] = Math.max(hi[k], p[i + k]); }
-    this.far = 4 * Math.hypot(...sub3(hi, lo)) + 10;
+    this.far = 4 * diagonal(p) + 10;
     this.vao = gl.createVertexArray();
     gl.bindVertexArray(this.vao);
     [p, normals, colours].forEach((data, i) => {
