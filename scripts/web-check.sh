@@ -10,7 +10,7 @@
 #                      [--lookup eye|cylinder] [--clovr]] [--prefetch MARGIN]
 #                     [--mode ods|stereo] [--ods-size W] [--ipd M] [--units-per-metre S]
 #                     [--pole-merge s,e,x[:s,e,x]] [--tessellation dynamic|K] [--reps N]
-#                     [--dominant left|right] [--patch yoro|median|none|render]
+#                     [--dominant left|right] [--patch yoro|render|none] [--reproject gather|points]
 #                     [--reference IMG]
 # --mode ods: each path point is the centre of an ODS pair (WebGPU; docs/web.md): the PNGs are
 # the W x W top-bottom pairs, --reps N renders each N more times (ms: the median); the page shows
@@ -71,6 +71,7 @@ while [[ $# -gt 0 ]]; do
     --dominant) extra+="&dominant=$2" ;;
     --patch) extra+="&patch=$2" ;;
     --reference) reference=$2 ;;
+    --reproject) extra+="&reproject=$2" ;;
     *) echo "web-check: unknown option $1" >&2; usage ;;
   esac
   shift 2
