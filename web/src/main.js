@@ -8,7 +8,7 @@
 // (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
 // frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size),
 // nearfar=r1,r2 with centre=x,y,z or centres=URL (JSON), envsize=N, lookup=eye|cylinder and
-// clovr=1 (docs/web.md).
+// clovr=1 (docs/web.md); mode=ods|stereo (ods.js, stereo.js).
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
 // scene), and the overlay says so in red.
@@ -24,6 +24,8 @@ import * as THREE from "three";
 import {parseGlb, objectColour} from "./glb.js";
 import {parsePath, vec3} from "./path.js";
 import {PvsClient} from "./pvs_client.js";
+import {OdsViewer} from "./ods.js";
+import {StereoViewer} from "./stereo.js";
 
 const params = new URLSearchParams(location.search);
 const overlay = document.getElementById("overlay");
@@ -678,7 +680,12 @@ class Viewer {
   }
 }
 
-const viewer = new Viewer();
+// mode=ods (ods.js) and mode=stereo (stereo.js) are viewers of their own with the same interface
+// (init, path, step, startWalking); docs/web.md.
+const mode = params.get("mode") || "walk";
+if (!["walk", "ods", "stereo"].includes(mode)) throw new Error(`mode=${mode}: walk, ods or stereo`);
+const viewer = mode === "ods" ? new OdsViewer(params, overlay, canvas)
+  : mode === "stereo" ? new StereoViewer(params, overlay, canvas) : new Viewer();
 window.viewer = viewer;
 window.viewerReady = viewer.init().then(
   async () => {

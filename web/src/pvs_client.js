@@ -27,6 +27,9 @@ export class PvsClient {
   }
   // The cell containing `position` (-1: none) and, when it is not `have`, its visible ids; on a
   // cell change with `prefetch` >= 0, the worker then fetches the neighbours' blocks.
+  // The cells an ODS panorama centred at `centre` needs (its viewing disc of `radius`) and the
+  // union of their sets (pvs_worker.js, op disc).
+  disc(centre, radius) { return this.call({op: "disc", centre, radius}); }
   lookup(position, have, prefetch = -1) {
     return this.call({op: "lookup", position, have, prefetch});
   }

@@ -19,6 +19,11 @@
 // the range test, `environment` rendered into the cube map from O); with CloVR on, every lookup
 // advances the scheduler one frame (pvs_rt_clovr_next_frame) and returns `clovr` (the frame) and,
 // when the near set changed, its `near` and `environment` ids.
+//   {op: "disc", centre, radius}  -> {cell, cells, inRegion, ids: Uint32Array} (the cells an ODS
+//                                    panorama's viewing disc needs, as `pvs view --ods` takes
+//                                    them: the cell containing the centre if the disc lies in
+//                                    its box, else also every neighbour whose box the disc
+//                                    touches; ids: the union of their sets, sorted)
 // Each range fetched is kept (a cell's block is fetched once); `bytes` counts every byte the
 // server sent for this file, so the page can show what streaming cost.
 /* global createPvsRuntime, importScripts */
@@ -253,6 +258,40 @@ function lookup(position) {
   return cell;
 }
 
+// The cells of the viewing disc (radius r about c, horizontal): runtime/ods.h's
+// disc_inside_box / disc_touches_box on the cells' boxes (for a grid the view region is the
+// box with y replaced by the eye band, the same in x-z; the centre's cell contains c in y).
+function cellBox(cell) {
+  const p = rt._malloc(48);
+  check(rt._pvs_rt_cell_box(handle, cell, p, p + 24), "pvs_rt_cell_box");
+  const b = new Float64Array(rt.HEAPU8.buffer, p, 6).slice();
+  rt._free(p);
+  return b;
+}
+function discCells(c, r) {
+  const cell = lookup(c);
+  if (cell < 0) return {cell, cells: [], inRegion: false, ids: new Uint32Array(0)};
+  const b = cellBox(cell);
+  const inRegion = c[0] - r >= b[0] && c[0] + r <= b[3] && c[2] - r >= b[2] && c[2] + r <= b[5];
+  const cells = [cell];
+  if (!inRegion) {
+    const cap = 4096, out = rt._malloc(4 * cap + 16), countP = out + 4 * cap;
+    check(rt._pvs_rt_neighbours(handle, cell, r, out, cap, countP), "pvs_rt_neighbours");
+    const n = new Uint32Array(rt.HEAPU8.buffer, countP, 1)[0];
+    const near = new Uint32Array(rt.HEAPU8.buffer, out, n).slice();
+    rt._free(out);
+    for (const u of near) {
+      const q = cellBox(u);
+      if (c[1] < q[1] || c[1] > q[4]) continue;
+      const dx = Math.max(q[0] - c[0], 0, c[0] - q[3]), dz = Math.max(q[2] - c[2], 0, c[2] - q[5]);
+      if (dx * dx + dz * dz <= r * r) cells.push(u);
+    }
+  }
+  const union = new Set();
+  for (const u of cells) for (const t of visibleIds(u)) union.add(t);
+  return {cell, cells, inRegion, ids: Uint32Array.from(union).sort()};
+}
+
 self.onmessage = async (ev) => {
   const m = ev.data;
   try {
@@ -262,6 +301,9 @@ self.onmessage = async (ev) => {
     } else if (m.op === "geometry") {
       setGeometry(m);
       self.postMessage({id: m.id, ok: true});
+    } else if (m.op === "disc") {
+      const r = discCells(m.centre, m.radius);
+      self.postMessage({id: m.id, ok: true, ...r, bytes: bytesFetched, requests});
     } else if (m.op === "lookup") {
       const before = requests;
       const cell = lookup(m.position);

@@ -1,10 +1,14 @@
 // web_check.mjs: drives the web client in Debian's chromium, headless (WebGL2 through
 // SwiftShader), with puppeteer-core: replays a path frame by frame and writes what each frame
-// did (scripts/web-check.sh starts the server and calls this).
+// did (scripts/web-check.sh starts the server and calls this). WebGPU (the ods and stereo modes)
+// comes from SwiftShader too, with --enable-unsafe-webgpu on a page served from 127.0.0.1. A page
+// whose viewer offers framePng() (the ods and stereo modes) gives its own frame's pixels for the
+// PNGs; otherwise they are screenshots.
 //
 // node web_check.mjs --url PAGE_URL --json OUT [--png-dir DIR --png-frames 0,5,9] [--size WxH]
 //                    [--server-log FILE --pvs-name NAME] [--chromium PATH]
-// Exit: 0 done, 1 the page failed, 2 bad arguments, 77 chromium cannot start (a skip for ctest).
+// Exit: 0 done, 1 the page failed, 2 bad arguments, 77 chromium cannot start or the page's mode
+// needs WebGPU and chromium offers none (a skip for ctest).
 import fs from "node:fs";
 import path from "node:path";
 import os from "node:os";
@@ -56,7 +60,7 @@ async function main() {
       executablePath: exe,
       headless: true,
       userDataDir: profile,
-      args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox",
+      args: ["--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--enable-unsafe-webgpu", "--no-sandbox",
              "--disable-background-networking", "--disable-component-update", "--disable-sync",
              "--no-first-run", "--disable-dev-shm-usage"],
       timeout: 60000,
@@ -80,6 +84,11 @@ async function main() {
     try {
       info = await page.evaluate(() => window.viewerReady);
     } catch (e) {
+      if (/needs WebGPU/.test(e.message)) {
+        console.error(`web_check: SKIPPED: ${e.message.split("\n")[0]}`);
+        code = 77;
+        return code;
+      }
       throw new Error(`the page failed to open: ${e.message}\n${errors.join("\n")}`);
     }
     const gpu = await page.evaluate(() => {
@@ -94,7 +103,13 @@ async function main() {
       const rec = await page.evaluate((k) => window.viewer.step(k), i);
       if (a.pngFrames.includes(i)) {
         rec.png = path.join(a.pngDir || ".", `frame_${String(i).padStart(4, "0")}.png`);
-        await page.screenshot({path: rec.png});
+        const own = await page.evaluate(() => typeof window.viewer.framePng === "function");
+        if (own) {
+          const url = await page.evaluate(() => window.viewer.framePng());
+          fs.writeFileSync(rec.png, Buffer.from(url.slice(url.indexOf(",") + 1), "base64"));
+        } else {
+          await page.screenshot({path: rec.png});
+        }
       }
       frames.push(rec);
     }
