@@ -194,7 +194,7 @@ Row measure(const Scene& scene, const Case& c, const EmbreeScene& es, int reps, 
 }
 
 // The regression bounds of the one-core CPU ratio (r_cpu) of the static cases (docs/performance.md,
-// "What the reported speed includes"); 0: none.
+// "What the reported times include"); 0: none.
 double ratio_bound(const std::string& name) {
   if (name == "city2") return 6.5;
   if (name == "city20") return 50;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # thread_overhead.sh: what a bake's threads cost, for one or more `pvs` binaries in one run
-# (docs/performance.md, "What 16 threads cost").
+# (docs/performance.md, "Where a bake's threads spend their time").
 #
 #   bench/thread_overhead.sh SCENE "J1 J2 ..." PVS... -- BAKE OPTIONS...
 #

@@ -25,6 +25,9 @@ install(FILES ${PROJECT_SOURCE_DIR}/runtime/pvs_runtime.h ${PROJECT_SOURCE_DIR}/
               ${PROJECT_BINARY_DIR}/generated/runtime/vislib_version.h
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/vislib/runtime)
 
+# The license travels with every install, runtime-only included (<prefix>/share/doc/vislib/LICENSE).
+install(FILES ${PROJECT_SOURCE_DIR}/LICENSE DESTINATION ${CMAKE_INSTALL_DOCDIR})
+
 set(VISLIB_INSTALLED_COMPONENTS runtime)
 if(NOT VISLIB_RUNTIME_ONLY)
   list(APPEND VISLIB_INSTALLED_COMPONENTS vislib)

@@ -685,6 +685,7 @@ PYBIND11_MODULE(pyvislib, m) {
   m.doc() =
       "vislib from Python: scenes, from-segment/region visibility, PVS files, reference frames "
       "and their metrics (docs/python.md).";
+  m.attr("__license__") = VISLIB_LICENSE;  // SPDX identifier, set by python/CMakeLists.txt
 
   bind_errors(m);
   bind_scenes(m);
