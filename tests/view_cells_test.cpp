@@ -425,13 +425,13 @@ TEST(WalkableReach, AgentTallerThanTheRoomReachesNothingAndNarrowFloorIsNotStood
 
 TEST(WalkableReach, StartWithoutFloorIsRefusedOrLeftOutAndRecorded) {
   const Scene s = closed_level();
-  WalkableOptions o = closed_level_options({{10, 0.5, 10}});  // under the room's floor
+  WalkableOptions o = closed_level_options({{10, -5, 10}});  // under the level
   try {
     walkable_cells(s, o);
     ADD_FAILURE() << "no error";
   } catch (const PlacementError& e) {
     EXPECT_EQ(e.problem(), PlacementProblem::StartWithoutFloor);
-    EXPECT_NE(std::string(e.what()).find("10,0.5,10"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("10,-5,10"), std::string::npos) << e.what();
   }
   o.required_starts = false;
   EXPECT_THROW(walkable_cells(s, o), PlacementError);  // no start has floor
@@ -441,7 +441,8 @@ TEST(WalkableReach, StartWithoutFloorIsRefusedOrLeftOutAndRecorded) {
   const auto d = nlohmann::json::parse(c.description);
   ASSERT_EQ(d["starts"].size(), 2u);
   EXPECT_TRUE(d["starts"][0]["floor"].is_null());
-  EXPECT_NEAR(d["starts"][1]["floor"].get<double>(), 1.0, 0.1);
+  // The floor as voxelized: rounded up by at most a voxel height (0.225).
+  EXPECT_NEAR(d["starts"][1]["floor"].get<double>(), 1.0 + 0.1125, 0.1125);
   EXPECT_EQ(d["starts"][1]["source"], "second");
 }
 
