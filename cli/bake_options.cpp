@@ -7,6 +7,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "cli/commands.h"
 #include "cli/options.h"
@@ -40,6 +41,27 @@ vislib::Shard parse_shard(const std::string& text) {
 
 namespace {
 
+// --walkable-from x,y,z (each given): three finite numbers; or "none" alone (no start).
+std::vector<vislib::WalkStart> parse_starts(const BakeArgs& a) {
+  std::vector<vislib::WalkStart> starts;
+  if (a.walkable_from.size() == 1 && a.walkable_from[0] == "none") return starts;
+  for (const std::string& text : a.walkable_from) {
+    std::vector<double> v;
+    try {
+      v = parse_doubles(text, "--walkable-from", 3);
+    } catch (const CLI::ValidationError&) {
+      v.clear();
+    }
+    if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
+      throw CLI::ValidationError("--walkable-from",
+                                 "expected x,y,z (three finite numbers, scene coordinates) or "
+                                 "'none' alone, got '" +
+                                     text + "'");
+    starts.push_back({{v[0], v[1], v[2]}, "--walkable-from"});
+  }
+  return starts;
+}
+
 // The placement of the options (parsed here; their combination is checked by the library).
 vislib::CellPlacement placement_of(const BakeArgs& a) {
   vislib::CellPlacement p;
@@ -60,6 +82,11 @@ vislib::CellPlacement placement_of(const BakeArgs& a) {
   p.cell_size = a.cell_size;
   p.max_slope_degrees = a.max_slope;
   p.require_headroom = !a.no_headroom;
+  p.starts = parse_starts(a);
+  const auto given = [](double v) { return std::isnan(v) ? std::nullopt : std::optional(v); };
+  p.agent_height = given(a.agent_height);
+  p.agent_radius = given(a.agent_radius);
+  p.agent_step = given(a.agent_step);
   return p;
 }
 
@@ -89,7 +116,11 @@ CLI::ValidationError placement_error(vislib::PlacementProblem problem) {
       return CLI::ValidationError("--grid", "more than 10^7 cells");
     case P::NoGridNorCellSize:
       return CLI::ValidationError("--grid", "give --grid nx,ny,nz or --cell-size S with --box");
+    case P::BadAgent:
+      return CLI::ValidationError("--agent-height",
+                                  "the agent's height (default: the eye band's top) must be > 0");
     case P::TooManySizedCells:
+    case P::StartWithoutFloor:  // reported with the library's message (make_cells)
       break;
   }
   return CLI::ValidationError("--cell-size", "more than 10^7 cells");
@@ -153,13 +184,20 @@ std::vector<uint32_t> parse_leaves(const std::string& text, const std::vector<ui
 }  // namespace
 
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
+  static const char* const kWalkableOnly[] = {"--walkable-from", "--agent-height", "--agent-radius",
+                                              "--agent-step"};
   if (a.cells != "bsp-leaves") {
     for (const char* o :
          {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
+    for (const char* o : kWalkableOnly)
+      if (!a.walkable && cmd.count(o))
+        throw CLI::ValidationError(o, "only applies with --walkable");
+    parse_starts(a);
     return;
   }
-  for (const char* o : {"--walkable", "--box", "--grid", "--cell-size", "--eye-height"})
+  for (const char* o : {"--walkable", "--box", "--grid", "--cell-size", "--eye-height",
+                        "--walkable-from", "--agent-height", "--agent-radius", "--agent-step"})
     if (cmd.count(o))
       throw CLI::ValidationError(o,
                                  "cannot be combined with --cells bsp-leaves (the cells are "
@@ -186,6 +224,22 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     return vislib::bsp_leaf_cells(bsp, o);
   }
   vislib::CellPlacement p = placement_of(a);
+  if (a.walkable && ends_with_bsp(a.scene)) {
+    // A Quake map: its faces are wound clockwise seen from the front; Quake's player walks, from
+    // the map's player starts unless given.
+    p.clockwise_front = true;
+    if (!p.agent_height) p.agent_height = vislib::kQuakePlayerHeight;
+    if (!p.agent_radius) p.agent_radius = vislib::kQuakePlayerRadius;
+    if (!p.agent_step) p.agent_step = vislib::kQuakeStepHeight;
+    if (a.walkable_from.empty()) {
+      for (const vislib::BspEntityPoint& e :
+           vislib::bsp_player_starts(vislib::read_quake_bsp(a.scene)))
+        p.starts.push_back({e.origin, e.classname});
+      p.required_starts = false;
+      if (p.starts.empty())
+        warn(a.scene + ": the map names no player start: walkable cells over every floor level");
+    }
+  }
   try {
     // --grid is parsed only where the library would use it, so that a conflicting combination is
     // reported before a malformed --grid (as before the placement moved into the library).
@@ -195,6 +249,9 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     }
     return vislib::place_view_cells(scene, p);
   } catch (const vislib::PlacementError& e) {
+    if (e.problem() == vislib::PlacementProblem::StartWithoutFloor)
+      throw CLI::ValidationError(a.walkable_from.empty() ? "--walkable" : "--walkable-from",
+                                 e.what());
     throw placement_error(e.problem());
   }
 }
@@ -282,6 +339,24 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--max-slope", a.max_slope, "Walkable: steepest floor, degrees from horizontal")
       ->check(in_range(0.0, 90.0))
       ->capture_default_str();
+  cmd->add_option("--walkable-from", a.walkable_from,
+                  "Walkable: keep only the floor an agent can stand on and walk to (steps up, "
+                  "drops down) from this point x,y,z (repeatable; default: a Quake map's player "
+                  "starts, else every floor level; 'none': every floor level)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  cmd->add_option("--agent-height", a.agent_height,
+                  "Walkable reachability: the agent's height (default: the eye band's top; Quake "
+                  "maps 56)")
+      ->check(positive());
+  cmd->add_option("--agent-radius", a.agent_radius,
+                  "Walkable reachability: the agent's radius (default: a quarter of the eye "
+                  "band's top; Quake maps 16)")
+      ->check(non_negative());
+  cmd->add_option("--agent-step", a.agent_step,
+                  "Walkable reachability: the highest step the agent climbs (default: a quarter "
+                  "of the eye band's top; Quake maps 18)")
+      ->check(non_negative());
   cmd->add_flag("--no-headroom", a.no_headroom,
                 "Walkable: keep floors covered by other geometry (under buildings)");
   cmd->add_option("--res", a.resolution, "Cube face resolution N of the from-segment runs")

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cli/load_scene.h"
 #include "vislib/bake/bake.h"
@@ -37,6 +39,8 @@ struct BakeArgs {
   std::string leaves;                             // --leaves A-B (bsp-leaves)
   std::string face_sweep = "even";                // --face-sweep even|adaptive (bsp-leaves)
   vislib::AdaptiveSpacing chords;                 // --chord-coarse, --chord-floor (adaptive)
+  std::vector<std::string> walkable_from;         // --walkable-from x,y,z (repeatable)
+  double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).
@@ -49,14 +53,17 @@ vislib::Shard parse_shard(const std::string& text);
 void apply_preset(BakeArgs& a, const CLI::App& cmd);
 
 // --cells bsp-leaves: refuses (CLI::ValidationError, exit 2) the options that place cells
-// otherwise (--walkable, --box, --grid, --cell-size, --eye-height) and, before the scene is
-// loaded, a scene that is not a .bsp (InputError naming it). Without --cells: refuses
-// --face-spacing and --leaves.
+// otherwise (--walkable, --box, --grid, --cell-size, --eye-height, --walkable-from, --agent-*)
+// and, before the scene is loaded, a scene that is not a .bsp (InputError naming it). Without
+// --cells: refuses --face-spacing and --leaves; without --walkable, --walkable-from and
+// --agent-*; a --walkable-from that is not three finite numbers.
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd);
 
 // The view cells of the options over `scene` (vislib::place_view_cells, or with --cells
 // bsp-leaves vislib::bsp_leaf_cells of the map read again from a.scene); a refused placement is
-// reported as the option that caused it.
+// reported as the option that caused it. Walkable cells of a Quake map (.bsp): the agent's
+// defaults are Quake's player, and without --walkable-from the starts are the map's player
+// starts (vislib::bsp_player_starts; one without floor under it is left out).
 vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene);
 
 // The kernel and bake settings of the options.

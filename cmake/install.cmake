@@ -61,6 +61,7 @@ configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/vislibConfig.cmake.in
 write_basic_package_version_file(${PROJECT_BINARY_DIR}/cmake/vislibConfigVersion.cmake
                                  COMPATIBILITY SameMinorVersion)
 install(FILES ${PROJECT_BINARY_DIR}/cmake/vislibConfig.cmake ${PROJECT_BINARY_DIR}/cmake/vislibConfigVersion.cmake
+              ${PROJECT_SOURCE_DIR}/cmake/FindRecast.cmake
         DESTINATION ${VISLIB_CMAKE_DIR})
 
 # pkg-config for the C API: `cc app.c $(pkg-config --cflags --libs vislib_runtime)`. Its paths are

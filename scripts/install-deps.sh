@@ -6,7 +6,7 @@ PACKAGES=(
   build-essential cmake ninja-build git pkg-config
   libembree-dev libtbb-dev libcgal-dev libopenmesh-dev libtinygltf-dev libmeshoptimizer-dev
   libopenimageio-dev openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev
-  libcli11-dev nlohmann-json3-dev libfmt-dev libstb-dev
+  libcli11-dev nlohmann-json3-dev libfmt-dev libstb-dev librecast-dev
   python3 python3-matplotlib python3-numpy help2man
   python3-dev python3-pybind11 pybind11-dev python3-pytest
   clang libclang-rt-14-dev clang-format

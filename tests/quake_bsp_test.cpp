@@ -217,6 +217,28 @@ TEST(QuakeBsp, ZUpBecomesYUpByAProperRotation) {
   EXPECT_EQ(quake_to_scene({0, 0, 1}), (Vec3{0, 1, 0}));
 }
 
+TEST(QuakeBsp, PlayerStartsAreReadFromTheEntitiesInSceneCoordinates) {
+  QuakeBsp m = tiny_map();
+  m.entities =
+      "{\n\"classname\" \"worldspawn\"\n\"wad\" \"x.wad\"\n}\n"
+      "{\n\"origin\" \"16 -32 24\"\n\"classname\" \"info_player_start\"\n}\n"
+      "{ \"classname\" \"light\" \"origin\" \"0 0 64\" }\n"
+      "{ \"classname\" \"info_player_deathmatch\" \"origin\" \"1.5 2 3\" \"angle\" \"90\" }\n"
+      "{ \"classname\" \"info_player_coop\" \"origin\" \"1 2\" }\n"  // malformed origin
+      "{ \"classname\" \"info_player_start2\" \"origin\" \"4 5 6\" }\n"
+      "{ \"classname\" \"info_player_deathmatch\" \"origin\" \"7 8 9\" \n"  // unclosed
+      "{ \"classname\" \"info_player_start\" \"origin\" \"0 0 0\" }\n";
+  const std::vector<BspEntityPoint> starts = bsp_player_starts(m);
+  ASSERT_EQ(starts.size(), 3u);
+  EXPECT_EQ(starts[0].classname, "info_player_start");
+  EXPECT_EQ(starts[0].origin, quake_to_scene({16, -32, 24}));
+  EXPECT_EQ(starts[1].classname, "info_player_deathmatch");
+  EXPECT_EQ(starts[1].origin, quake_to_scene({1.5, 2, 3}));
+  EXPECT_EQ(starts[2].classname, "info_player_start2");
+  m.entities = "{ \"classname\" \"worldspawn\" }";
+  EXPECT_TRUE(bsp_player_starts(m).empty());
+}
+
 TEST(QuakeBsp, OptionsSelectModelsAndLiquids) {
   std::string dir = temp_dir("quake_bsp_options");
   std::string path = write_map(dir, "tiny.bsp", encode_bsp(tiny_map()));

@@ -6,11 +6,16 @@
 #include <tbb/global_control.h>
 
 #include <array>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 
 #include "tests/scene_builders.h"
+#include "tests/test_support.h"
 #include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/free_space.h"
+#include "vislib/scene/import.h"
 
 using namespace vislib;
 using vislib_test::add_quad;
@@ -310,4 +315,274 @@ TEST(CellPlacement, InconsistentPlacementsAreRefusedWithTheirProblem) {
   EXPECT_EQ(problem(p), PlacementProblem::NoGridNorCellSize);
   p.cell_size = 0.004;  // 2500 * 750 * 2500 cells
   EXPECT_EQ(problem(p), PlacementProblem::TooManySizedCells);
+}
+
+// --- Reachable walkable cells (walkable_reach.h) -------------------------------------------------
+
+namespace {
+
+// A closed room: a box whose faces point inwards (its floor faces up, its ceiling down).
+void add_room(Scene& s, Vec3 lo, Vec3 hi) {
+  const size_t first = s.triangles.size();
+  add_box(s, lo, hi);
+  for (size_t t = first; t < s.triangles.size(); ++t)
+    std::swap(s.triangles[t][1], s.triangles[t][2]);
+}
+
+// A closed level: a shell [-1, 21] x [0, 12] x [-1, 21] whose roof (y = 12) faces up outside,
+// around a room [0, 20] x [1, 11] x [0, 20] (floor y = 1); in the room, a platform 4 m high
+// (top y = 5, over [3, 7] x [3, 7]: more than a step) and a low one 0.3 m high (top y = 1.3,
+// over [15, 19] x [15, 19]: one step). Columns of 2 start at -1: the platforms cover whole ones.
+Scene closed_level() {
+  Scene s;
+  add_box(s, {-1, 0, -1}, {21, 12, 21});
+  add_room(s, {0, 1, 0}, {20, 11, 20});
+  add_box(s, {3, 1, 3}, {7, 5, 7});
+  add_box(s, {15, 1, 15}, {19, 1.3, 19});
+  return s;
+}
+
+// Cells of `c` by the floor level they stand on (their bottom is the floor + 1.5).
+struct LevelCounts {
+  size_t roof = 0, platform = 0, floor = 0, other = 0;
+};
+LevelCounts level_counts(const ViewCells& c) {
+  LevelCounts n;
+  for (const auto& b : c.layout.boxes) {
+    if (b.min[1] == 12 + 1.5)
+      ++n.roof;
+    else if (b.min[1] == 5 + 1.5)
+      ++n.platform;
+    else if (b.min[1] == 1 + 1.5)
+      ++n.floor;
+    else
+      ++n.other;
+  }
+  return n;
+}
+
+WalkableOptions closed_level_options(std::vector<Vec3> starts) {
+  WalkableOptions o;
+  o.cell_size = 2;
+  o.agent = {1.8, 0.45, 0.45};
+  for (Vec3 p : starts) o.starts.push_back({p, "test"});
+  return o;
+}
+
+}  // namespace
+
+TEST(WalkableReach, RoofOutsideAClosedLevelGetsCellsOnlyWithoutAStart) {
+  const Scene s = closed_level();
+  const LevelCounts all = level_counts(walkable_cells(s, closed_level_options({})));
+  EXPECT_EQ(all.roof, 11u * 11u);  // the shell's roof: every column
+  EXPECT_EQ(all.platform, 4u);
+  EXPECT_EQ(all.floor, 11u * 11u - 4u);  // not under the high platform (no headroom)
+  EXPECT_EQ(all.other, 0u);
+  const LevelCounts kept = level_counts(walkable_cells(s, closed_level_options({{10, 2, 10}})));
+  EXPECT_EQ(kept.roof, 0u);
+  EXPECT_EQ(kept.floor, all.floor);  // the room's floor and the low platform, one step up
+}
+
+TEST(WalkableReach, PlatformsHigherThanAStepAreDroppedUnlessAStartIsOnThem) {
+  const Scene s = closed_level();
+  const LevelCounts all = level_counts(walkable_cells(s, closed_level_options({})));
+  const LevelCounts from_floor =
+      level_counts(walkable_cells(s, closed_level_options({{10, 2, 10}})));
+  EXPECT_EQ(from_floor.platform, 0u);
+  // From the platform's top the agent drops onto the floor: both are kept, the roof is not.
+  const LevelCounts from_top = level_counts(walkable_cells(s, closed_level_options({{5, 6, 5}})));
+  EXPECT_EQ(from_top.platform, all.platform);
+  EXPECT_EQ(from_top.floor, all.floor);
+  EXPECT_EQ(from_top.roof, 0u);
+  // A step as high as the platform climbs it.
+  WalkableOptions climb = closed_level_options({{10, 2, 10}});
+  climb.agent.step = 4.1;
+  EXPECT_EQ(level_counts(walkable_cells(s, climb)).platform, all.platform);
+}
+
+TEST(WalkableReach, AgentTallerThanTheRoomReachesNothingAndNarrowFloorIsNotStoodOn) {
+  const Scene s = closed_level();
+  WalkableOptions tall = closed_level_options({{10, 2, 10}});
+  tall.agent.height = 10.5;  // the room is 10 high
+  EXPECT_THROW(walkable_cells(s, tall), PlacementError);
+  // A ledge 0.4 wide (a shelf on the wall, 1.2 up: reached from a start on it) is narrower
+  // than an agent of radius 0.45 but not than one of radius 0.1.
+  Scene shelf = closed_level();
+  add_box(shelf, {0, 3.2, 9}, {0.4, 3.4, 13});
+  WalkableOptions wide = closed_level_options({{0.2, 4, 11}});
+  wide.required_starts = false;
+  wide.starts.push_back({{10, 2, 10}, "test"});
+  auto shelf_cells = [&](const WalkableOptions& o) {
+    size_t n = 0;
+    for (const auto& b : walkable_cells(shelf, o).layout.boxes) n += b.min[1] == 3.4 + 1.5;
+    return n;
+  };
+  EXPECT_EQ(shelf_cells(wide), 0u);
+  WalkableOptions thin = wide;
+  thin.agent.radius = 0.1;
+  EXPECT_EQ(shelf_cells(thin), 2u);
+}
+
+TEST(WalkableReach, StartWithoutFloorIsRefusedOrLeftOutAndRecorded) {
+  const Scene s = closed_level();
+  WalkableOptions o = closed_level_options({{10, -5, 10}});  // under the level
+  try {
+    walkable_cells(s, o);
+    ADD_FAILURE() << "no error";
+  } catch (const PlacementError& e) {
+    EXPECT_EQ(e.problem(), PlacementProblem::StartWithoutFloor);
+    EXPECT_NE(std::string(e.what()).find("10,-5,10"), std::string::npos) << e.what();
+  }
+  o.required_starts = false;
+  EXPECT_THROW(walkable_cells(s, o), PlacementError);  // no start has floor
+  o.starts.push_back({{10, 2, 10}, "second"});
+  const ViewCells c = walkable_cells(s, o);
+  EXPECT_EQ(level_counts(c).roof, 0u);
+  const auto d = nlohmann::json::parse(c.description);
+  ASSERT_EQ(d["starts"].size(), 2u);
+  EXPECT_TRUE(d["starts"][0]["floor"].is_null());
+  // The floor as voxelized: rounded up by at most a voxel height (0.225).
+  EXPECT_NEAR(d["starts"][1]["floor"].get<double>(), 1.0 + 0.1125, 0.1125);
+  EXPECT_EQ(d["starts"][1]["source"], "second");
+}
+
+TEST(WalkableReach, DescriptionRecordsTheRuleTheAgentAndTheStarts) {
+  const Scene s = closed_level();
+  const auto none = nlohmann::json::parse(walkable_cells(s, closed_level_options({})).description);
+  EXPECT_EQ(none["rule"], "every floor level with headroom");
+  EXPECT_FALSE(none.contains("starts"));
+  const auto d =
+      nlohmann::json::parse(walkable_cells(s, closed_level_options({{10, 2, 10}})).description);
+  EXPECT_NE(d["rule"].get<std::string>().find("reachable from the starts"), std::string::npos);
+  EXPECT_EQ(d["agent"]["height"], 1.8);
+  EXPECT_EQ(d["agent"]["radius"], 0.45);
+  EXPECT_EQ(d["agent"]["step"], 0.45);
+  EXPECT_EQ(d["starts"][0]["point"], nlohmann::json({10, 2, 10}));
+  EXPECT_GT(d["voxel"]["side"].get<double>(), 0);
+}
+
+TEST(WalkableReach, SameInputsGiveTheSameCells) {
+  const Scene s = closed_level();
+  const WalkableOptions o = closed_level_options({{5, 6, 5}, {10, 2, 10}});
+  const ViewCells a = walkable_cells(s, o), b = walkable_cells(s, o);
+  EXPECT_EQ(a.description, b.description);
+  ASSERT_EQ(a.layout.boxes.size(), b.layout.boxes.size());
+  for (size_t k = 0; k < a.layout.boxes.size(); ++k)
+    EXPECT_TRUE(a.layout.boxes[k] == b.layout.boxes[k]) << k;
+}
+
+TEST(WalkableReach, ClockwiseFrontFacesFindTheSameFloorsWhenTheWindingIsReversed) {
+  // A Quake map's faces are wound clockwise seen from the front: the same level with every
+  // triangle reversed, read with clockwise_front, gives the same cells.
+  const Scene s = closed_level();
+  Scene reversed = s;
+  for (auto& t : reversed.triangles) std::swap(t[1], t[2]);
+  WalkableOptions o = closed_level_options({{10, 2, 10}});
+  const ViewCells a = walkable_cells(s, o);
+  EXPECT_THROW(walkable_cells(reversed, o), PlacementError);  // read counter-clockwise: no floor
+  o.clockwise_front = true;
+  const ViewCells b = walkable_cells(reversed, o);
+  ASSERT_EQ(a.layout.boxes.size(), b.layout.boxes.size());
+  for (size_t k = 0; k < a.layout.boxes.size(); ++k)
+    EXPECT_TRUE(a.layout.boxes[k] == b.layout.boxes[k]) << k;
+}
+
+TEST(WalkableReach, PlacementDefaultsTheAgentFromTheEyeBandAndRefusesABadOne) {
+  const Scene s = closed_level();
+  CellPlacement p;
+  p.walkable = true;
+  p.starts = {{{10, 2, 10}, "test"}};
+  const auto d = nlohmann::json::parse(place_view_cells(s, p).description);
+  EXPECT_EQ(d["agent"]["height"], 1.8);
+  EXPECT_EQ(d["agent"]["radius"], 0.45);
+  EXPECT_EQ(d["agent"]["step"], 0.45);
+  p.agent_step = -1;
+  try {
+    place_view_cells(s, p);
+    ADD_FAILURE() << "no error";
+  } catch (const PlacementError& e) {
+    EXPECT_EQ(e.problem(), PlacementProblem::BadAgent);
+  }
+}
+
+// The level as an OBJ file, for the command line.
+namespace {
+std::string closed_level_obj() {
+  static const std::string path = [] {
+    const Scene s = closed_level();
+    std::string p = vislib_test::temp_dir("walkable_reach_obj") + "/level.obj";
+    std::ofstream out(p);
+    for (const Vec3& v : s.positions[0]) out << "v " << v.x << ' ' << v.y << ' ' << v.z << '\n';
+    for (const auto& t : s.triangles)
+      out << "f " << t[0] + 1 << ' ' << t[1] + 1 << ' ' << t[2] + 1 << '\n';
+    return p;
+  }();
+  return path;
+}
+}  // namespace
+
+TEST(WalkableReach, CliKeepsOnlyReachableCellsAndRefusesBadStartsWithExitTwo) {
+  const std::string base = "bake " + closed_level_obj() + " --walkable --cell-size 2 --dry-run ";
+  std::string out;
+  ASSERT_EQ(vislib_test::run_pvs(base + "-o x.pvs", &out), 0) << out;
+  const size_t all = std::stoul(out);
+  ASSERT_EQ(vislib_test::run_pvs(base + "--walkable-from 10,2,10 -o x.pvs", &out), 0) << out;
+  EXPECT_EQ(std::stoul(out), all - 11 * 11 - 4) << out;  // no roof, no platform top
+  ASSERT_EQ(
+      vislib_test::run_pvs(base + "--walkable-from 10,2,10 --walkable-from 5,6,5 -o x.pvs", &out),
+      0)
+      << out;
+  EXPECT_EQ(std::stoul(out), all - 11 * 11) << out;
+  ASSERT_EQ(vislib_test::run_pvs(base + "--walkable-from none -o x.pvs", &out), 0) << out;
+  EXPECT_EQ(std::stoul(out), all) << out;  // every floor level, as without a start
+  EXPECT_EQ(
+      vislib_test::run_pvs(base + "--walkable-from none --walkable-from 1,2,3 -o x.pvs", &out), 2)
+      << out;
+  EXPECT_NE(out.find("'none' alone"), std::string::npos) << out;
+  for (const char* bad : {"1,2", "1,2,3,4", "a,b,c", "nan,0,0", "1,inf,3", ""}) {
+    EXPECT_EQ(vislib_test::run_pvs(base + "--walkable-from '" + bad + "' -o x.pvs", &out), 2)
+        << bad << "\n"
+        << out;
+    EXPECT_NE(out.find("--walkable-from"), std::string::npos) << out;
+    EXPECT_NE(out.find("expected x,y,z"), std::string::npos) << out;
+  }
+  EXPECT_EQ(vislib_test::run_pvs(base + "--walkable-from 10,-50,10 -o x.pvs", &out), 2) << out;
+  EXPECT_NE(out.find("10,-50,10 (--walkable-from) has no walkable floor under it"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(vislib_test::run_pvs("bake " + closed_level_obj() +
+                                     " --box 0,0,0,20,12,20 --grid 1,1,1 --walkable-from 1,2,3 "
+                                     "--dry-run -o x.pvs",
+                                 &out),
+            2)
+      << out;
+  EXPECT_NE(out.find("--walkable-from: only applies with --walkable"), std::string::npos) << out;
+  EXPECT_EQ(vislib_test::run_pvs(base + "--walkable-from 10,2,10 --agent-height 0 -o x.pvs", &out),
+            2)
+      << out;
+}
+
+// fdm6 (Sauerbraten units, eyes 12-16 up, docs/bake.md): a basin whose outer walls' tops form a
+// ring at y = 144 (208 on one side), the roof of the map's shell. From a start in the basin no
+// cell stands on them.
+TEST(WalkableReachRealScenes, Fdm6KeepsNoCellOnTheShellsRoof) {
+  VISLIB_REQUIRE_SHARED(shared);
+  const Scene s = load_scene(shared + "/scenes/sauer_fdm6/fdm6.obj");
+  CellPlacement p;
+  p.walkable = true;
+  p.cell_size = 16;
+  p.eye = EyeBand{12, 16};
+  auto on_roof = [](const ViewCells& c) {
+    size_t n = 0;
+    for (const auto& b : c.layout.boxes) n += b.min[1] - 12 >= 144;
+    return n;
+  };
+  const ViewCells all = place_view_cells(s, p);
+  EXPECT_EQ(all.layout.cell_count(), 1266u);
+  EXPECT_GT(on_roof(all), 200u);
+  p.starts = {{{-16, 20, -16}, "basin"}};
+  const ViewCells kept = place_view_cells(s, p);
+  EXPECT_EQ(on_roof(kept), 0u);
+  EXPECT_LT(kept.layout.cell_count(), all.layout.cell_count());
+  for (const auto& b : kept.layout.boxes) EXPECT_LT(b.max[1], 144.0);
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "vislib/base/random.h"
@@ -125,6 +126,34 @@ struct FloorPiece {
   double lo, hi;
 };
 
+std::string point_text(Vec3 p) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%g,%g,%g", p.x, p.y, p.z);
+  return text;
+}
+
+// The starts without floor: refused as WalkableOptions::required_starts says.
+void check_start_floors(const WalkableOptions& o, const ReachableFloor& reach) {
+  const WalkAgent& a = o.agent;
+  char agent[160];
+  std::snprintf(agent, sizeof agent, "agent height %g, radius %g, step %g; slope limit %g degrees",
+                a.height, a.radius, a.step, o.max_slope_degrees);
+  bool any = false;
+  for (size_t k = 0; k < o.starts.size(); ++k) {
+    any = any || reach.start_floors[k].has_value();
+    if (o.required_starts && !reach.start_floors[k])
+      throw PlacementError(PlacementProblem::StartWithoutFloor,
+                           "start " + point_text(o.starts[k].point) + " (" + o.starts[k].source +
+                               ") has no walkable floor under it (" + agent + ")");
+  }
+  if (!any)
+    throw PlacementError(
+        PlacementProblem::StartWithoutFloor,
+        "none of the " + std::to_string(o.starts.size()) +
+            " starts has walkable floor under it (first: " + point_text(o.starts[0].point) + ", " +
+            o.starts[0].source + "; " + agent + ")");
+}
+
 }  // namespace
 
 ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
@@ -138,7 +167,41 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
                       {"eye_height", {options.eye.lo, options.eye.hi}},
                       {"max_slope_degrees", options.max_slope_degrees},
                       {"require_headroom", options.require_headroom}};
+  if (options.clockwise_front) d["front_faces"] = "clockwise";
   if (options.clip) d["clip"] = box_json(*options.clip);
+  d["rule"] = options.starts.empty() ? "every floor level with headroom"
+                                     : "floor levels an agent can stand on, reachable from the "
+                                       "starts by steps and drops";
+  // Reachability: the floor the agent can stand on, from the starts.
+  std::optional<ReachableFloor> reach;
+  if (!options.starts.empty() && scene.triangle_count() > 0) {
+    ReachOptions ro;
+    ro.agent = options.agent;
+    ro.max_slope_degrees = options.max_slope_degrees;
+    ro.clockwise_front = options.clockwise_front;
+    ro.starts = options.starts;
+    ro.voxel = S / 4;
+    if (options.agent.radius > 0) ro.voxel = std::min(ro.voxel, options.agent.radius / 2);
+    ro.state = options.state;
+    reach = reachable_floor(scene, ro);
+    check_start_floors(options, *reach);
+  }
+  if (!options.starts.empty()) {
+    nlohmann::json starts = nlohmann::json::array();
+    for (size_t k = 0; k < options.starts.size(); ++k) {
+      const WalkStart& st = options.starts[k];
+      nlohmann::json floor = nullptr;
+      if (reach && reach->start_floors[k]) floor = *reach->start_floors[k];
+      starts.push_back({{"point", {st.point.x, st.point.y, st.point.z}},
+                        {"source", st.source},
+                        {"floor", floor}});
+    }
+    d["agent"] = {{"height", options.agent.height},
+                  {"radius", options.agent.radius},
+                  {"step", options.agent.step}};
+    d["starts"] = starts;
+    if (reach) d["voxel"] = {{"side", reach->voxel}, {"height", reach->voxel_height}};
+  }
   cells.description = d.dump();
   if (region.empty() || scene.triangle_count() == 0) return cells;
 
@@ -154,7 +217,6 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
   };
 
   // Bin every non-vertical triangle by its xz bounding box; mark floors.
-  const double cos_limit = std::cos(options.max_slope_degrees * M_PI / 180.0);
   std::vector<std::vector<uint32_t>> columns(size_t(nx) * nz);
   std::vector<uint8_t> is_floor(scene.triangle_count(), 0);
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
@@ -162,7 +224,7 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
     Vec3 n = cross(c[1] - c[0], c[2] - c[0]);
     double len = length(n);
     if (!(len > 0) || n.y == 0) continue;
-    is_floor[t] = n.y > 0 && n.y >= cos_limit * len;
+    is_floor[t] = floor_triangle(c, options.max_slope_degrees, options.clockwise_front);
     double x0 = std::min({c[0].x, c[1].x, c[2].x}), x1 = std::max({c[0].x, c[1].x, c[2].x});
     double z0 = std::min({c[0].z, c[1].z, c[2].z}), z1 = std::max({c[0].z, c[1].z, c[2].z});
     if (x1 < region.min.x || x0 > region.max.x || z1 < region.min.z || z0 > region.max.z) continue;
@@ -175,6 +237,7 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
         columns[size_t(k) * nx + i].push_back(t);
   }
 
+  const double up = options.clockwise_front ? -1 : 1;  // the sign of a front normal's y facing up
   const double min_area = kMinFloorAreaFraction * S * S;
   const double tol = kFloorHeightTolerance * S;
   for (uint32_t k = 0; k < nz; ++k) {
@@ -226,7 +289,7 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
                   auto c = scene.corners(u, options.state);
                   auto h = height_at(c, x, z);
                   if (!h) continue;
-                  bool facing_down = cross(c[1] - c[0], c[2] - c[0]).y < 0;
+                  bool facing_down = cross(c[1] - c[0], c[2] - c[0]).y * up < 0;
                   if ((*h > *f + tol && *h <= *f + options.eye.lo) ||
                       (facing_down && *h >= *f - tol && *h <= *f + options.eye.lo)) {
                     blocked = true;
@@ -241,6 +304,10 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
             }
           }
           if (!open) continue;
+        }
+        if (reach) {
+          const double t = reach->voxel + reach->voxel_height;
+          if (!reach->any_in(x0, x1, z0, z1, level.lo - t, level.hi + t)) continue;
         }
         pvs::Box b;
         b.min[0] = x0;
@@ -266,12 +333,23 @@ ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
     w.cell_size = p.cell_size > 0 ? p.cell_size : 2.0;
     if (p.eye) w.eye = *p.eye;
     w.max_slope_degrees = p.max_slope_degrees;
+    w.clockwise_front = p.clockwise_front;
     w.require_headroom = p.require_headroom;
     w.clip = box;
+    w.starts = p.starts;
+    w.required_starts = p.required_starts;
+    w.agent.height = p.agent_height.value_or(w.eye.hi);
+    w.agent.radius = p.agent_radius.value_or(w.eye.hi / 4);
+    w.agent.step = p.agent_step.value_or(w.eye.hi / 4);
     const Box3 r = box ? *box : scene.bounds();
     auto columns = [&](double extent) { return std::max(1.0, std::ceil(extent / w.cell_size)); };
     if (!r.empty() && columns(r.max.x - r.min.x) * columns(r.max.z - r.min.z) > kMaxPlacedCells)
       throw PlacementError(PlacementProblem::TooManyColumns, "more than 10^7 walkable columns");
+    const WalkAgent& a = w.agent;
+    if (!w.starts.empty() && !(std::isfinite(a.height) && a.height > 0 && std::isfinite(a.radius) &&
+                               a.radius >= 0 && std::isfinite(a.step) && a.step >= 0))
+      throw PlacementError(PlacementProblem::BadAgent,
+                           "the agent needs a finite height > 0, radius >= 0 and step >= 0");
     return walkable_cells(scene, w);
   }
   if (!box) throw PlacementError(PlacementProblem::NoBox, "a grid of cells needs a box");

@@ -25,6 +25,7 @@
 
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/face_sweep.h"
+#include "vislib/bake/walkable_reach.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/scene.h"
 
@@ -73,6 +74,9 @@ struct WalkableOptions {
   double cell_size = 2;           // side of a column in x and z (scene units), > 0
   EyeBand eye;                    // band above the floor
   double max_slope_degrees = 45;  // floor triangles: angle between the normal and +y below this
+  // Front faces are wound clockwise (a Quake map's faces): floor and facing down are then taken
+  // from -(b - a) x (c - a) (floor_triangle, walkable_reach.h).
+  bool clockwise_front = false;
   // Drop a floor level that has no headroom: at every one of a 4 x 4 grid of sample points in the
   // column where the level's floor is, some other surface lies within eye.lo above it (the ground
   // under a building, the floor inside a wall). Point-sampled: errs towards keeping cells.
@@ -80,6 +84,14 @@ struct WalkableOptions {
   // Only place cells in this box (x and z range of the columns, y range of the floors), if set.
   std::optional<Box3> clip;
   size_t state = 0;  // key state whose geometry is used
+  // Reachability (walkable_reach.h): with starts, a level is kept only where `agent` can stand
+  // on floor reachable from one of them; without, every level (with headroom) is kept.
+  std::vector<WalkStart> starts;
+  WalkAgent agent;
+  // Starts whose point has no walkable floor under it: with `required_starts`, the first such
+  // start throws PlacementError(StartWithoutFloor); otherwise it is left out (and recorded), and
+  // only when no start has floor is PlacementError(StartWithoutFloor) thrown.
+  bool required_starts = true;
 };
 
 // (b) Walkable cells. Columns start at the x/z minimum of `clip` (or of the scene bounds) and are
@@ -87,10 +99,14 @@ struct WalkableOptions {
 // parts of floor triangles inside the column, clipped exactly, each of area above
 // kMinFloorAreaFraction * cell_size^2) are grouped into levels: sorted by height, a piece joins
 // the level below when its lowest point is within eye.hi of that level's highest point. A level
-// [lo, hi] gives the cell [column x] x [lo + eye.lo, hi + eye.hi] x [column z]. Cell order: columns
+// [lo, hi] gives the cell [column x] x [lo + eye.lo, hi + eye.hi] x [column z]. With starts, a
+// level is kept only when reachable_floor (voxel side min(cell_size / 4, agent.radius / 2 when
+// > 0)) has a floor in a voxel column centred in the column at a height within
+// [lo - t, hi + t], t = the voxel's side + its height (the voxels round floors up by at most
+// their height, and a column's top is the highest floor over its side). Cell order: columns
 // by z index, then x index, levels bottom to top. Deterministic (sequential, no threads).
-// Triangles facing up are those with (b - a) x (c - a) having a positive y component: the
-// winding matters (glTF's counter-clockwise front faces).
+// Triangles facing up are those with (b - a) x (c - a) having a positive y component (the
+// opposite with clockwise_front): the winding matters (glTF's counter-clockwise front faces).
 ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options);
 
 // How the cells of a bake are placed (pvs bake --box, --grid, --cell-size, --walkable,
@@ -103,7 +119,13 @@ struct CellPlacement {
   bool walkable = false;  // (b) instead of (a)
   std::optional<EyeBand> eye;     // band above a cell's bottom / a floor; (b) default EyeBand{}
   double max_slope_degrees = 45;  // (b) WalkableOptions::max_slope_degrees
+  bool clockwise_front = false;   // (b) WalkableOptions::clockwise_front
   bool require_headroom = true;   // (b) WalkableOptions::require_headroom
+  // (b) WalkableOptions::starts and required_starts; the agent's height (default: the eye band's
+  // top), radius and step (default: a quarter of the band's top each), each finite, height > 0.
+  std::vector<WalkStart> starts;
+  bool required_starts = true;
+  std::optional<double> agent_height, agent_radius, agent_step;
 };
 
 // At most this many grid cells, or walkable columns, are placed (their index would not fit the
@@ -119,6 +141,8 @@ enum class PlacementProblem {
   TooManyGridCells,   // (a) nx * ny * nz > kMaxPlacedCells
   NoGridNorCellSize,  // (a) neither grid counts nor a cell size
   TooManySizedCells,  // (a) more than kMaxPlacedCells cells of cell_size over box
+  BadAgent,           // (b) agent height <= 0, radius or step < 0, or one not finite
+  StartWithoutFloor,  // (b) a start has no walkable floor under it (walkable_cells); or none has
 };
 class PlacementError : public std::invalid_argument {
  public:
@@ -132,7 +156,8 @@ class PlacementError : public std::invalid_argument {
 
 // The cells of `placement`: walkable_cells (cell_size 0 = 2) when `walkable`, else grid_cells
 // (counts) or grid_cells_by_size (cell size). Throws PlacementError, checked in the order of
-// PlacementProblem, before placing anything. May return no cell (walkable: no floor in box).
+// PlacementProblem, before placing anything (StartWithoutFloor: while placing; its message names
+// the start, its source and the agent). May return no cell (walkable: no floor in box).
 // Deterministic; `scene` is read only for walkable cells.
 ViewCells place_view_cells(const Scene& scene, const CellPlacement& placement);
 

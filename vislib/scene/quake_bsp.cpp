@@ -27,7 +27,10 @@
 #include <cassert>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <iterator>
+#include <optional>
 
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
@@ -607,6 +610,56 @@ std::vector<uint32_t> bsp_leaf_drawn_triangles(const QuakeBsp& bsp,
     for (uint32_t k = 0; k < faces[f].triangle_count; ++k)
       tris.push_back(faces[f].first_triangle + k);
   return tris;
+}
+
+std::vector<BspEntityPoint> bsp_player_starts(const QuakeBsp& bsp) {
+  const std::string& t = bsp.entities;
+  size_t at = 0;
+  const auto skip_space = [&] {
+    while (at < t.size() && std::isspace(static_cast<unsigned char>(t[at]))) ++at;
+  };
+  // A quoted string at `at`, or none (malformed).
+  const auto quoted = [&]() -> std::optional<std::string> {
+    skip_space();
+    if (at >= t.size() || t[at] != '"') return std::nullopt;
+    const size_t end = t.find('"', at + 1);
+    if (end == std::string::npos) return std::nullopt;
+    std::string out = t.substr(at + 1, end - at - 1);
+    at = end + 1;
+    return out;
+  };
+  std::vector<BspEntityPoint> starts;
+  for (;;) {
+    skip_space();
+    if (at >= t.size() || t[at] != '{') break;
+    ++at;
+    std::string classname, origin;
+    bool closed = false;
+    for (;;) {
+      skip_space();
+      if (at < t.size() && t[at] == '}') {
+        ++at;
+        closed = true;
+        break;
+      }
+      const auto key = quoted();
+      const auto value = key ? quoted() : std::nullopt;
+      if (!value) break;
+      if (*key == "classname") classname = *value;
+      if (*key == "origin") origin = *value;
+    }
+    if (!closed) break;
+    static const char* const kStarts[] = {"info_player_start", "info_player_start2",
+                                          "info_player_deathmatch", "info_player_coop"};
+    if (std::find(std::begin(kStarts), std::end(kStarts), classname) == std::end(kStarts)) continue;
+    double q[3];
+    char extra;
+    if (std::sscanf(origin.c_str(), "%lf %lf %lf %c", &q[0], &q[1], &q[2], &extra) != 3 ||
+        !std::isfinite(q[0]) || !std::isfinite(q[1]) || !std::isfinite(q[2]))
+      continue;
+    starts.push_back({classname, quake_to_scene({q[0], q[1], q[2]})});
+  }
+  return starts;
 }
 
 uint32_t bsp_point_leaf(const QuakeBsp& bsp, Vec3 p) {

@@ -162,6 +162,24 @@ std::vector<uint32_t> bsp_leaf_drawn_faces(const QuakeBsp& bsp, uint32_t leaf);
 std::vector<uint32_t> bsp_leaf_drawn_triangles(const QuakeBsp& bsp,
                                                const std::vector<BspFaceTriangles>& faces,
                                                uint32_t leaf);
+// A point entity of the map's entities lump: its classname and origin (scene coordinates).
+struct BspEntityPoint {
+  std::string classname;
+  Vec3 origin;
+};
+// The player starts the entities lump names, in lump order: the entities whose classname is
+// info_player_start, info_player_start2, info_player_deathmatch or info_player_coop and whose
+// "origin" is three finite numbers (Quake coordinates, turned into the scene's by
+// quake_to_scene). The origin is the player's centre, 24 units above the floor it stands on. The
+// lump is read as the engine reads it ({ "key" "value" ... } blocks); an entity with no or a
+// malformed origin is left out, and reading stops at the first malformed block (the starts
+// before it are kept). Deterministic.
+std::vector<BspEntityPoint> bsp_player_starts(const QuakeBsp& bsp);
+
+// Quake's player (the engine's player hull, -16..16 x -16..16 x -24..32, and its STEPSIZE), in
+// Quake units: the agent of walkable cells on a Quake map.
+constexpr double kQuakePlayerHeight = 56, kQuakePlayerRadius = 16, kQuakeStepHeight = 18;
+
 // The leaf of model 0 holding the Quake-space point `p`: walks the node tree from model 0's head
 // node, taking the front child where dot(normal, p) - dist > 0 and the back child otherwise (the
 // engine's Mod_PointInLeaf).
