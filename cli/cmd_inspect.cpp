@@ -146,12 +146,7 @@ void run_inspect(const InspectArgs& a) {
     if (!a.scene.empty()) {
       // Points of the view region enclosed by the scene.
       free_space = vislib::cell_free_space(scene, vislib::to_box3(info.layout.view_region(c)));
-      j["free_space"] = {{"samples", free_space.samples},
-                         {"enclosed", free_space.enclosed},
-                         {"centre_enclosed", free_space.centre_enclosed}};
-      if (free_space.free_point)
-        j["free_space"]["free_point"] = {free_space.free_point->x, free_space.free_point->y,
-                                         free_space.free_point->z};
+      j["free_space"] = free_space_json(free_space);
       if (free_space.enclosed > 0)
         warn("cell " + std::to_string(c) + ": " + std::to_string(free_space.enclosed) + " of " +
              std::to_string(free_space.samples) +

@@ -3,24 +3,20 @@
 // files belong together, prints.
 #include <cmath>
 #include <cstdio>
-#include <mutex>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
 
+#include "cli/bake_metadata.h"
 #include "cli/commands.h"
+#include "cli/kernel_rerun.h"
 #include "cli/load_scene.h"
 #include "cli/options.h"
 #include "cli/threads.h"
 #include "pvs_format/pvs_format.h"
-#include "vislib/bake/bsp_cells.h"
 #include "vislib/bake/cell_set.h"
-#include "vislib/bake/cell_visibility.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/vis_compare.h"
-#include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/quake_bsp.h"
-#include "vislib/scene/scene_fingerprint.h"
 
 namespace pvs_cli {
 namespace {
@@ -36,35 +32,6 @@ struct VisCompareArgs {
   ImportArgs import;
 };
 
-// The first value of `key` anywhere in `j` (depth first, object keys in order), or null.
-nlohmann::json find_key(const nlohmann::json& j, const std::string& key) {
-  if (j.is_object()) {
-    if (j.contains(key)) return j[key];
-    for (const auto& [k, v] : j.items()) {
-      nlohmann::json r = find_key(v, key);
-      if (!r.is_null()) return r;
-    }
-  } else if (j.is_array()) {
-    for (const auto& v : j) {
-      nlohmann::json r = find_key(v, key);
-      if (!r.is_null()) return r;
-    }
-  }
-  return nullptr;
-}
-
-// Import options recorded in the PVS metadata override the flags (the scene must be the one the
-// bake used); a flag given with another value is warned about.
-void import_from_metadata(const nlohmann::json& md, const std::string& key, std::string& value,
-                          const CLI::App& cmd, const std::string& flag, const std::string& pvs) {
-  const nlohmann::json v = find_key(md, key);
-  if (!v.is_string()) return;
-  const std::string recorded = v.get<std::string>();
-  if (cmd.count(flag) && value != recorded)
-    warn(flag + " " + value + " ignored: " + pvs + " was baked with " + recorded);
-  value = recorded;
-}
-
 void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   if (!a.json.empty()) check_output_file(a.json, "--json", true);
   if (!a.theirs_pvs.empty()) check_output_file(a.theirs_pvs, "--theirs-pvs", false);
@@ -78,44 +45,22 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   if (info.partial)
     throw vislib::InputError(a.pvs, "a partial file (a shard): merge the shards first");
   const nlohmann::json md = nlohmann::json::parse(info.metadata, nullptr, false);
-  if (!md.is_discarded()) {
-    import_from_metadata(md, "bsp_liquids", a.import.bsp_liquids, cmd, "--bsp-liquids", a.pvs);
-    import_from_metadata(md, "bsp_models", a.import.bsp_models, cmd, "--bsp-models", a.pvs);
-  }
   vislib::VisCompareOptions opt;
   opt.samples = a.samples;
   opt.witness_eyes = a.witness_eyes;
   opt.witness_targets = a.witness_targets;
   opt.seed = a.seed;
-  opt.resolution = 64;
-  if (!md.is_discarded()) {
-    if (md.contains("resolution") && md["resolution"].is_number_integer())
-      opt.resolution = md["resolution"].get<int>();
-    if (md.contains("near") && md["near"].is_number()) opt.z_near = md["near"].get<double>();
-    if (md.contains("eps_z") && md["eps_z"].is_number()) opt.eps_z = md["eps_z"].get<double>();
-  }
-  if (a.resolution > 0) opt.resolution = a.resolution;
-  if (!(opt.resolution >= 1 && opt.z_near > 0 && opt.eps_z >= 0))
-    throw vislib::InputError(a.pvs, "metadata holds an invalid resolution, near or eps_z");
+  const BakeSampling sampling = bake_sampling(md, a.pvs, a.resolution);
+  opt.resolution = sampling.resolution;
+  opt.z_near = sampling.near;
+  opt.eps_z = sampling.eps_z;
 
-  vislib::Scene scene = load_scene_for_cli(a.map, 1, a.import);
-  if (vislib::scene_fingerprint(scene) != info.scene_fingerprint)
-    throw vislib::InputError(a.pvs, "was not baked from " + a.map + " imported with --bsp-models " +
-                                        a.import.bsp_models + " --bsp-liquids " +
-                                        a.import.bsp_liquids + " (scene fingerprints differ)");
+  const vislib::Scene scene = load_baked_scene(a.map, info, md, a.import, cmd, a.pvs);
   const vislib::QuakeBsp bsp = vislib::read_quake_bsp(a.map);
-  vislib::LoadOptions lo;
-  lo.bsp_models = a.import.bsp_models == "all" ? vislib::BspModels::all : vislib::BspModels::world;
-  lo.bsp_liquids = a.import.bsp_liquids == "omit"          ? vislib::BspLiquids::omit
-                   : a.import.bsp_liquids == "see-through" ? vislib::BspLiquids::see_through
-                                                           : vislib::BspLiquids::opaque;
+  const vislib::LoadOptions lo = load_options_of(a.import);
   const std::vector<vislib::BspFaceTriangles> faces = vislib::bsp_face_triangles(bsp, lo);
   const std::vector<uint32_t>& cell_leaf = info.layout.cell_leaf;
-  for (uint32_t c = 0; c < cell_leaf.size(); ++c)
-    if (cell_leaf[c] == 0 || cell_leaf[c] >= bsp.leaves.size())
-      throw vislib::InputError(a.pvs, "cell " + std::to_string(c) + " is leaf " +
-                                          std::to_string(cell_leaf[c]) +
-                                          ", not a non-solid leaf of " + a.map);
+  check_leaf_cells(info, bsp, a.map, a.pvs);
   std::vector<std::vector<uint32_t>> ours(cell_leaf.size());
   vislib::reading_pvs(a.pvs, [&] {
     for (uint32_t c = 0; c < cell_leaf.size(); ++c) ours[c] = reader.read_cell(c);
@@ -142,73 +87,8 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
   }
 
   // Kernel witnesses: the cells rebuilt and their runs re-made as the bake's metadata says.
-  vislib::ViewCells cells;
-  vislib::RegionOptions ro;
-  vislib::TriangleBvh bvh;
-  vislib::EdgeLines lines;
-  std::once_flag scene_built;
-  // What the re-run needs from the metadata; the first key missing, if any.
-  std::string missing;
-  const nlohmann::json spacing = md.is_discarded() ? nullptr : find_key(md, "face_spacing");
-  if (!spacing.is_number()) missing = "face_spacing";
-  for (const char* k : {"resolution", "near", "eps_len", "eps_z", "runs", "seed"})
-    if (missing.empty() && (md.is_discarded() || !md.contains(k) || !md[k].is_number()))
-      missing = k;
-  if (a.kernel_witnesses == "on" && !missing.empty())
-    throw vislib::InputError(a.pvs, "its metadata lacks '" + missing +
-                                        "', needed to re-run its cells for kernel witnesses");
-  const bool rerun = a.kernel_witnesses != "off" && missing.empty();
-  if (rerun) {
-    vislib::BspCellOptions co;
-    co.face_spacing = spacing.get<double>();
-    const nlohmann::json sweep = find_key(md, "face_sweep");
-    if (sweep.is_string() && sweep.get<std::string>() == "adaptive") {
-      const nlohmann::json coarse = find_key(md, "chord_coarse"),
-                           floor = find_key(md, "chord_floor");
-      if (!coarse.is_number() || !floor.is_number() || !(floor.get<double>() > 0) ||
-          !(floor.get<double>() <= coarse.get<double>()))
-        throw vislib::InputError(a.pvs, "metadata holds an invalid chord_coarse or chord_floor");
-      co.adaptive = vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>()};
-    }
-    co.leaves = cell_leaf;
-    co.scene = lo;
-    ro.segment.resolution = md["resolution"].get<int>();
-    ro.segment.near = md["near"].get<double>();
-    co.near = ro.segment.near;
-    ro.segment.eps_len = md["eps_len"].get<double>();
-    ro.segment.eps_z = md["eps_z"].get<double>();
-    ro.runs = md["runs"].get<int>();
-    ro.seed = md["seed"].get<uint64_t>();
-    const nlohmann::json coplanar = find_key(md, "coplanar");
-    ro.segment.coplanar = coplanar.is_string() && coplanar.get<std::string>() == "first"
-                              ? vislib::CoplanarRule::First
-                              : vislib::CoplanarRule::Both;
-    if (!(co.face_spacing >= 0 && ro.segment.resolution >= 1 && ro.segment.near > 0 &&
-          ro.segment.eps_len >= 0 && ro.segment.eps_z >= 0 && ro.runs >= 1))
-      throw vislib::InputError(
-          a.pvs,
-          "metadata holds an invalid face_spacing, resolution, near, eps_len, eps_z or runs");
-    try {
-      cells = vislib::bsp_leaf_cells(bsp, co);
-    } catch (const std::invalid_argument& e) {
-      throw vislib::InputError(a.pvs,
-                               std::string("its cells are not the map's leaf cells: ") + e.what());
-    }
-    opt.kernel_witnesses = [&](uint32_t cell, const std::vector<uint32_t>& extras) {
-      // The tree and the edge lines the bake's runs used, built once the first leaf needs them.
-      std::call_once(scene_built, [&] {
-        bvh = vislib::build_triangle_bvh(scene);
-        ro.segment.bvh = &bvh;
-        lines = vislib::build_edge_lines(scene);
-        ro.segment.edge_lines = &lines;
-      });
-      std::vector<vislib::VisWitness> out;
-      for (const vislib::CellWitnessRay& w :
-           vislib::cell_witness_rays(scene, cells, cell, ro, extras))
-        out.push_back({w.tri, w.eye, w.dir, true});
-      return out;
-    };
-  }
+  KernelRerun rerun(md, a.pvs, a.kernel_witnesses, bsp, scene, cell_leaf, lo);
+  opt.kernel_witnesses = rerun.witnesses();
 
   vislib::VisCompareResult r;
   const bool bar = show_progress();
@@ -251,13 +131,14 @@ void run_vis_compare(VisCompareArgs a, const CLI::App& cmd) {
       (unsigned long)num("extras_confirmed"), (unsigned long)num("extras_unconfirmed"),
       (unsigned long)num("extras_coincident"), (unsigned long)num("extras_tie"),
       (unsigned long)num("extras_false_witness"));
-  if (rerun)
+  if (rerun.enabled())
     std::printf("  kernel witnesses       %lu leaves re-run: %lu extras confirmed by them\n",
                 (unsigned long)num("kernel_rerun_leaves"),
                 (unsigned long)num("extras_confirmed_by_kernel"));
   else
-    std::printf("  kernel witnesses       off%s\n",
-                missing.empty() ? "" : (" (the metadata lacks " + missing + ")").c_str());
+    std::printf(
+        "  kernel witnesses       off%s\n",
+        rerun.missing().empty() ? "" : (" (the metadata lacks " + rerun.missing() + ")").c_str());
   std::printf("  ours lacks             %lu\n", (unsigned long)num("ours_lacks"));
   std::printf(
       "  sampling               %d eyes a leaf, N = %d, %lu rays (%lu no hit, %lu "

@@ -163,6 +163,13 @@ json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids,
 }
 
 // The text output of one cell (the JSON `j` built by the command).
+nlohmann::json free_space_json(const vislib::CellFreeSpace& f) {
+  nlohmann::json j = {
+      {"samples", f.samples}, {"enclosed", f.enclosed}, {"centre_enclosed", f.centre_enclosed}};
+  if (f.free_point) j["free_point"] = {f.free_point->x, f.free_point->y, f.free_point->z};
+  return j;
+}
+
 void print_cell(const json& j, const std::vector<uint32_t>& ids, uint32_t cell_count,
                 const pvs::FileInfo& info, const pvs::BlockInfo& b, size_t scene_triangles,
                 int max_ids) {
@@ -184,11 +191,13 @@ void print_cell(const json& j, const std::vector<uint32_t>& ids, uint32_t cell_c
     std::printf("  absent: this file is a shard; the cell is in another shard\n");
     return;
   }
-  std::printf("  visible: %zu of %u %ss (%.2f%%)\n", ids.size(), info.universe,
+  // One line; object sets add the triangles they hold.
+  std::printf("  visible: %zu of %u %ss (%.2f%%)", ids.size(), info.universe,
               j["granularity"].get<std::string>().c_str(), 100 * j["share"].get<double>());
-  if (j.contains("visible_triangles"))
-    std::printf("  visible triangles: %zu of %zu (%.2f%%)\n", j["visible_triangles"].get<size_t>(),
+  if (j.contains("visible_triangles") && info.granularity == pvs::Granularity::Object)
+    std::printf(", %zu of %zu triangles (%.2f%%)", j["visible_triangles"].get<size_t>(),
                 scene_triangles, 100 * j["triangle_share"].get<double>());
+  std::printf("\n");
   std::printf("  ids:");
   for (size_t i = 0; i < ids.size() && int(i) < max_ids; ++i) std::printf(" %u", ids[i]);
   if (int(ids.size()) > max_ids)

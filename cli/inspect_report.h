@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/free_space.h"
 #include "vislib/base/vec.h"
 #include "vislib/eval/cell_views.h"
 #include "vislib/kernel/region_visibility.h"
@@ -27,6 +28,10 @@ void print_summary(const std::string& path, const nlohmann::json& j);
 nlohmann::json render_cell(const vislib::Scene& scene, const std::vector<uint32_t>& ids,
                            vislib::Granularity g, vislib::Vec3 eye, const std::string& dir,
                            int width, int height, const vislib::CellViewOptions& views = {});
+
+// A cell's free-space samples (vislib/bake/free_space.h) as JSON: samples, enclosed,
+// centre_enclosed and, when there is one, free_point.
+nlohmann::json free_space_json(const vislib::CellFreeSpace& f);
 
 // The text output of one cell (the JSON `j` built by the command).
 void print_cell(const nlohmann::json& j, const std::vector<uint32_t>& ids, uint32_t cell_count,

@@ -14,107 +14,29 @@
 #include "vislib/base/cubemap.h"
 #include "vislib/base/random.h"
 #include "vislib/eval/embree_scene.h"
+#include "vislib/eval/pvs_check.h"
 #include "vislib/eval/ray_reference.h"
+#include "vislib/eval/seeing_rule.h"
 #include "vislib/scene/quake_bsp_volumes.h"
 
 namespace vislib {
 namespace {
-
-constexpr uint32_t kNoPlane = std::numeric_limits<uint32_t>::max();
-// A random eye of a view region is drawn uniformly in its bounding box up to this many times
-// until it falls inside; a region thinner than that allows gets a random convex combination of
-// its corners instead.
-constexpr int kRejectionTries = 64;
 
 struct Context {
   const QuakeBsp& bsp;
   const Scene& scene;
   const EmbreeScene& embree;
   const VisCompareOptions& opt;             // z_near: the cell's (its leaf's near_limit applied)
-  const std::vector<uint32_t>& tri_plane;   // map plane of each triangle's face (kNoPlane: none)
+  SeeingRule rule;                          // with the cell's z_near
+  const std::vector<uint32_t>& tri_plane;   // map plane of each triangle's face (or none)
   const std::vector<uint8_t>& degenerate;   // per triangle
   const std::vector<uint8_t>& never_drawn;  // per triangle: its face is in no marksurfaces
 };
-
-bool inside(const ConvexPolytope& p, Vec3 q) {
-  for (const HalfSpace& h : p.halfspaces)
-    if (dot(h.normal, q) > h.offset) return false;
-  return true;
-}
-
-std::vector<Vec3> corners(const ConvexPolytope& p) {
-  std::vector<Vec3> v;
-  for (const auto& f : p.faces)
-    for (const Vec3& q : f)
-      if (std::find(v.begin(), v.end(), q) == v.end()) v.push_back(q);
-  return v;
-}
-
-// A random point of the region (Quake coordinates).
-Vec3 random_point(const ConvexPolytope& p, const std::vector<Vec3>& c, Rng& rng) {
-  const Box3 b = p.bounds();
-  for (int i = 0; i < kRejectionTries; ++i) {
-    const Vec3 q{rng.uniform(b.min.x, b.max.x), rng.uniform(b.min.y, b.max.y),
-                 rng.uniform(b.min.z, b.max.z)};
-    if (inside(p, q)) return q;
-  }
-  Vec3 sum{0, 0, 0};
-  double w = 0;
-  for (const Vec3& q : c) {
-    const double wi = -std::log(1.0 - rng.uniform());
-    sum = sum + q * wi;
-    w += wi;
-  }
-  return sum * (1.0 / w);
-}
 
 Vec3 centroid(const std::vector<Vec3>& c) {
   Vec3 s{0, 0, 0};
   for (const Vec3& q : c) s = s + q;
   return s * (1.0 / double(c.size()));
-}
-
-// The crossing of `tri` among `cr`, if any.
-const RayCrossing* crossing_of(const std::vector<RayCrossing>& cr, uint32_t tri) {
-  for (const RayCrossing& c : cr)
-    if (c.tri == tri) return &c;
-  return nullptr;
-}
-
-// The seeing rule of vis_compare.h: `tri` is crossed inside its edges beyond z_near and no opaque
-// crossing lies in front of it by more than eps_z. Returns its depth, or a negative value.
-double seen_depth(const Context& ctx, const std::vector<RayCrossing>& cr, uint32_t tri) {
-  const RayCrossing* t = crossing_of(cr, tri);
-  if (!t || t->min_bary <= kReferenceBarycentric || t->lambda <= ctx.opt.z_near + kReferenceNear)
-    return -1;
-  const double front = t->lambda * (1.0 - ctx.opt.eps_z);
-  for (const RayCrossing& c : cr)
-    if (c.tri != tri && !ctx.scene.triangle_see_through(c.tri) &&
-        c.lambda > ctx.opt.z_near - kReferenceNear && c.lambda < front)
-      return -1;
-  return t->lambda;
-}
-
-// The tie class of vis_compare.h: `tri` is crossed beyond z_near but not farther than
-// kReferenceBarycentric inside its edges (so seen_depth refused it), and no opaque crossing lies
-// in front of it by more than eps_z: only the kernel's tie rules decide such a ray.
-bool seen_at_tie(const Context& ctx, const std::vector<RayCrossing>& cr, uint32_t tri) {
-  const RayCrossing* t = crossing_of(cr, tri);
-  if (!t || t->lambda <= ctx.opt.z_near + kReferenceNear) return false;
-  const double front = t->lambda * (1.0 - ctx.opt.eps_z);
-  for (const RayCrossing& c : cr)
-    if (c.tri != tri && !ctx.scene.triangle_see_through(c.tri) &&
-        c.lambda > ctx.opt.z_near - kReferenceNear && c.lambda < front)
-      return false;
-  return true;
-}
-
-// Whether a triangle with in_set != 0 is crossed within eps_z of depth `lambda`.
-bool set_at_depth(const Context& ctx, const std::vector<RayCrossing>& cr, double lambda,
-                  const std::vector<uint8_t>& in_set) {
-  for (const RayCrossing& c : cr)
-    if (in_set[c.tri] && std::fabs(c.lambda - lambda) <= ctx.opt.eps_z * lambda) return true;
-  return false;
 }
 
 // The witness search for extra `tri` of a cell whose eyes (scene coordinates) are `eyes`.
@@ -156,11 +78,11 @@ Search find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& e
       }
       if (!candidate) continue;
       const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, eye, dir);
-      const double lambda = seen_depth(ctx, cr, tri);
+      const double lambda = ctx.rule.seen_depth(cr, tri);
       if (lambda < 0) continue;
       // Seen, but where a triangle of theirs lies at the same depth (a coincident face they
       // draw), the ray shows no miss of theirs: search on.
-      if (set_at_depth(ctx, cr, lambda, in_theirs)) {
+      if (ctx.rule.set_at_depth(cr, lambda, in_theirs)) {
         coincident = true;
         continue;
       }
@@ -189,12 +111,12 @@ void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<Vis
     VisWitness w = kw[k];
     w.from_kernel = true;
     const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, w.eye, w.dir);
-    const double lambda = seen_depth(ctx, cr, t);
-    if (lambda < 0 && seen_at_tie(ctx, cr, t))
+    const double lambda = ctx.rule.seen_depth(cr, t);
+    if (lambda < 0 && ctx.rule.seen_at_tie(cr, t))
       row.tie_witnesses.push_back(w);
     else if (lambda < 0)
       row.false_witnesses.push_back(w);
-    else if (set_at_depth(ctx, cr, lambda, in_theirs))
+    else if (ctx.rule.set_at_depth(cr, lambda, in_theirs))
       row.coincident.push_back(t);
     else
       row.confirmed.push_back(w);
@@ -205,97 +127,31 @@ void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<Vis
             [](const VisWitness& a, const VisWitness& b) { return a.tri < b.tri; });
 }
 
-// One hit `x` of the ray (eye, dir), missing from ours and/or theirs: the pre-filter (the next
-// surface behind it, on the same map plane, in the set) then the double-precision re-cast.
-void check_hit(const Context& ctx, VisCompareLeaf& row, Vec3 eye, Vec3 dir, uint32_t x,
-               const std::vector<uint8_t>& in_ours, const std::vector<uint8_t>& in_theirs,
-               std::vector<uint32_t>& our_missed, std::vector<uint32_t>& their_missed) {
-  bool need_ours = !in_ours[x], need_theirs = !in_theirs[x];
-  if (!need_ours && !need_theirs) return;
-  if (!ctx.scene.triangle_see_through(x)) {
-    const Hit g = ctx.embree.first_hit_excluding(eye, dir, ctx.opt.z_near, x);
-    if (g.tri != kNoHit && ctx.tri_plane[g.tri] != kNoPlane &&
-        ctx.tri_plane[g.tri] == ctx.tri_plane[x]) {
-      if (in_ours[g.tri]) need_ours = false;
-      if (in_theirs[g.tri]) need_theirs = false;
-    }
-    if (!need_ours && !need_theirs) return;
+// The sampled ground truth of one leaf (pvs_check.h's sampler, against ours and theirs).
+void sample_leaf(const Context& ctx, VisCompareLeaf& row, const EyeRegion& region,
+                 const std::vector<uint8_t>& in_ours, const std::vector<uint8_t>& in_theirs,
+                 Rng& rng) {
+  SampleSettings st;
+  st.resolution = ctx.opt.resolution;
+  st.z_near = ctx.opt.z_near;
+  st.eps_z = ctx.opt.eps_z;
+  st.tri_plane = &ctx.tri_plane;
+  std::vector<SampledSet> sets(2);
+  sets[0].in_set = &in_ours;
+  sets[1].in_set = &in_theirs;
+  sets[1].excused = &ctx.never_drawn;
+  SampleTally tally;
+  for (int s = 0; s < ctx.opt.samples; ++s)
+    sample_eye(ctx.scene, ctx.embree, st, random_eye(region, rng), sets, tally);
+  row.rays = tally.rays, row.no_hit = tally.no_hit, row.ambiguous = tally.ambiguous;
+  row.our_misses = sets[0].misses, row.their_misses = sets[1].misses;
+  row.their_never_drawn = sets[1].excused_misses;
+  for (SampledSet& set : sets) {
+    std::sort(set.missed.begin(), set.missed.end());
+    set.missed.erase(std::unique(set.missed.begin(), set.missed.end()), set.missed.end());
   }
-  const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, eye, dir);
-  const double lambda = seen_depth(ctx, cr, x);
-  if (lambda < 0) {
-    ++row.ambiguous;
-    return;
-  }
-  if (need_ours && !set_at_depth(ctx, cr, lambda, in_ours)) {
-    ++row.our_misses;
-    our_missed.push_back(x);
-  }
-  if (need_theirs && !set_at_depth(ctx, cr, lambda, in_theirs)) {
-    if (ctx.never_drawn[x]) {
-      ++row.their_never_drawn;
-    } else {
-      ++row.their_misses;
-      their_missed.push_back(x);
-    }
-  }
-}
-
-void sort_unique(std::vector<uint32_t>& v) {
-  std::sort(v.begin(), v.end());
-  v.erase(std::unique(v.begin(), v.end()), v.end());
-}
-
-void sample_leaf(const Context& ctx, VisCompareLeaf& row, const ConvexPolytope& region,
-                 const std::vector<Vec3>& region_corners, const std::vector<uint8_t>& in_ours,
-                 const std::vector<uint8_t>& in_theirs, Rng& rng) {
-  const int n = ctx.opt.resolution;
-  FaceAxes axes[kCubeFaces];
-  for (int k = 0; k < kCubeFaces; ++k) axes[k] = face_axes(k, identity_orientation());
-  std::vector<Vec3> dirs(static_cast<size_t>(n));
-  std::vector<Hit> hits(static_cast<size_t>(n));
-  std::vector<uint32_t> passed;
-  std::vector<uint32_t> our_missed, their_missed;
-  const bool see_through = ctx.embree.has_see_through();
-  for (int s = 0; s < ctx.opt.samples; ++s) {
-    const Vec3 eye = quake_to_scene(random_point(region, region_corners, rng));
-    for (int k = 0; k < kCubeFaces; ++k) {
-      for (int y = 0; y < n; ++y) {
-        for (int x = 0; x < n; ++x) dirs[size_t(x)] = pixel_direction(axes[k], x, y, n);
-        bool redo = false;
-        if (see_through) {
-          passed.clear();
-          ctx.embree.hits_through(eye, dirs.data(), size_t(n), ctx.opt.z_near, hits.data(), passed);
-          for (uint32_t p : passed)
-            if (!in_ours[p] || !in_theirs[p]) redo = true;
-        } else {
-          ctx.embree.first_hits(eye, dirs.data(), size_t(n), ctx.opt.z_near, hits.data());
-        }
-        row.rays += uint64_t(n);
-        for (int x = 0; x < n; ++x) {
-          const Vec3 d = dirs[size_t(x)];
-          if (redo) {  // this row passed a see-through triangle missing from a set: ray by ray
-            Hit h;
-            passed.clear();
-            ctx.embree.hits_through(eye, &d, 1, ctx.opt.z_near, &h, passed);
-            sort_unique(passed);
-            for (uint32_t p : passed)
-              check_hit(ctx, row, eye, d, p, in_ours, in_theirs, our_missed, their_missed);
-          }
-          const uint32_t h = hits[size_t(x)].tri;
-          if (h == kNoHit) {
-            ++row.no_hit;
-            continue;
-          }
-          check_hit(ctx, row, eye, d, h, in_ours, in_theirs, our_missed, their_missed);
-        }
-      }
-    }
-  }
-  sort_unique(our_missed);
-  sort_unique(their_missed);
-  row.our_missed = std::move(our_missed);
-  row.their_missed = std::move(their_missed);
+  row.our_missed = std::move(sets[0].missed);
+  row.their_missed = std::move(sets[1].missed);
 }
 
 }  // namespace
@@ -324,7 +180,7 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
       marked[bsp.marksurfaces[l.first_marksurface + i]] = 1;
   const Box3 bounds = scene.bounds();
   const EmbreeScene embree(scene, 0, tris ? (bounds.min + bounds.max) * 0.5 : Vec3{0, 0, 0});
-  std::vector<uint32_t> tri_plane(tris, kNoPlane);
+  std::vector<uint32_t> tri_plane(tris, kNoTrianglePlane);
   std::vector<uint8_t> degenerate(tris, 0), never_drawn(tris, 0);
   for (uint32_t f = 0; f < faces.size(); ++f) {
     const BspFaceTriangles& ft = faces[f];
@@ -344,10 +200,9 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
     result.never_drawn_triangles += never_drawn[t] && !degenerate[t];
   }
 
-  std::vector<int64_t> piece_of(bsp.leaves.size(), -1);
-  const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(bsp);
-  for (size_t i = 0; i < pieces.size(); ++i)
-    if (pieces[i].leaf != 0) piece_of[pieces[i].leaf] = int64_t(i);
+  std::vector<double> insets;
+  const std::vector<EyeRegion> regions =
+      bsp_leaf_eye_regions(bsp, cell_leaf, options.z_near, &insets);
 
   result.leaves.resize(cell_leaf.size());
   auto one_cell = [&](size_t c) {
@@ -377,16 +232,19 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
 
     Rng witness_rng(Rng::derive(options.seed, 2 * uint64_t(c)));
     Rng sample_rng(Rng::derive(options.seed, 2 * uint64_t(c) + 1));
-    ConvexPolytope region;
+    const EyeRegion& region = regions[c];
+    const std::vector<Vec3>& region_corners = region.leaf_corners;
+    row.inset = insets[c];
     VisCompareOptions cell_options = options;
-    if (piece_of[leaf] >= 0) {
-      BspViewRegion r = bsp_leaf_view_region(pieces[size_t(piece_of[leaf])].volume, options.z_near);
-      region = std::move(r.volume);
-      row.inset = r.inset;
-      cell_options.z_near = std::min(options.z_near, r.near_limit);
-    }
-    const Context ctx{bsp, scene, embree, cell_options, tri_plane, degenerate, never_drawn};
-    const std::vector<Vec3> region_corners = corners(region);
+    cell_options.z_near = std::min(options.z_near, region.near_limit);
+    const Context ctx{bsp,
+                      scene,
+                      embree,
+                      cell_options,
+                      SeeingRule{scene, cell_options.z_near, options.eps_z},
+                      tri_plane,
+                      degenerate,
+                      never_drawn};
     std::vector<Vec3> eyes;  // scene coordinates
     if (!region_corners.empty()) {
       const Vec3 mid = centroid(region_corners);
@@ -396,7 +254,7 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
         eyes.push_back(quake_to_scene(q + (mid - q) * 0.01));
       }
       while (int(eyes.size()) < options.witness_eyes)
-        eyes.push_back(quake_to_scene(random_point(region, region_corners, witness_rng)));
+        eyes.push_back(random_eye(region, witness_rng));
     }
     for (uint32_t t : ours[c]) {
       if (in_theirs[t] || ctx.degenerate[t] || ctx.never_drawn[t]) continue;
@@ -415,8 +273,8 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
       settle_with_kernel(ctx, row, options.kernel_witnesses(uint32_t(c), row.unconfirmed),
                          in_theirs);
     }
-    if (options.samples > 0 && !region_corners.empty())
-      sample_leaf(ctx, row, region, region_corners, in_ours, in_theirs, sample_rng);
+    if (options.samples > 0 && region.kind != EyeRegion::none)
+      sample_leaf(ctx, row, region, in_ours, in_theirs, sample_rng);
   };
   // Chunks of cells in parallel, progress reported between them from the calling thread.
   constexpr size_t kChunk = 64;

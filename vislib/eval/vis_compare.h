@@ -34,9 +34,10 @@
 // coincident coplanar pair (a sky or liquid boundary carries one face turned to each side) are
 // seen, and see-through triangles (liquids imported see-through) never hide anything.
 //
-// Sampled ground truth: `samples` random eyes in each region, a first-hit cubemap of N x N faces
-// from each (Embree; see-through triangles passed through as the kernel's rule says), and every
-// triangle hit must be in ours and in theirs. A hit x missing from a set S is re-cast: it is a
+// Sampled ground truth (the sampler of pvs_check.h, sample_eye, shared with `pvs check`):
+// `samples` random eyes in each region, a first-hit cubemap of N x N faces from each (Embree;
+// see-through triangles passed through as the kernel's rule says), and every triangle hit must be
+// in ours and in theirs. A hit x missing from a set S is re-cast: it is a
 // miss of S when the double-precision ray sees x and crosses no triangle of S (edges widened by
 // kReferenceBarycentric) within eps_z * lambda_x of x: a hit on either of two coincident faces, or
 // on a shared edge, counts for a set holding either. A hit whose re-cast does not see x is
