@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cassert>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -169,9 +170,11 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
                              "leaves");
 }
 
-vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
+vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
+                             const vislib::QuakeBsp* map) {
   if (a.cells == "bsp-leaves") {
-    const vislib::QuakeBsp bsp = vislib::read_quake_bsp(a.scene);
+    assert(map);
+    const vislib::QuakeBsp& bsp = *map;
     vislib::BspCellOptions o;
     o.face_spacing = a.face_spacing;
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));

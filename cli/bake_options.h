@@ -53,9 +53,10 @@ void apply_preset(BakeArgs& a, const CLI::App& cmd);
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd);
 
 // The view cells of the options over `scene` (vislib::place_view_cells, or with --cells
-// bsp-leaves vislib::bsp_leaf_cells of the map read again from a.scene); a refused placement is
-// reported as the option that caused it.
-vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene);
+// bsp-leaves vislib::bsp_leaf_cells of `map`, the map `scene` was imported from, which must then
+// be given); a refused placement is reported as the option that caused it.
+vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
+                             const vislib::QuakeBsp* map);
 
 // The kernel and bake settings of the options.
 vislib::BakeSettings settings_of(const BakeArgs& a);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "vislib/scene/import.h"
+#include "vislib/scene/quake_bsp.h"
 #include "vislib/scene/scene_transform.h"
 
 namespace pvs_cli {
@@ -43,8 +44,10 @@ vislib::LoadOptions load_options_of(const ImportArgs& import, int states = 1);
 // Loads `path` with `states` key states (throws CLI::ValidationError naming --states if < 1;
 // InputError from the importer passes through). Importer warnings go to stderr. Objects whose
 // names match one of `import.see_through` (vislib::mark_see_through) become see-through; a
-// pattern that matches no object is an error naming it (CLI::ValidationError, exit 2).
+// pattern that matches no object is an error naming it (CLI::ValidationError, exit 2). With
+// `map`, `path` must be a .bsp: it is read once (vislib::load_bsp_scene) and the parsed map is
+// left in *map for whatever else needs it.
 vislib::Scene load_scene_for_cli(const std::string& path, int states = 1,
-                                 const ImportArgs& import = {});
+                                 const ImportArgs& import = {}, vislib::QuakeBsp* map = nullptr);
 
 }  // namespace pvs_cli
