@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cassert>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -208,9 +209,11 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
                              "leaves");
 }
 
-vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
+vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
+                             const vislib::QuakeBsp* map) {
   if (a.cells == "bsp-leaves") {
-    const vislib::QuakeBsp bsp = vislib::read_quake_bsp(a.scene);
+    assert(map);
+    const vislib::QuakeBsp& bsp = *map;
     vislib::BspCellOptions o;
     o.face_spacing = a.face_spacing;
     o.near = a.near;
@@ -232,8 +235,9 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     if (!p.agent_radius) p.agent_radius = vislib::kQuakePlayerRadius;
     if (!p.agent_step) p.agent_step = vislib::kQuakeStepHeight;
     if (a.walkable_from.empty()) {
-      for (const vislib::BspEntityPoint& e :
-           vislib::bsp_player_starts(vislib::read_quake_bsp(a.scene)))
+      std::optional<vislib::QuakeBsp> own;
+      const vislib::QuakeBsp& bsp = map ? *map : own.emplace(vislib::read_quake_bsp(a.scene));
+      for (const vislib::BspEntityPoint& e : vislib::bsp_player_starts(bsp))
         p.starts.push_back({e.origin, e.classname});
       p.required_starts = false;
       if (p.starts.empty())

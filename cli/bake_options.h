@@ -60,11 +60,13 @@ void apply_preset(BakeArgs& a, const CLI::App& cmd);
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd);
 
 // The view cells of the options over `scene` (vislib::place_view_cells, or with --cells
-// bsp-leaves vislib::bsp_leaf_cells of the map read again from a.scene); a refused placement is
-// reported as the option that caused it. Walkable cells of a Quake map (.bsp): the agent's
-// defaults are Quake's player, and without --walkable-from the starts are the map's player
-// starts (vislib::bsp_player_starts; one without floor under it is left out).
-vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene);
+// bsp-leaves vislib::bsp_leaf_cells of `map`, the map `scene` was imported from, which must then
+// be given); a refused placement is reported as the option that caused it. Walkable cells of a
+// Quake map (.bsp): the agent's defaults are Quake's player, and without --walkable-from the
+// starts are the map's player starts (vislib::bsp_player_starts of `map` when given, else of the
+// map read from a.scene; one without floor under it is left out).
+vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
+                             const vislib::QuakeBsp* map);
 
 // The kernel and bake settings of the options.
 vislib::BakeSettings settings_of(const BakeArgs& a);

@@ -129,13 +129,16 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     throw Exit{2};
   }
   auto t0 = std::chrono::steady_clock::now();
-  vislib::Scene scene = load_scene_for_cli(a.scene, a.states, a.import);
+  // A Quake map is read and parsed once, for the scene and for its leaves or player starts.
+  vislib::QuakeBsp map;
+  const bool bsp = vislib::file_extension(a.scene) == ".bsp";
+  vislib::Scene scene = load_scene_for_cli(a.scene, a.states, a.import, bsp ? &map : nullptr);
   if (scene.triangle_count() + scene.sphere_count() >= 0xFFFFFFFFull)
     throw vislib::InputError(a.scene, "more than 2^32-1 triangles and spheres");
   if (scene.has_see_through() && (scene.sphere_count() > 0 || scene.is_dynamic()))
     throw vislib::InputError(a.scene, vislib::kSeeThroughStaticOnly);
-  vislib::ViewCells cells =
-      vislib::with_memory_stage("placing view cells", [&] { return make_cells(a, scene); });
+  vislib::ViewCells cells = vislib::with_memory_stage(
+      "placing view cells", [&] { return make_cells(a, scene, bsp ? &map : nullptr); });
   info.setup_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   uint32_t n = cells.layout.cell_count();
   if (n == 0) {

@@ -86,13 +86,15 @@ vislib::LoadOptions load_options_of(const ImportArgs& import, int states) {
   return options;
 }
 
-vislib::Scene load_scene_for_cli(const std::string& path, int states, const ImportArgs& import) {
+vislib::Scene load_scene_for_cli(const std::string& path, int states, const ImportArgs& import,
+                                 vislib::QuakeBsp* map) {
   if (states < 1)
     throw CLI::ValidationError("--states", "must be >= 1, got " + std::to_string(states));
   const vislib::LoadOptions options = load_options_of(import, states);
   std::vector<std::string> warnings;
   const auto t0 = std::chrono::steady_clock::now();
-  vislib::Scene scene = vislib::load_scene(path, options, &warnings);
+  vislib::Scene scene = map ? vislib::load_bsp_scene(path, options, *map, &warnings)
+                            : vislib::load_scene(path, options, &warnings);
   for (const auto& w : warnings) warn(w);
   const std::vector<size_t> kept = vislib::keep_opaque(scene, import.opaque);
   for (size_t i = 0; i < kept.size(); ++i)

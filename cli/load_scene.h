@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "vislib/scene/import.h"
+#include "vislib/scene/quake_bsp.h"
 #include "vislib/scene/scene_transform.h"
 
 namespace pvs_cli {
@@ -47,8 +48,9 @@ vislib::LoadOptions load_options_of(const ImportArgs& import, int states = 1);
 // objects whose names match one of `import.see_through` become see-through
 // (vislib::mark_see_through); a pattern of either that matches nothing is an error naming it
 // (CLI::ValidationError, exit 2). A scene left mostly see-through is warned about
-// (vislib::see_through_warning).
+// (vislib::see_through_warning). With `map`, `path` must be a .bsp: it is read once
+// (vislib::load_bsp_scene) and the parsed map is left in *map for whatever else needs it.
 vislib::Scene load_scene_for_cli(const std::string& path, int states = 1,
-                                 const ImportArgs& import = {});
+                                 const ImportArgs& import = {}, vislib::QuakeBsp* map = nullptr);
 
 }  // namespace pvs_cli

@@ -276,6 +276,52 @@ TEST(QuakeBsp, OptionsSelectModelsAndLiquids) {
   EXPECT_TRUE(ft[3].imported && ft[3].first_triangle == 3 && ft[3].triangle_count == 2);
 }
 
+// load_bsp_scene reads the file once for both uses: the scene, warnings and errors of load_scene,
+// and the map of read_quake_bsp.
+TEST(QuakeBsp, LoadBspSceneGivesTheSceneOfLoadSceneAndTheMapItImported) {
+  std::string dir = temp_dir("quake_bsp_load_once");
+  QuakeBsp m = tiny_map();
+  m.faces[0].edge_count = 2;  // a face of fewer than 3 edges: a warning
+  const std::string path = write_map(dir, "tiny.bsp", encode_bsp(m));
+  for (BspModels models : {BspModels::world, BspModels::all}) {
+    LoadOptions o;
+    o.bsp_models = models;
+    std::vector<std::string> warnings, once_warnings;
+    const Scene scene = load_scene(path, o, &warnings);
+    QuakeBsp map;
+    const Scene once = load_bsp_scene(path, o, map, &once_warnings);
+    EXPECT_EQ(scene_fingerprint(once), scene_fingerprint(scene));
+    EXPECT_EQ(once.positions, scene.positions);
+    EXPECT_EQ(once_warnings, warnings);
+    ASSERT_EQ(warnings.size(), 1u);
+    const QuakeBsp read = read_quake_bsp(path);
+    EXPECT_EQ(map.entities, read.entities);
+    EXPECT_EQ(map.visibility, read.visibility);
+    EXPECT_EQ(map.marksurfaces, read.marksurfaces);
+    EXPECT_EQ(map.surfedges, read.surfedges);
+    EXPECT_EQ(map.leaves.size(), read.leaves.size());
+    EXPECT_EQ(map.nodes.size(), read.nodes.size());
+    EXPECT_EQ(map.faces.size(), read.faces.size());
+    EXPECT_EQ(map.models.size(), read.models.size());
+  }
+  // A bad map: the same error as load_scene's.
+  const std::string bad = write_map(dir, "bad.bsp", encode_bsp(tiny_map()).substr(0, 50));
+  std::string expected, got;
+  try {
+    load_scene(bad);
+  } catch (const InputError& e) {
+    expected = e.what();
+  }
+  QuakeBsp map;
+  try {
+    load_bsp_scene(bad, {}, map);
+  } catch (const InputError& e) {
+    got = e.what();
+  }
+  EXPECT_NE(expected, "");
+  EXPECT_EQ(got, expected);
+}
+
 TEST(QuakeBsp, EveryFormatReadsBackTheSameMap) {
   for (BspFormat f : {BspFormat::bsp29, BspFormat::bsp2, BspFormat::bsp2rmq}) {
     QuakeBsp m = parse_quake_bsp("map.bsp", encode_bsp(tiny_map(f)));

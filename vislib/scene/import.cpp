@@ -9,6 +9,7 @@
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/scene/import_formats.h"
+#include "vislib/scene/quake_bsp.h"
 
 namespace vislib {
 
@@ -43,6 +44,16 @@ void check_scene(const std::string& path, const Scene& s) {
   assert(s.sphere_object.size() == s.sphere_radius.size());
 }
 
+// The scene `load` returns, built under the memory stage "loading PATH" and checked.
+template <class F>
+Scene checked_load(const std::string& path, F&& load) {
+  return with_memory_stage("loading " + path, [&] {
+    Scene scene = load();
+    check_scene(path, scene);
+    return scene;
+  });
+}
+
 }  // namespace
 
 Scene load_scene(const std::string& path, const LoadOptions& options,
@@ -51,23 +62,25 @@ Scene load_scene(const std::string& path, const LoadOptions& options,
   std::vector<std::string> local;
   std::vector<std::string>& warn = warnings ? *warnings : local;
   std::string ext = file_extension(path);
-  return with_memory_stage("loading " + path, [&] {
-    Scene scene;
-    if (ext == ".gltf" || ext == ".glb") {
-      scene = load_gltf(path, options, warn);
-    } else if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl") {
-      scene = load_mesh(path, warn);
-    } else if (ext == ".spheres") {
-      scene = load_spheres(path, warn);
-    } else if (ext == ".bsp") {
-      scene = load_bsp(path, options, warn);
-    } else {
-      throw InputError(path, "unsupported file format '" +
-                                 (ext.empty() ? std::string("(none)") : ext) +
-                                 "' (supported: .gltf .glb .obj .ply .off .stl .spheres .bsp)");
-    }
-    check_scene(path, scene);
-    return scene;
+  return checked_load(path, [&] {
+    if (ext == ".gltf" || ext == ".glb") return load_gltf(path, options, warn);
+    if (ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl")
+      return load_mesh(path, warn);
+    if (ext == ".spheres") return load_spheres(path, warn);
+    if (ext == ".bsp") return load_bsp(read_quake_bsp(path), path, options, warn);
+    throw InputError(path, "unsupported file format '" +
+                               (ext.empty() ? std::string("(none)") : ext) +
+                               "' (supported: .gltf .glb .obj .ply .off .stl .spheres .bsp)");
+  });
+}
+
+Scene load_bsp_scene(const std::string& path, const LoadOptions& options, QuakeBsp& map,
+                     std::vector<std::string>* warnings) {
+  std::vector<std::string> local;
+  std::vector<std::string>& warn = warnings ? *warnings : local;
+  return checked_load(path, [&] {
+    map = read_quake_bsp(path);
+    return load_bsp(map, path, options, warn);
   });
 }
 

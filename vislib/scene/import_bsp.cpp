@@ -13,9 +13,8 @@
 
 namespace vislib {
 
-Scene load_bsp(const std::string& path, const LoadOptions& options,
+Scene load_bsp(const QuakeBsp& bsp, const std::string& path, const LoadOptions& options,
                std::vector<std::string>& warnings) {
-  const QuakeBsp bsp = read_quake_bsp(path);
   const std::vector<BspFaceTriangles> faces = bsp_face_triangles(bsp, options);
   Scene scene;
   scene.positions.resize(1);

@@ -26,8 +26,9 @@ Scene load_stl(const std::string& path, std::vector<std::string>& warnings);
 // The sphere text format of docs/sphere-format.md (import_spheres.cpp).
 Scene load_spheres(const std::string& path, std::vector<std::string>& warnings);
 
-// Compiled Quake maps, .bsp (import_bsp.cpp).
-Scene load_bsp(const std::string& path, const LoadOptions& options,
+// Compiled Quake maps, .bsp (import_bsp.cpp): the scene of `bsp`, the map read from `path`.
+struct QuakeBsp;
+Scene load_bsp(const QuakeBsp& bsp, const std::string& path, const LoadOptions& options,
                std::vector<std::string>& warnings);
 
 }  // namespace vislib

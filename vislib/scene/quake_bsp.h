@@ -124,6 +124,11 @@ struct QuakeBsp {
 QuakeBsp parse_quake_bsp(const std::string& path, const std::string& bytes);
 // read_file(path) then parse_quake_bsp.
 QuakeBsp read_quake_bsp(const std::string& path);
+// The map at `path` (a .bsp) read once for two uses: returns the scene load_scene(path, options,
+// warnings) returns (the same triangles, warnings and errors) and leaves in `map` what
+// read_quake_bsp(path) returns, the map it was imported from (import.cpp).
+Scene load_bsp_scene(const std::string& path, const LoadOptions& options, QuakeBsp& map,
+                     std::vector<std::string>* warnings = nullptr);
 
 // Quake (z up) to scene (y up) coordinates and back: (x, y, z) -> (x, z, -y).
 inline Vec3 quake_to_scene(Vec3 q) {
