@@ -15,7 +15,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 # only go down.
 bake_budget=120
 check_budget=30
-miss_bound=3433
+miss_bound=432
 mkdir -p "$work"
 # The quick start's bake line, with its continuation lines joined, `$PVS` and out/ replaced.
 cmd=$(awk '/^\$PVS bake data\/city.glb/ {on = 1} on {line = line $0; if ($0 !~ /\\$/) exit} END {print line}' \
