@@ -104,6 +104,16 @@ EyeRegion box_eye_region(const Box3& box) {
   return r;
 }
 
+void for_cells_in_chunks(size_t n, const std::function<void(size_t)>& one_cell,
+                         const std::function<void(size_t, size_t)>& progress) {
+  constexpr size_t kChunk = 64;  // cells between two progress reports
+  for (size_t first = 0; first < n; first += kChunk) {
+    const size_t last = std::min(n, first + kChunk);
+    tbb::parallel_for(first, last, one_cell);
+    if (progress) progress(last, n);
+  }
+}
+
 std::vector<EyeRegion> bsp_leaf_eye_regions(const QuakeBsp& bsp,
                                             const std::vector<uint32_t>& leaves, double near,
                                             std::vector<double>* insets) {
@@ -239,12 +249,7 @@ PvsCheckResult pvs_check(const Scene& scene, const std::vector<EyeRegion>& regio
       i = j;
     }
   };
-  constexpr size_t kChunk = 64;
-  for (size_t first = 0; first < regions.size(); first += kChunk) {
-    const size_t last = std::min(regions.size(), first + kChunk);
-    tbb::parallel_for(first, last, one_cell);
-    if (progress) progress(last, regions.size());
-  }
+  for_cells_in_chunks(regions.size(), one_cell, progress);
   return result;
 }
 

@@ -62,6 +62,11 @@ struct EyeRegion {
 EyeRegion box_eye_region(const Box3& box);  // box.min <= box.max on every axis
 // The distinct vertices of `p`'s faces, in face order.
 std::vector<Vec3> polytope_corners(const ConvexPolytope& p);
+// Calls one_cell(c) for every c < n, in parallel within chunks of 64 cells, and
+// progress(done, n) (if given) from the calling thread after each chunk.
+void for_cells_in_chunks(size_t n, const std::function<void(size_t)>& one_cell,
+                         const std::function<void(size_t, size_t)>& progress);
+
 // The eye regions of the leaves `leaves` of model 0 of `bsp` for a bake of near distance `near`:
 // bsp_leaf_view_region(piece, near) of each leaf's piece (bsp_leaf_pieces), with its near_limit,
 // and each region's inset (Quake units; 0 for an empty region) in `insets` if given. Leaf 0 and a

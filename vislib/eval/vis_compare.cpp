@@ -276,13 +276,7 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
     if (options.samples > 0 && region.kind != EyeRegion::none)
       sample_leaf(ctx, row, region, in_ours, in_theirs, sample_rng);
   };
-  // Chunks of cells in parallel, progress reported between them from the calling thread.
-  constexpr size_t kChunk = 64;
-  for (size_t first = 0; first < cell_leaf.size(); first += kChunk) {
-    const size_t last = std::min(cell_leaf.size(), first + kChunk);
-    tbb::parallel_for(first, last, one_cell);
-    if (progress) progress(last, cell_leaf.size());
-  }
+  for_cells_in_chunks(cell_leaf.size(), one_cell, progress);
   return result;
 }
 
