@@ -14,9 +14,9 @@
 // scene), and the overlay says so in red.
 //
 // Shading is the CPU reference renderer's (vislib/eval/render.h): albedo = the object's colour
-// from a hash of its id (vislib::object_colour, glb.js), shade = 0.1 + 0.9 |n.v| with n the
-// geometric normal of the triangle and v the direction from the eye to the point (two-sided
-// headlight), background RGB (150, 170, 195); no colour management, no tone mapping. The CPU
+// from a hash of its id (vislib::object_colour, glb.js), shade = 0.35 + 0.65 max(|n.v|,
+// 0.6 |n.y|) with n the geometric normal of the triangle and v the direction from the eye to the
+// point (two-sided headlight, light from above), background RGB (150, 170, 195); no colour management, no tone mapping. The CPU
 // renderer samples pixel centres by ray casting and rounds albedo and result to 8 bits; WebGL
 // rasterises the same triangles with the same camera, so frames agree up to rasterisation on
 // triangle edges and one 8-bit step.
@@ -94,7 +94,8 @@ void main() {
     if (rO > 0.0 && vl > rO * (1.0 + 1.0e-6)) discard;
   }
   float lambert = nl > 0.0 && vl > 0.0 ? abs(dot(n, v)) / (nl * vl) : 0.0;
-  float shade = 0.1 + 0.9 * min(lambert, 1.0);
+  float sky = nl > 0.0 ? 0.6 * abs(n.y) / nl : 0.0;
+  float shade = 0.35 + 0.65 * min(max(lambert, sky), 1.0);
   outColour = vec4(vColour * shade, 1.0);
 }`;
 // The environment map's range channel: the distance from O (the cube camera) to the surface.
