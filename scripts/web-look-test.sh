@@ -102,8 +102,8 @@ reds = int(((checker[:, 0] > 150) & (checker[:, 2] < 80)).sum())
 blues = int(((checker[:, 2] > 150) & (checker[:, 0] < 80)).sum())
 greens = float(((green[:, 1] > green[:, 0] + 60) & (green[:, 1] > green[:, 2] + 60)).mean())
 textures = json.load(open("%s/materials.json" % work))["frames"][0]["textures"]
-report(reds > 300 and blues > 300 and greens > 0.95 and textures == 1,
-       "materials: the checker wall shows %d red and %d blue pixels (> 300 each), %.0f%% of the "
+report(reds > 100 and blues > 100 and greens > 0.95 and textures == 1,
+       "materials: the checker wall shows %d red and %d blue pixels (> 100 each), %.0f%% of the "
        "green wall is green (> 95%%), %d texture decoded (1)" % (reds, blues, 100 * greens, textures))
 flat = r[100:130, 115:157].reshape(-1, 3)
 spread = int((flat.max(axis=0) - flat.min(axis=0)).max())
