@@ -1,7 +1,9 @@
 // pvs export SCENE -o flat.obj [--states K] [--time TAU]: the scene as a flat OBJ whose face i is
 // triangle id i. With -o FILE.glb: the scene as binary glTF for the web client (web/), one node
 // and mesh per object in object order, primitives in id order (scene_to_glb), so that reading the
-// meshes in order gives the triangles in id order; refused (exit 2) when the scene's triangle
+// meshes in order gives the triangles in id order, with what a viewer needs besides the triangles
+// when the scene is glTF (normals, UVs, materials with their base colour images: load_appearance;
+// normals turned by --rotate); refused (exit 2) when the scene's triangle
 // objects are not non-decreasing in id order, where that reading would not give vislib's ids. One
 // `o <object name>` line each time the object changes along the id order, all vertices as `v` lines
 // (%.17g, exact round trip) in vertex order, one `f` line per triangle. Positions are those at
@@ -34,6 +36,7 @@
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/render/view_setup.h"
+#include "vislib/scene/appearance.h"
 #include "vislib/scene/id_map.h"
 #include "vislib/scene/scene_fingerprint.h"
 #include "vislib/scene/scene_transform.h"
@@ -115,7 +118,13 @@ void run_export(const ExportOptions& o) {
                                               "(export .obj instead)");
     // The centres first: a PVS that does not fit the scene leaves no output at all.
     const std::string centres = o.centres.empty() ? "" : centres_json(scene, o.pvs);
-    vislib::write_file_atomic(o.out, vislib::scene_to_glb(scene));
+    // The page draws the scene's own materials (docs/web.md, "Shading").
+    std::vector<std::string> warnings;
+    vislib::SceneAppearance app =
+        vislib::load_appearance(o.scene, load_options_of(o.import, o.states), &warnings);
+    for (const auto& w : warnings) warn(w);
+    for (vislib::Vec3& n : app.normals) n = sim.rotation * n;
+    vislib::write_file_atomic(o.out, vislib::scene_to_glb(scene, &app));
     if (!o.centres.empty()) vislib::write_file_atomic(o.centres, centres);
     if (show_progress())
       std::fprintf(stderr, "pvs: wrote %s (%zu objects, %zu triangles in id order)\n",

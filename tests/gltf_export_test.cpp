@@ -181,6 +181,39 @@ TEST(GltfExport, MaterialRunsBecomePrimitivesAndOrderIsKept) {
     for (int c = 0; c < 3; ++c) EXPECT_EQ(back.corners(t)[c], s.corners(t)[c]);
 }
 
+TEST(GltfExport, DataUriImageIsEmbedded) {
+  // A .gltf whose base colour image is a data: URI (here the 8 bytes of the PNG signature: the
+  // export carries bytes, it does not decode them). tinygltf keeps no URI for it, so the bytes
+  // must come from the document.
+  const std::string gltf = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+    "nodes": [{"name": "tri", "mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+    "materials": [{"name": "m", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}],
+    "images": [{"uri": "data:image/png;base64,iVBORw0KGgo="}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                   "min": [0, 0, 0], "max": [1, 1, 0]},
+                  {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                    {"buffer": 0, "byteOffset": 36, "byteLength": 6}],
+    "buffers": [{"byteLength": 44, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAABAAIAAAA="}]})";
+  const std::string path = vislib_test::temp_dir("gltf_export") + "/data_uri.gltf";
+  write_file_atomic(path, gltf);
+  const Scene s = load_scene(path);
+  const SceneAppearance app = load_appearance(path);
+  ASSERT_EQ(app.images.size(), 1u);
+  EXPECT_EQ(app.images[0].bytes, std::string("\x89PNG\r\n\x1a\n", 8));
+  EXPECT_EQ(app.images[0].mime_type, "image/png");
+  ASSERT_EQ(app.materials.size(), 1u);
+  EXPECT_EQ(app.materials[0].base_color_image, 0);
+  const tinygltf::Model m = parse_glb(scene_to_glb(s, &app));
+  ASSERT_EQ(m.images.size(), 1u);
+  EXPECT_GE(m.images[0].bufferView, 0);
+  EXPECT_EQ(m.images[0].mimeType, "image/png");
+  ASSERT_EQ(m.materials.size(), 1u);
+  EXPECT_EQ(m.materials[0].pbrMetallicRoughness.baseColorTexture.index, 0);
+}
+
 TEST(GltfExport, KhronosValidatorFindsNoErrorOnEverySharedScene) {
   VISLIB_REQUIRE_SHARED(shared);
   if (std::system("command -v node > /dev/null 2>&1") != 0) GTEST_SKIP() << "node is not installed";

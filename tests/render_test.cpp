@@ -89,6 +89,32 @@ TEST(Render, FrontalPlaneShowsTheObjectColourAtTheCentre) {
   EXPECT_NE(object_colour(1), object_colour(2));
 }
 
+TEST(Render, StreetSeenFromEyeHeightKeepsMostOfItsColour) {
+  // A floor 1.6 below the eye and a wall along the view direction, both seen at grazing angles
+  // (|n.v| well under 0.5 in the lower and right parts of the frame): the floor is lit from above
+  // (at least kRenderAmbient + (1 - kRenderAmbient) * kRenderSky = 0.74 of its colour), the wall by
+  // the ambient term at least; the headlight alone left them near black (0.1 + 0.9 |n.v|).
+  Scene s = plane({0, -1.6, 0}, {0, 1, 0});
+  const Scene wall = plane({3, 0, 0}, {-1, 0, 0});
+  add_quad(s, wall.positions[0][0], wall.positions[0][1], wall.positions[0][2],
+           wall.positions[0][3]);
+  const EmbreeScene rt(s, 0.0, Vec3{});
+  const Frame f = render_frame(s, rt, camera({0, 0, 0}, {0, 0, -1}));
+  const double floor_share = kRenderAmbient + (1 - kRenderAmbient) * kRenderSky;
+  size_t floor = 0, wall_pixels = 0;
+  for (size_t p = 0; p < f.pixel_count(); ++p) {
+    if (f.tri[p] == kNoHit) continue;
+    const bool on_floor = f.tri[p] < 2;
+    (on_floor ? floor : wall_pixels) += 1;
+    const double share = on_floor ? floor_share : kRenderAmbient;
+    const auto albedo = object_colour(s.triangle_object[f.tri[p]]);
+    for (size_t k = 0; k < 3; ++k)
+      EXPECT_GE(f.rgb[3 * p + k] + 1.0, albedo[k] * share) << p;  // 8-bit rounding
+  }
+  EXPECT_GT(floor, 200u);
+  EXPECT_GT(wall_pixels, 100u);
+}
+
 TEST(Render, EmptySceneIsAllBackground) {
   Scene s;
   const EmbreeScene rt(s, 0.0, Vec3{});

@@ -132,7 +132,9 @@ std::array<uint8_t, 3> shade_triangle(const Scene& scene, uint32_t tri, Vec3 dir
   const Vec3 normal = cross(c[1] - c[0], c[2] - c[0]);
   const double nl = length(normal);
   const double lambert = nl > 0 ? std::fabs(dot(normal, dir)) / (nl * len) : 0.0;
-  const double shade = kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(lambert, 1.0);
+  const double sky = nl > 0 ? kRenderSky * std::fabs(normal.y) / nl : 0.0;
+  const double shade =
+      kRenderAmbient + (1.0 - kRenderAmbient) * std::fmin(std::fmax(lambert, sky), 1.0);
   const auto albedo = object_colour(scene.triangle_object[tri]);
   std::array<uint8_t, 3> out;
   for (int k = 0; k < 3; ++k) out[size_t(k)] = to_byte(double(albedo[size_t(k)]) / 255.0 * shade);

@@ -11,10 +11,12 @@
 // A hit counts at view depth > z_near (a rasteriser's near plane).
 //
 // Shading (plain and readable, not physically based): an object colour drawn from a hash of the
-// object id (object_colour) times the headlight Lambert term
-//   shade = kRenderAmbient + (1 - kRenderAmbient) * |n.v|
-// with n the unit geometric normal of the triangle and v the unit ray direction (two-sided), each
-// channel rounded to 8 bits. Pixels that hit nothing get kRenderBackground.
+// object id (object_colour) times
+//   shade = kRenderAmbient + (1 - kRenderAmbient) * max(|n.v|, kRenderSky * |n.y|)
+// with n the unit geometric normal of the triangle and v the unit ray direction: a two-sided
+// headlight, and light from above (+y) so that floors and roofs seen at a grazing angle (a street
+// from eye height) keep most of their colour; a surface facing the eye shows its colour exactly.
+// Each channel is rounded to 8 bits. Pixels that hit nothing get kRenderBackground.
 //
 // Subset frames: render_frame with an `allowed` mask casts the same rays through the same BVH with
 // an intersect filter (EmbreeScene::first_hits_among), so a pixel whose full-scene first hit is
@@ -35,7 +37,9 @@
 namespace vislib {
 
 // Light not from the headlight: the share of the object colour a surface seen edge-on keeps.
-constexpr double kRenderAmbient = 0.1;
+constexpr double kRenderAmbient = 0.35;
+// Light from above: a horizontal surface is lit at least as if seen at |n.v| = kRenderSky.
+constexpr double kRenderSky = 0.6;
 // RGB of pixels that hit no triangle.
 constexpr std::array<uint8_t, 3> kRenderBackground = {150, 170, 195};
 
@@ -101,8 +105,8 @@ bool in_image(const Camera& camera, const PixelPosition& p);
 std::array<uint8_t, 3> object_colour(uint32_t object);
 
 // render_frame's colour of triangle `tri` (< triangle_count) seen along `dir` (non-zero; the
-// un-normalised pixel direction): object_colour times the headlight Lambert term above, with the
-// normal from key state 0. Thread-safe.
+// un-normalised pixel direction): object_colour times the shade above, with the normal from key
+// state 0. Thread-safe.
 std::array<uint8_t, 3> shade_triangle(const Scene& scene, uint32_t tri, Vec3 dir);
 
 // Renders `scene` through `rt`, which must have been built from `scene` at tau = 0 (normals are

@@ -22,8 +22,8 @@
 //    drawing or on the thread count. With the exact projection, a small triangle with a vertex
 //    inside the viewing circle (seen by no ODS ray) is dropped; the paper's formula draws it.
 // Both write a vislib::Frame: tri = scene triangle id (kNoHit where nothing), depth = range from
-// the eye's ray origin (scene units), rgb = render_frame's shading (object colour times the
-// headlight Lambert term with the pixel's direction), kRenderBackground where nothing.
+// the eye's ray origin (scene units), rgb = render_frame's shading (shade_triangle with the
+// pixel's direction), kRenderBackground where nothing.
 // Both are deterministic and identical for any thread count. Thread-safe.
 #pragma once
 

@@ -194,13 +194,20 @@ void read_materials(Ctx& ctx, SceneAppearance& app) {
     AppearanceImage out;
     out.name = im.name;
     out.mime_type = image_mime(im);
+    // tinygltf passes a data: URI's bytes to the image loader and keeps no URI: read it from the
+    // document.
+    std::string data_uri;
+    if (im.bufferView < 0 && im.uri.empty() && ctx.doc.contains("images") &&
+        ctx.doc["images"].is_array() && i < ctx.doc["images"].size() &&
+        ctx.doc["images"][i].is_object())
+      data_uri = ctx.doc["images"][i].value("uri", "");
     if (im.bufferView >= 0) {
       Bytes b = view_bytes(ctx, im.bufferView, "image " + std::to_string(i));
       out.bytes.assign(reinterpret_cast<const char*>(b.data), b.size);
-    } else if (im.uri.rfind("data:", 0) == 0) {
+    } else if (data_uri.rfind("data:", 0) == 0) {
       std::vector<unsigned char> data;
       std::string mime;
-      if (tinygltf::DecodeDataURI(&data, mime, im.uri, 0, false))
+      if (tinygltf::DecodeDataURI(&data, mime, data_uri, 0, false))
         out.bytes.assign(data.begin(), data.end());
       if (out.mime_type.empty()) out.mime_type = mime;
     } else if (!im.uri.empty()) {

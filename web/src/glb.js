@@ -27,7 +27,12 @@ function accessorArray(gltf, bin, index, want) {
 // Returns {positions: Float32Array(9 * T) (triangle t's corners at 9t..9t+8, de-indexed),
 // triangleObject: Uint32Array(T), dynamic: Uint8Array(T) (1: a vertex of the triangle moves in
 // some state, as vislib::moving_triangles; positions are the rest state 0), objectCount,
-// objectNames}. Throws on anything else than the
+// objectNames, and what the page needs to draw the scene's own materials:
+// triangleMaterial: Int32Array(T) (index into materials, -1: the primitive has none),
+// uvs: Float32Array(6 * T) (TEXCOORD_0 of triangle t's corners at 6t..6t+5; 0 where a primitive
+// has no float TEXCOORD_0), materials: [{name, baseColour: linear RGBA, image: index into images
+// or -1, wrapS, wrapT (WebGL wrap modes)}], images: [{bytes: Uint8Array or null, mimeType, uri}]
+// (embedded bytes, else the URI as the file writes it)}. Throws on anything else than the
 // export's layout (node transforms, non-triangle primitives, several scenes).
 export function parseGlb(arrayBuffer) {
   const dv = new DataView(arrayBuffer);
@@ -62,7 +67,11 @@ export function parseGlb(arrayBuffer) {
         for (let v = 0; v < moves.length; ++v)
           if (d[3 * v] !== 0 || d[3 * v + 1] !== 0 || d[3 * v + 2] !== 0) moves[v] = 1;
       }
-      parts.push({pos, idx, moves});
+      // Texture coordinates only as float (the export writes them so); else untextured.
+      const uvAccessor = prim.attributes.TEXCOORD_0;
+      const uv = uvAccessor !== undefined && gltf.accessors[uvAccessor].componentType === FLOAT
+        ? accessorArray(gltf, bin, uvAccessor, 2) : null;
+      parts.push({pos, idx, moves, uv, material: prim.material ?? -1});
       objects.push([object, idx.length / 3]);
       total += idx.length / 3;
     }
@@ -70,8 +79,10 @@ export function parseGlb(arrayBuffer) {
   const positions = new Float32Array(9 * total);
   const triangleObject = new Uint32Array(total);
   const dynamic = new Uint8Array(total);
+  const triangleMaterial = new Int32Array(total);
+  const uvs = new Float32Array(6 * total);
   let t = 0;
-  parts.forEach(({pos, idx, moves}, k) => {
+  parts.forEach(({pos, idx, moves, uv, material}, k) => {
     const [object, n] = objects[k];
     for (let i = 0; i < 3 * n; ++i) {
       const v = idx[i];
@@ -79,10 +90,40 @@ export function parseGlb(arrayBuffer) {
       positions[3 * (3 * t) + 3 * (i % 3) + 1] = pos[3 * v + 1];
       positions[3 * (3 * t) + 3 * (i % 3) + 2] = pos[3 * v + 2];
       if (moves[v]) dynamic[t] = 1;
-      if (i % 3 === 2) triangleObject[t++] = object;
+      if (uv) {
+        uvs[6 * t + 2 * (i % 3)] = uv[2 * v];
+        uvs[6 * t + 2 * (i % 3) + 1] = uv[2 * v + 1];
+      }
+      if (i % 3 === 2) {
+        triangleMaterial[t] = material;
+        triangleObject[t++] = object;
+      }
     }
   });
-  return {positions, triangleObject, dynamic, objectCount: nodes.length, objectNames: names};
+  return {positions, triangleObject, dynamic, objectCount: nodes.length, objectNames: names,
+          triangleMaterial, uvs, ...readMaterials(gltf, bin)};
+}
+
+// The materials' base colour (factor and texture) and the images they use (see parseGlb).
+function readMaterials(gltf, bin) {
+  const REPEAT = 10497;
+  const materials = (gltf.materials || []).map((m, k) => {
+    const pbr = m.pbrMetallicRoughness || {};
+    const texture = pbr.baseColorTexture && (pbr.baseColorTexture.texCoord ?? 0) === 0
+      ? gltf.textures[pbr.baseColorTexture.index] : null;
+    const sampler = texture && texture.sampler !== undefined ? gltf.samplers[texture.sampler] : {};
+    return {name: m.name || `material ${k}`, baseColour: pbr.baseColorFactor || [1, 1, 1, 1],
+            image: texture && texture.source !== undefined ? texture.source : -1,
+            wrapS: sampler.wrapS ?? REPEAT, wrapT: sampler.wrapT ?? REPEAT};
+  });
+  const images = (gltf.images || []).map((im) => {
+    if (im.bufferView === undefined) return {bytes: null, mimeType: im.mimeType || "", uri: im.uri || ""};
+    const view = gltf.bufferViews[im.bufferView];
+    const start = bin.byteOffset + (view.byteOffset || 0);
+    return {bytes: new Uint8Array(bin.buffer.slice(start, start + view.byteLength)),
+            mimeType: im.mimeType || "", uri: ""};
+  });
+  return {materials, images};
 }
 
 // splitmix64 as vislib/eval/render.cpp has it (BigInt: 64-bit wrapping arithmetic).

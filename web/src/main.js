@@ -8,20 +8,25 @@
 // (the frame alone, to compare with the CPU renderer's), path="x,y,z[@lx,ly,lz];..." (replay: window.viewer.step(i) renders
 // frame i; without @ a frame looks towards the next point), size=WxH (fixed canvas size),
 // nearfar=r1,r2 with centre=x,y,z or centres=URL (JSON), envsize=N, lookup=eye|cylinder and
-// clovr=1 (docs/web.md); mode=ods|stereo (ods.js, stereo.js).
+// clovr=1, shading=materials|reference (docs/web.md); mode=ods|stereo (ods.js, stereo.js). Key H
+// hides and shows the overlays.
 //
 // Outside every cell the last cell's set stays drawn (before any cell was entered: the whole
 // scene), and the overlay says so in red.
 //
-// Shading is the CPU reference renderer's (vislib/eval/render.h): albedo = the object's colour
-// from a hash of its id (vislib::object_colour, glb.js), shade = 0.1 + 0.9 |n.v| with n the
-// geometric normal of the triangle and v the direction from the eye to the point (two-sided
-// headlight), background RGB (150, 170, 195); no colour management, no tone mapping. The CPU
-// renderer samples pixel centres by ray casting and rounds albedo and result to 8 bits; WebGL
-// rasterises the same triangles with the same camera, so frames agree up to rasterisation on
-// triangle edges and one 8-bit step.
+// Shading (shading=...): `reference` is the CPU reference renderer's (vislib/eval/render.h),
+// which the frame comparisons use: albedo = the object's colour from a hash of its id
+// (vislib::object_colour, glb.js), shade = 0.35 + 0.65 max(|n.v|, 0.6 |n.y|) with n the geometric
+// normal of the triangle and v the direction from the eye to the point (two-sided headlight,
+// light from above), background RGB (150, 170, 195); no colour management, no tone mapping.
+// `materials` (the default) draws the scene's own glTF materials, base colour factor times base
+// colour texture (sRGB-decoded), times the same shade in linear light, encoded to sRGB; a
+// triangle without a material gets its object's colour. The CPU renderer samples pixel centres
+// by ray casting and rounds albedo and result to 8 bits; WebGL rasterises the same triangles
+// with the same camera, so frames agree up to rasterisation on triangle edges and one 8-bit step.
 import * as THREE from "three";
 import {parseGlb, objectColour} from "./glb.js";
+import {drawTriangles, loadTextures} from "./materials.js";
 import {parsePath, vec3} from "./path.js";
 import {PvsClient} from "./pvs_client.js";
 import {OdsViewer} from "./ods.js";
@@ -31,6 +36,7 @@ const params = new URLSearchParams(location.search);
 const overlay = document.getElementById("overlay");
 const mapCanvas = document.getElementById("map");
 const canvas = document.getElementById("view");
+const SHADINGS = ["materials", "reference"];
 
 // Vertex displacement by `mode` (the GPU counterparts of runtime/near_far.h, which the worker's
 // partition and scheduler use through the C API):
@@ -44,12 +50,12 @@ const canvas = document.getElementById("view");
 //      moves to where the ray from U along normalize(w d_U + (1 - w) d_O), w = clamp((R - r) /
 //      (R - R_n), 0, 1), leaves the cylinder of radius r.
 const VERTEX = `
-in vec3 position; in vec3 normal; in vec3 colour;
+in vec3 position; in vec3 normal; in vec3 colour; in vec2 uv;
 uniform mat4 projectionMatrix, viewMatrix;
 uniform vec3 eye, centre;
 uniform float r1, r2;
 uniform int mode;
-out vec3 vWorld; out vec3 vNormal; out vec3 vColour;
+out vec3 vWorld; out vec3 vNormal; out vec3 vColour; out vec2 vUv;
 vec3 morph(vec3 p) {
   float r = length(p.xz - centre.xz);
   if (r <= r1) return p;
@@ -72,20 +78,29 @@ vec3 inject(vec3 p) {
 void main() {
   vWorld = mode == 1 ? morph(position) : mode == 2 ? eye + position - centre
          : mode == 3 ? inject(position) : position;
-  vNormal = normal; vColour = colour;
+  vNormal = normal; vColour = colour; vUv = uv;
   gl_Position = projectionMatrix * viewMatrix * vec4(vWorld, 1.0);
 }`;
 // Shading; with rangeTest (dynamic far fragments, near-far Eq. 3, passes_range_test) a fragment
 // at displaced position q survives iff |q - U| <= r_O (1 + kRangeRelativeTolerance), r_O the
 // range the cube map from O stores for direction q - U (0: no surface there, infinitely far).
+// shade = 0.35 + 0.65 max(|n.v|, 0.6 |n.y|) (kRenderAmbient, kRenderSky); shading 0 (reference):
+// colour = vColour (the object's colour) * shade, as the CPU; shading 1 (materials): vColour is
+// the linear base colour factor, times the texture where `textured`, times shade, to sRGB.
 const FRAGMENT = `precision highp float;
 precision highp int;
 uniform vec3 eye;
 uniform bool rangeTest;
 uniform samplerCube rangeMap;
-uniform int mode;
-in vec3 vWorld; in vec3 vNormal; in vec3 vColour;
+uniform int mode, shading;
+uniform bool textured;
+uniform sampler2D map;
+in vec3 vWorld; in vec3 vNormal; in vec3 vColour; in vec2 vUv;
 out vec4 outColour;
+vec3 toLinear(vec3 c) { return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(0.04045, c)); }
+vec3 toSrgb(vec3 c) {
+  return mix(c * 12.92, 1.055 * pow(max(c, 0.0), vec3(1.0 / 2.4)) - 0.055, step(0.0031308, c));
+}
 void main() {
   vec3 v = vWorld - eye;
   // A morphed triangle is shaded as the CPU shades it: by its displaced corners' plane.
@@ -96,8 +111,14 @@ void main() {
     if (rO > 0.0 && vl > rO * (1.0 + 1.0e-6)) discard;
   }
   float lambert = nl > 0.0 && vl > 0.0 ? abs(dot(n, v)) / (nl * vl) : 0.0;
-  float shade = 0.1 + 0.9 * min(lambert, 1.0);
-  outColour = vec4(vColour * shade, 1.0);
+  float sky = nl > 0.0 ? 0.6 * abs(n.y) / nl : 0.0;
+  float shade = 0.35 + 0.65 * min(max(lambert, sky), 1.0);
+  if (shading == 0) {
+    outColour = vec4(vColour * shade, 1.0);
+    return;
+  }
+  vec3 albedo = textured ? vColour * toLinear(texture(map, vUv).rgb) : vColour;
+  outColour = vec4(toSrgb(min(albedo * shade, 1.0)), 1.0);
 }`;
 // The environment map's range channel: the distance from O (the cube camera) to the surface.
 const RANGE_FRAGMENT = `precision highp float;
@@ -105,8 +126,8 @@ uniform vec3 eye;
 in vec3 vWorld; in vec3 vNormal; in vec3 vColour;
 out vec4 outColour;
 void main() { outColour = vec4(length(vWorld - eye), 0.0, 0.0, 1.0); }`;
-// The far region: a full-screen pass behind everything that samples the cube map (nearest
-// texel, as the CPU's cube_pixel) along the eye ray (lookup=eye, the paper) or where the eye ray
+// The far region: a full-screen pass behind everything that samples the cube map (filtered
+// linearly; shading=reference: the nearest texel, as the CPU's cube_pixel) along the eye ray (lookup=eye, the paper) or where the eye ray
 // leaves the cylinder of radius r2 about O's axis (lookup=cylinder), as pvs view --lookup.
 const BACKGROUND_VERTEX = `
 in vec3 position;
@@ -157,20 +178,31 @@ async function fetchBytes(url) {
   return r.arrayBuffer();
 }
 
-function buildGeometry(scene) {
+// The sRGB value c in [0, 1] in linear light.
+function toLinear(c) {
+  return c <= 0.04045 ? c / 12.92 : Math.pow((c + 0.055) / 1.055, 2.4);
+}
+
+// The de-indexed scene's attributes: position, normal (the triangle's geometric normal), uv and
+// colour: with shading=reference the object's colour as the CPU renders it; with materials the
+// triangle's material's base colour factor (linear), or for a triangle without one its object's
+// colour in linear light.
+function buildGeometry(scene, shading) {
   const T = scene.triangleObject.length;
   const normals = new Float32Array(9 * T);
   const colours = new Float32Array(9 * T);
   const palette = new Map();
+  const materials = shading === "materials";
+  const objectColourOf = (ob) => objectColour(ob).map((c) => materials ? toLinear(c / 255) : c / 255);
   const p = scene.positions;
   for (let t = 0; t < T; ++t) {
     const o = 9 * t;
     const ax = p[o + 3] - p[o], ay = p[o + 4] - p[o + 1], az = p[o + 5] - p[o + 2];
     const bx = p[o + 6] - p[o], by = p[o + 7] - p[o + 1], bz = p[o + 8] - p[o + 2];
     const n = [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx];
-    const ob = scene.triangleObject[t];
-    if (!palette.has(ob)) palette.set(ob, objectColour(ob).map((c) => c / 255));
-    const c = palette.get(ob);
+    const ob = scene.triangleObject[t], m = materials ? scene.triangleMaterial[t] : -1;
+    if (m < 0 && !palette.has(ob)) palette.set(ob, objectColourOf(ob));
+    const c = m >= 0 ? scene.materials[m].baseColour.slice(0, 3) : palette.get(ob);
     for (let k = 0; k < 3; ++k) {
       normals.set(n, o + 3 * k);
       colours.set(c, o + 3 * k);
@@ -180,20 +212,9 @@ function buildGeometry(scene) {
   g.setAttribute("position", new THREE.BufferAttribute(scene.positions, 3));
   g.setAttribute("normal", new THREE.BufferAttribute(normals, 3));
   g.setAttribute("colour", new THREE.BufferAttribute(colours, 3));
+  g.setAttribute("uv", new THREE.BufferAttribute(scene.uvs, 2));
   g.computeBoundingSphere();
   return g;
-}
-
-// The index buffer drawing triangles `ids` of the de-indexed geometry (triangle t = vertices
-// 3t, 3t+1, 3t+2).
-function indexOf(ids) {
-  const idx = new Uint32Array(3 * ids.length);
-  for (let i = 0; i < ids.length; ++i) {
-    idx[3 * i] = 3 * ids[i];
-    idx[3 * i + 1] = 3 * ids[i] + 1;
-    idx[3 * i + 2] = 3 * ids[i] + 2;
-  }
-  return new THREE.BufferAttribute(idx, 1);
 }
 
 class Viewer {
@@ -202,8 +223,16 @@ class Viewer {
     const sceneUrl = params.get("scene"), pvsUrl = params.get("pvs");
     if (!sceneUrl || !pvsUrl) throw new Error("give ?scene=URL.glb&pvs=URL.pvs");
     this.fov = Number(params.get("fov") || 60);
-    if (params.get("overlay") === "0")
-      for (const id of ["overlay", "map", "help"]) document.getElementById(id).style.display = "none";
+    this.shading = params.get("shading") || "materials";
+    if (!SHADINGS.includes(this.shading)) throw new Error(`shading=${this.shading}: ${SHADINGS.join(" or ")}`);
+    // The overlays: off with overlay=0; key H hides and shows them.
+    const overlays = ["overlay", "map", "help"].map((id) => document.getElementById(id));
+    if (params.get("overlay") === "0") for (const e of overlays) e.style.display = "none";
+    addEventListener("keydown", (e) => {
+      if (e.key !== "h" && e.key !== "H") return;
+      const hidden = overlays[0].style.display === "none";
+      for (const o of overlays) o.style.display = hidden ? "" : "none";
+    });
     // nearfar=r1,r2: the near-far mode (off by default); envsize=N: the cube map's face size;
     // centre=x,y,z: O for every cell; centres=URL: each cell's O as pvs view chooses it (the JSON
     // of `pvs export --centres`); neither: the centre of the cell's lookup box.
@@ -240,15 +269,19 @@ class Viewer {
     this.renderer.setPixelRatio(1);
     this.renderer.setSize(canvas.clientWidth || canvas.width, canvas.clientHeight || canvas.height, false);
     this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
-    this.geometry = buildGeometry(this.scene);
+    this.textures = this.shading === "materials" ? await loadTextures(this.scene, sceneUrl)
+                                                 : {groups: null, errors: []};
+    this.geometry = buildGeometry(this.scene, this.shading);
     this.material = new THREE.RawShaderMaterial({
       vertexShader: VERTEX, fragmentShader: FRAGMENT, side: THREE.DoubleSide,
       glslVersion: THREE.GLSL3,
       uniforms: {eye: {value: new THREE.Vector3()}, centre: {value: new THREE.Vector3()},
                  r1: {value: 0}, r2: {value: 1}, mode: {value: 0},
-                 rangeTest: {value: false}, rangeMap: {value: null}},
+                 rangeTest: {value: false}, rangeMap: {value: null},
+                 shading: {value: this.shading === "reference" ? 0 : 1}, textured: {value: false},
+                 map: {value: null}},
     });
-    this.mesh = new THREE.Mesh(this.geometry, this.material);
+    this.mesh = new THREE.Mesh(this.geometry, this.withTextures(this.material));
     this.mesh.frustumCulled = false;
     this.world = new THREE.Scene();
     this.world.add(this.mesh);
@@ -269,6 +302,16 @@ class Viewer {
     return this;
   }
 
+  // `base` alone, or with textures one material per draw group (materials.js).
+  withTextures(base) {
+    return this.textures.groups ? this.textures.groups.materialsFor(base) : base;
+  }
+
+  // Draws the triangles `ids` (null: all) of the de-indexed geometry (by texture, materials.js).
+  drawIds(geometry, ids) {
+    drawTriangles(geometry, ids, this.textures.groups);
+  }
+
   // The draw list of a cell (null: the whole scene). With near-far on, `partition` is the
   // worker's (pvs_rt_partition_near_far): its geometry ids are drawn, its environment ids go to
   // the cube map; with CloVR on, the scheduler's frames replace it (setClovr).
@@ -282,10 +325,10 @@ class Viewer {
     }
     if (ids && this.nearFar) ids = this.applyPartition(partition);
     if (ids) {
-      this.geometry.setIndex(indexOf(ids));
+      this.drawIds(this.geometry, ids);
       this.drawn = ids.length;
     } else {
-      this.geometry.setIndex(null);
+      this.drawIds(this.geometry, null);
       this.drawn = this.total;
     }
   }
@@ -305,16 +348,21 @@ class Viewer {
     if (!["eye", "cylinder"].includes(this.lookupMode))
       throw new Error(`lookup=${this.lookupMode}: eye or cylinder`);
     this.clovr = params.get("clovr") === "1";
+    // The colour map is filtered linearly (no stair steps on far edges), except with
+    // shading=reference, whose frames are compared with pvs view's (nearest texel, cube_pixel);
+    // the range map is always read at the nearest texel (ranges do not blend across edges).
     const nearest = {minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
                      generateMipmaps: false};
-    this.envTarget = new THREE.WebGLCubeRenderTarget(this.envSize, nearest);
+    const filter = this.shading === "reference" ? THREE.NearestFilter : THREE.LinearFilter;
+    this.envTarget = new THREE.WebGLCubeRenderTarget(
+      this.envSize, {...nearest, minFilter: filter, magFilter: filter});
     this.rangeTarget = new THREE.WebGLCubeRenderTarget(
       this.envSize, {...nearest, type: THREE.FloatType, format: THREE.RGBAFormat});
     this.cubeCamera = new THREE.CubeCamera(0.05, this.camera.far, this.envTarget);
     this.rangeCamera = new THREE.CubeCamera(0.05, this.camera.far, this.rangeTarget);
     this.envGeometry = new THREE.BufferGeometry();
     this.dynGeometry = new THREE.BufferGeometry();
-    for (const name of ["position", "normal", "colour"]) {
+    for (const name of ["position", "normal", "colour", "uv"]) {
       this.envGeometry.setAttribute(name, this.geometry.getAttribute(name));
       this.dynGeometry.setAttribute(name, this.geometry.getAttribute(name));
     }
@@ -324,7 +372,8 @@ class Viewer {
       vertexShader: VERTEX, fragmentShader: RANGE_FRAGMENT, side: THREE.DoubleSide,
       glslVersion: THREE.GLSL3, uniforms: this.envMaterial.uniforms,
     });
-    this.envMesh = new THREE.Mesh(this.envGeometry, this.envMaterial);
+    this.envMaterials = this.withTextures(this.envMaterial);
+    this.envMesh = new THREE.Mesh(this.envGeometry, this.envMaterials);
     this.envMesh.frustumCulled = false;
     this.envWorld = new THREE.Scene();
     this.envWorld.add(this.envMesh);
@@ -335,7 +384,7 @@ class Viewer {
     this.dynMaterial.uniforms.rangeTest.value = true;
     this.dynMaterial.uniforms.rangeMap.value = this.rangeTarget.texture;
     this.dynMaterial.uniforms.eye = this.material.uniforms.eye;  // shared
-    this.dynMesh = new THREE.Mesh(this.dynGeometry, this.dynMaterial);
+    this.dynMesh = new THREE.Mesh(this.dynGeometry, this.withTextures(this.dynMaterial));
     this.dynMesh.frustumCulled = false;
     this.dynMesh.visible = false;
     this.world.add(this.dynMesh);
@@ -372,19 +421,19 @@ class Viewer {
 
   // Renders the cube maps (colour and range) from O of the triangles `ids`.
   renderEnvironment(ids, o) {
-    this.envGeometry.setIndex(indexOf(ids));
+    this.drawIds(this.envGeometry, ids);
     this.envMaterial.uniforms.eye.value.set(...o);
     this.cubeCamera.position.set(...o);
     this.rangeCamera.position.set(...o);
     const clear = new THREE.Color();
     this.renderer.getClearColor(clear);
     this.renderer.setClearColor(new THREE.Color(150 / 255, 170 / 255, 195 / 255), 1);
-    this.envMesh.material = this.envMaterial;
+    this.envMesh.material = this.envMaterials;
     this.cubeCamera.update(this.renderer, this.envWorld);
     this.renderer.setClearColor(new THREE.Color(0, 0, 0), 0);  // range 0: nothing there
     this.envMesh.material = this.rangeMaterial;
     this.rangeCamera.update(this.renderer, this.envWorld);
-    this.envMesh.material = this.envMaterial;
+    this.envMesh.material = this.envMaterials;
     this.renderer.setClearColor(clear, 1);
     this.backgroundMesh.visible = true;
   }
@@ -411,7 +460,7 @@ class Viewer {
     this.material.uniforms.r1.value = this.nearFar[0];
     this.material.uniforms.r2.value = this.nearFar[1];
     this.renderEnvironment(part.environment, o);
-    this.dynGeometry.setIndex(indexOf(part.farDynamic));
+    this.drawIds(this.dynGeometry, part.farDynamic);
     this.dynMesh.visible = part.farDynamic.length > 0;
     this.far = part.farStatic;
     this.farDynamic = part.farDynamic.length;
@@ -429,7 +478,7 @@ class Viewer {
     if (f.done && this.partition) {
       this.clovrExact = true;
       const ids = this.applyExact(this.partition);
-      this.geometry.setIndex(indexOf(ids));
+      this.drawIds(this.geometry, ids);
       this.drawn = ids.length;
       return;
     }
@@ -439,7 +488,7 @@ class Viewer {
     u.r2.value = f.radius;
     this.dynMesh.visible = false;
     if (f.near) {
-      this.geometry.setIndex(indexOf(f.near));
+      this.drawIds(this.geometry, f.near);
       this.drawn = f.near.length;
       this.renderEnvironment(f.environment, this.centre);
       this.far = f.environment.length;
@@ -550,7 +599,9 @@ class Viewer {
             triangles_total: this.total, ms, bytes_fetched: this.bytes,
             range_requests: this.requests, frame_range_requests: this.lookupRequests,
             prefetched_chain_blocks: this.chainBlocks, eye: [p.x, p.y, p.z],
-            centre: this.centre ?? null, centre_source: this.centreSource ?? null};
+            centre: this.centre ?? null, centre_source: this.centreSource ?? null,
+            shading: this.shading, textures: this.textures.groups ? this.textures.groups.count : 0,
+            texture_errors: this.textures.errors};
   }
 
   // Replay: frame i of the path.
@@ -584,7 +635,8 @@ class Viewer {
       `PVS bytes fetched ${this.bytes} of ${this.pvs.info.file_size} (${this.requests} range requests)` +
       `\nscene ${this.sceneBytes} bytes` +
       (this.clovrFrame ? `\nCloVR ring ${this.clovrFrame.ring} of ${this.clovrFrame.ring_count}, R ${this.clovrFrame.radius.toFixed(1)}${this.clovrFrame.done ? " (complete: the exact set by triangle)" : ""}` : "") +
-      (this.popping === null ? "" : `\npopping pixels ${this.popping} (last measured; P measures)`);
+      (this.popping === null ? "" : `\npopping pixels ${this.popping} (last measured; P measures)`) +
+      (this.textures.errors.length ? `\n<span class="outside">textures not shown: ${this.textures.errors.join("; ")}</span>` : "");
   }
 
   // Top view of the cells, coloured by PVS size (dark blue: smallest, yellow: largest).

@@ -22,8 +22,9 @@
 //     the pole row.
 //  4. draw (render, per eye into its half of a W x W texture, left eye on top): x = lon / pi,
 //     y = lat / (pi / 2), depth = range (linear in the image, the paper's orthographic z =
-//     -|v|). The fragment shades as the CPU reference does (shade_frame): albedo times 0.1 + 0.9
-//     |n . d|, d the direction of the pixel centre's ray (pixel_to_lonlat).
+//     -|v|). The fragment shades as the CPU reference does (shade_triangle): albedo times
+//     0.35 + 0.65 max(|n . d|, 0.6 |n_y|), d the direction of the pixel centre's ray
+//     (pixel_to_lonlat).
 //
 // Deviation from runtime/ods.h: a vertex inside the viewing circle (r_h <= h at its latitude; no
 // ODS ray reaches it) is placed on the pole row at lon_c - s pi / 2, the limit of the projection
@@ -312,7 +313,8 @@ struct VOut { @builtin(position) p: vec4f, @location(0) @interpolate(flat) tri: 
   let v = outv[i];
   return VOut(vec4f(v.x / PI, v.y / (0.5 * PI), v.z / P.maxRange, 1.0), bitcast<u32>(v.w));
 }
-// shade_frame / shade_triangle: albedo * (0.1 + 0.9 |n . d|), d the pixel centre's direction.
+// shade_triangle (vislib/eval/render.cpp): albedo * (0.35 + 0.65 min(max(|n . d|, 0.6 |n_y|), 1)),
+// d the pixel centre's direction (kRenderAmbient, kRenderSky).
 @fragment fn fs(in: VOut) -> @location(0) vec4f {
   let u = in.p.x;
   let v = in.p.y - P.rowOffset;
@@ -323,8 +325,9 @@ struct VOut { @builtin(position) p: vec4f, @location(0) @interpolate(flat) tri: 
   let n = cross(corner(in.tri, 1u) - a, corner(in.tri, 2u) - a);
   let nl = length(n);
   var lambert = 0.0;
-  if (nl > 0.0) { lambert = abs(dot(n, d)) / nl; }
-  let shade = 0.1 + 0.9 * min(lambert, 1.0);
+  var sky = 0.0;
+  if (nl > 0.0) { lambert = abs(dot(n, d)) / nl; sky = 0.6 * abs(n.y) / nl; }
+  let shade = 0.35 + 0.65 * min(max(lambert, sky), 1.0);
   let c = colours[in.tri];
   let albedo = vec3f(f32(c & 255u), f32((c >> 8u) & 255u), f32((c >> 16u) & 255u)) / 255.0;
   return vec4f(albedo * shade, 1.0);

@@ -55,7 +55,8 @@ void main() {
   vV = position - e; vN = normal; vC = colour;
   gl_Position = m * vec4(position, 1.0);
 }`;
-// The CPU renderer's shading (render.h): albedo * (0.1 + 0.9 |n . v|), v from the eye.
+// The CPU renderer's shading (shade_triangle, render.h): albedo * (0.35 + 0.65 min(max(|n . v|,
+// 0.6 |n_y|), 1)), v from the eye (kRenderAmbient, kRenderSky).
 const SCENE_FS = `#version 300 es
 precision highp float;
 in vec3 vV; flat in vec3 vN; flat in vec3 vC;
@@ -63,7 +64,8 @@ out vec4 o;
 void main() {
   float nl = length(vN), vl = length(vV);
   float l = nl > 0.0 && vl > 0.0 ? abs(dot(vN, vV)) / (nl * vl) : 0.0;
-  o = vec4(vC * (0.1 + 0.9 * min(l, 1.0)), 1.0);
+  float sky = nl > 0.0 ? 0.6 * abs(vN.y) / nl : 0.0;
+  o = vec4(vC * (0.35 + 0.65 * min(max(l, sky), 1.0)), 1.0);
 }`;
 // One point per source pixel, to the other eye.
 const SPLAT_VS = `#version 300 es

@@ -3,7 +3,8 @@
 // did (scripts/web-check.sh starts the server and calls this). WebGPU (the ods and stereo modes)
 // comes from SwiftShader too, with --enable-unsafe-webgpu on a page served from 127.0.0.1. A page
 // whose viewer offers framePng() (the ods and stereo modes) gives its own frame's pixels for the
-// PNGs; otherwise they are screenshots.
+// PNGs; otherwise they are screenshots. With the overlays shown, it also records where they lie
+// after the last frame (`layout`, see overlayLayout) and that key H hides and shows them again.
 //
 // node web_check.mjs --url PAGE_URL --json OUT [--png-dir DIR --png-frames 0,5,9] [--size WxH]
 //                    [--server-log FILE --pvs-name NAME] [--chromium PATH]
@@ -38,6 +39,41 @@ function findChromium() {
   for (const p of ["/usr/lib/chromium/chromium", "/usr/bin/chromium", "/usr/bin/chromium-browser"])
     if (fs.existsSync(p)) return p;
   return null;
+}
+
+// The overlays' boxes (getBoundingClientRect, CSS pixels) in the page's viewport, and what is
+// wrong with them: each must lie inside the viewport in its own corner (overlay: top left, map:
+// top right, help: bottom left), none may overlap another, the map's side may not exceed 30% of
+// the viewport's shorter side (+1 px of rounding), and no text may be clipped (an element's
+// scrolling size beyond its client size). Runs in the page.
+function overlayLayout() {
+  const W = innerWidth, H = innerHeight, boxes = {}, problems = [];
+  for (const id of ["overlay", "map", "help"]) {
+    const e = document.getElementById(id);
+    if (getComputedStyle(e).display === "none") continue;
+    const r = e.getBoundingClientRect();
+    boxes[id] = {left: r.left, top: r.top, right: r.right, bottom: r.bottom,
+                 clipped: e.scrollWidth > e.clientWidth || e.scrollHeight > e.clientHeight};
+  }
+  const corner = {overlay: (b) => b.left < W / 2 && b.top < H / 2,
+                  map: (b) => b.right > W / 2 && b.top < H / 2,
+                  help: (b) => b.left < W / 2 && b.bottom > H / 2};
+  const ids = Object.keys(boxes);
+  for (const id of ids) {
+    const b = boxes[id];
+    if (b.left < 0 || b.top < 0 || b.right > W || b.bottom > H) problems.push(`${id} leaves the viewport`);
+    if (!corner[id](b)) problems.push(`${id} is not in its corner`);
+    if (b.clipped) problems.push(`${id}'s text is clipped`);
+  }
+  for (let i = 0; i < ids.length; ++i)
+    for (let j = i + 1; j < ids.length; ++j) {
+      const a = boxes[ids[i]], b = boxes[ids[j]];
+      if (a.left < b.right && b.left < a.right && a.top < b.bottom && b.top < a.bottom)
+        problems.push(`${ids[i]} and ${ids[j]} overlap`);
+    }
+  if (boxes.map && boxes.map.right - boxes.map.left > 0.3 * Math.min(W, H) + 1)
+    problems.push(`the map is ${boxes.map.right - boxes.map.left} px wide, over 30% of ${Math.min(W, H)} px`);
+  return {viewport: [W, H], boxes, problems};
 }
 
 async function main() {
@@ -113,10 +149,21 @@ async function main() {
       }
       frames.push(rec);
     }
+    let layout = null;
+    const shown = () => page.evaluate(() => ["overlay", "map", "help"].map(
+      (id) => getComputedStyle(document.getElementById(id)).display !== "none"));
+    if ((await shown()).every((v) => v)) {
+      layout = await page.evaluate(overlayLayout);
+      await page.keyboard.press("h");
+      layout.hidden_by_h = (await shown()).every((v) => !v);
+      await page.keyboard.press("h");
+      layout.shown_again_by_h = (await shown()).every((v) => v);
+    }
     const ms = frames.map((f) => f.ms).sort((x, y) => x - y);
     const out = {
       url: a.url, renderer: gpu, chromium: await browser.version(), ...info,
       frames,
+      layout,
       summary: {
         frames: n,
         ms_median: ms.length ? ms[Math.floor(ms.length / 2)] : null,
