@@ -154,7 +154,7 @@ std::vector<uint32_t> parse_leaves(const std::string& text, const std::vector<ui
 
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   if (a.cells != "bsp-leaves") {
-    for (const char* o : {"--face-spacing", "--leaves"})
+    for (const char* o : {"--face-spacing", "--leaves", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     return;
   }
@@ -176,6 +176,9 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene) {
     o.face_spacing = a.face_spacing;
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
     o.scene = load_options_of(a.import);
+    o.bound = a.bound == "none"      ? vislib::BspBound::none
+              : a.bound == "map-vis" ? vislib::BspBound::map_vis
+                                     : vislib::BspBound::portal;
     return vislib::bsp_leaf_cells(bsp, o);
   }
   vislib::CellPlacement p = placement_of(a);
@@ -248,6 +251,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");
+  cmd->add_option("--bound", a.bound,
+                  "bsp-leaves: restrict each leaf's runs to the faces of the leaves it may see: "
+                  "'portal' (our own portal flow, exact), 'map-vis' (the map's own vis, only as "
+                  "conservative as the map's compiler) or 'none' (docs/quake.md)")
+      ->check(CLI::IsMember({"portal", "map-vis", "none"}))
+      ->capture_default_str();
   cmd->add_option("--box", a.box,
                   "Grid box x0,y0,z0,x1,y1,z1 (with --walkable: only place cells in it)");
   cmd->add_option("--grid", a.grid, "Grid cells nx,ny,nz over --box");

@@ -35,6 +35,7 @@ struct BakeArgs {
   std::string cells;                              // --cells: "" (grid or walkable) or bsp-leaves
   double face_spacing = vislib::kBspFaceSpacing;  // --face-spacing (bsp-leaves), Quake units
   std::string leaves;                             // --leaves A-B (bsp-leaves)
+  std::string bound = "portal";                   // --bound portal|map-vis|none (bsp-leaves)
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).
@@ -49,7 +50,7 @@ void apply_preset(BakeArgs& a, const CLI::App& cmd);
 // --cells bsp-leaves: refuses (CLI::ValidationError, exit 2) the options that place cells
 // otherwise (--walkable, --box, --grid, --cell-size, --eye-height) and, before the scene is
 // loaded, a scene that is not a .bsp (InputError naming it). Without --cells: refuses
-// --face-spacing and --leaves.
+// --face-spacing, --leaves and --bound.
 void check_cells_options(const BakeArgs& a, const CLI::App& cmd);
 
 // The view cells of the options over `scene` (vislib::place_view_cells, or with --cells

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -668,7 +669,12 @@ struct RayCheck {
   double seconds = 0;
 };
 
-RayCheck check_rays(const std::string& path, int eyes, int dirs, uint64_t seed) {
+// `allowed(m, leaf)`: the triangles a ray from `leaf` may hit (sorted); by default those the
+// engine draws from it.
+using AllowedFn = std::function<std::vector<uint32_t>(const QuakeBsp&, uint32_t)>;
+
+RayCheck check_rays(const std::string& path, int eyes, int dirs, uint64_t seed,
+                    const AllowedFn& allowed = {}) {
   RayCheck out;
   const auto t0 = std::chrono::steady_clock::now();
   const QuakeBsp m = read_quake_bsp(path);
@@ -686,7 +692,8 @@ RayCheck check_rays(const std::string& path, int eyes, int dirs, uint64_t seed) 
   for (const auto& p : bsp_leaf_pieces(m)) {
     if (p.leaf == 0 || p.volume.empty() || m.leaves[p.leaf].contents == kBspContentsSky) continue;
     ++out.leaves;
-    const std::vector<uint32_t> drawn = bsp_leaf_drawn_triangles(m, faces, p.leaf);
+    const std::vector<uint32_t> drawn =
+        allowed ? allowed(m, p.leaf) : bsp_leaf_drawn_triangles(m, faces, p.leaf);
     std::vector<Vec3> corners;
     for (const auto& f : p.volume.faces) corners.insert(corners.end(), f.begin(), f.end());
     for (int e = 0; e < eyes; ++e) {
@@ -753,6 +760,33 @@ TEST(QuakeBspLibreQuake, Lqdm1RaysFromEveryLeafHitOnlyTrianglesTheEngineDraws) {
                   << ", which the engine does not draw from there";
 }
 
+// The triangles of each cell leaf's portal bound in the map at `path` (bsp_cell_bound,
+// BspBound::portal), as check_rays' `allowed`.
+AllowedFn portal_bound_triangles(const std::string& path) {
+  const QuakeBsp m = read_quake_bsp(path);
+  auto leaves = std::make_shared<std::vector<uint32_t>>(bsp_cell_leaves(m));
+  auto bound = std::make_shared<CellBound>(bsp_cell_bound(m, BspBound::portal, *leaves, {}));
+  return [leaves, bound](const QuakeBsp&, uint32_t leaf) {
+    const auto it = std::lower_bound(leaves->begin(), leaves->end(), leaf);
+    return bound->triangles(uint32_t(it - leaves->begin()));
+  };
+}
+
+// Our own portal flow, held against the same rays: every first hit from a leaf is a triangle of
+// its portal bound, so cutting the scene to the bound (the bake's restriction) changes no first hit
+// from the leaf. Budget: a few seconds (Release).
+TEST(QuakeBspLibreQuake, Lqdm1RaysFromEveryLeafHitOnlyTrianglesOfItsPortalBound) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  const RayCheck c = check_rays(*path, 4, 64, 3605, portal_bound_triangles(*path));
+  print("lqdm1 (portal bound)", c);
+  EXPECT_EQ(c.leaves, 321u);
+  EXPECT_EQ(c.no_hit, 0u);
+  EXPECT_LE(c.ambiguous, c.rays / 1000);
+  for (const auto& [leaf, tri] : c.misses)
+    ADD_FAILURE() << "leaf " << leaf << " sees triangle " << tri << ", outside its portal bound";
+}
+
 // The same on e1m2 and e2m3 (opt-in: VISLIB_LONG_TESTS=1; about a minute and a half here). A
 // sampled check with failure-rate thresholds: unambiguous hits the map's vis does not draw, and
 // rays that leave the map through a crack, each at most 1 in 10^4 rays. Ambiguous re-casts are
@@ -771,6 +805,23 @@ TEST(QuakeBspLibreQuake, LongRaysFromEveryLeafOfE1m2AndE2m3) {
     for (uint32_t f : c.missed_faces) std::printf(" %u", f);
     std::printf("\n%s: textures of ambiguous hits:", name);
     for (const auto& [tex, k] : c.ambiguous_textures) std::printf(" %s %zu", tex.c_str(), k);
+    std::printf("\n");
+  }
+}
+
+// Our own portal flow on e1m2 and e2m3, held against the same rays with the same thresholds
+// (opt-in: VISLIB_LONG_TESTS=1; about a minute and a half here).
+TEST(QuakeBspLibreQuake, LongRaysFromEveryLeafOfE1m2AndE2m3HitOnlyTrianglesOfTheirPortalBound) {
+  VISLIB_REQUIRE_LONG_TESTS();
+  for (const char* name : {"e1m2.bsp", "e2m3.bsp"}) {
+    auto path = librequake(name);
+    if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+    const RayCheck c = check_rays(*path, 4, 64, 3602, portal_bound_triangles(*path));
+    print(name, c);
+    EXPECT_LE(c.no_hit, c.rays / 10000) << name;
+    EXPECT_LE(c.misses.size(), c.rays / 10000) << name;
+    std::printf("%s: faces hit outside the portal bound:", name);
+    for (uint32_t f : c.missed_faces) std::printf(" %u", f);
     std::printf("\n");
   }
 }
@@ -903,6 +954,8 @@ TEST(QuakeBake, CellsAreTheLeavesAndTheirSegmentsLieInTheInsetVolume) {
   EXPECT_EQ(d["inset"], kBspLeafInset);
   EXPECT_EQ(d["bsp_liquids"], "see-through");
   EXPECT_EQ(d["bsp_models"], "world");
+  EXPECT_EQ(d["bound"], "none");
+  EXPECT_TRUE(cells.bound.empty());
   o.leaves = {2};
   EXPECT_EQ(bsp_leaf_cells(m, o).layout.cell_leaf, (std::vector<uint32_t>{2}));
   o.leaves = {0};
@@ -931,8 +984,12 @@ TEST(QuakeBake, SetsHoldEveryTriangleARayFromTheRegionHitsOnAnyThreadCount) {
     EXPECT_EQ(r.info().layout.cell_leaf, cells.layout.cell_leaf);
     const nlohmann::json meta = nlohmann::json::parse(r.info().metadata);
     EXPECT_EQ(meta["cells"]["kind"], "bsp-leaves");
+    BspCellOptions bounded = o;
+    bounded.bound = BspBound::portal;
+    const ViewCells portal_cells = bsp_leaf_cells(m, bounded);
     for (uint32_t c = 0; c < 2; ++c) {
       EXPECT_EQ(r.read_cell(c), bake_cell(scene, cells, c, s));
+      EXPECT_EQ(r.read_cell(c), bake_cell(scene, portal_cells, c, s));
       const Vec3 centre = quake_to_scene({32, 48, c == 0 ? 8.0 : 24.0});
       const double p[3] = {centre.x, centre.y, centre.z};
       EXPECT_EQ(r.info().layout.find_cell(p), std::optional<uint32_t>(c));
@@ -975,6 +1032,14 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_NE(out.find("--cell-size"), std::string::npos) << out;
   EXPECT_EQ(run_pvs("bake " + map + " --face-spacing 8 --walkable -o " + dir + "/x.pvs", &out), 2);
   EXPECT_NE(out.find("--face-spacing"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs("bake " + map + " --bound none --walkable -o " + dir + "/x.pvs", &out), 2);
+  EXPECT_NE(out.find("--bound"), std::string::npos) << out;
+  EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --bound all -o " + dir + "/x.pvs", &out),
+            2);
+  EXPECT_NE(out.find("--bound"), std::string::npos) << out;
+  // The default bound is the portal flow, recorded in the metadata.
+  ASSERT_EQ(run_pvs("inspect --json " + dir + "/tiny.pvs", &out), 0) << out;
+  EXPECT_NE(out.find("\"bound\":\"portal\""), std::string::npos) << out;
   // --leaves: a list of A, A-B and A-B/K items; anything else exits 2 naming the option.
   for (const char* bad : {"5-", "x", "3-1", "1-4/0", "-3", "1,,2", "2 3"}) {
     EXPECT_EQ(
@@ -1051,6 +1116,55 @@ TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourBakeThroughTheCliAndHoldTheirRays)
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256);
+}
+
+// The restriction is exact: six spread leaves of lqdm1 baked with the portal bound and with the
+// map's vis as the bound hold the very sets of the unrestricted bake (the file's sets, through
+// bake() with its BVH and lines), though each cell's runs see a part of the map. A bound that drops
+// the leaf holding most of a cell's visible triangles changes that cell's set, so the comparison
+// can fail. Budget: a few seconds (Release, --res 32).
+TEST(QuakeBakeLibreQuake, Lqdm1BoundsLeaveTheSetsOfSixLeavesUnchanged) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  const std::string dir = temp_dir("quake_bake_bound");
+  const QuakeBsp m = read_quake_bsp(*path);
+  const Scene scene = load_scene(*path);
+  BakeSettings s;
+  s.region.segment.resolution = 32;
+  BspCellOptions o;
+  o.leaves = {1, 60, 120, 180, 240, 300};
+  const ViewCells full = bsp_leaf_cells(m, o);
+  pvs::Reader unrestricted =
+      pvs::Reader::from_memory(bake_file(scene, full, s, dir + "/none.pvs", 2));
+  for (BspBound bound : {BspBound::portal, BspBound::map_vis}) {
+    o.bound = bound;
+    const ViewCells cells = bsp_leaf_cells(m, o);
+    pvs::Reader r = pvs::Reader::from_memory(bake_file(scene, cells, s, dir + "/b.pvs", 2));
+    EXPECT_EQ(nlohmann::json::parse(r.info().metadata)["cells"]["bound"], bsp_bound_name(bound));
+    for (uint32_t c = 0; c < 6; ++c) {
+      const size_t kept = cells.bound.triangles(c).size();
+      EXPECT_LT(kept, scene.triangle_count());
+      EXPECT_EQ(r.read_cell(c), unrestricted.read_cell(c)) << "cell " << c;
+      std::printf("lqdm1 leaf %u, bound %s: %zu of %zu triangles kept, set %zu\n", o.leaves[c],
+                  bsp_bound_name(bound), kept, scene.triangle_count(), r.read_cell(c).size());
+    }
+  }
+  // Cell 0 with its bound short of the leaf (not its own) whose faces hold most of its set.
+  o.bound = BspBound::portal;
+  ViewCells broken = bsp_leaf_cells(m, o);
+  const std::vector<uint32_t> set = unrestricted.read_cell(0);
+  std::vector<uint32_t>& groups = broken.bound.cell_groups[0];
+  size_t best = 0, best_count = 0;
+  for (size_t i = 0; i < groups.size(); ++i) {
+    if (groups[i] == o.leaves[0]) continue;
+    size_t count = 0;
+    for (uint32_t t : broken.bound.group_triangles[groups[i]])
+      count += std::binary_search(set.begin(), set.end(), t);
+    if (count > best_count) best = i, best_count = count;
+  }
+  ASSERT_GT(best_count, 0u);
+  groups.erase(groups.begin() + long(best));
+  EXPECT_NE(bake_cell(scene, broken, 0, s), set);
 }
 
 // --leaves picks the listed leaves of a real map: every 10th from 1 to 40, and 3.

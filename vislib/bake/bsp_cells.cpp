@@ -9,107 +9,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "vislib/bake/bsp_portals.h"
 #include "vislib/scene/quake_bsp_volumes.h"
 
 namespace vislib {
 
 namespace {
-
-// Two faces of BSP leaf volumes (Quake units) lie on one plane, facing each other, when their
-// unit normals are opposite to within this (1 + dot of the normals) and each vertex of one is
-// within kBspFaceCoplanarDistance of the other's plane (vislib/bake/bsp_cells.h). The volumes
-// come from the same float planes, so a shared face agrees to about 1e-12 units.
-constexpr double kBspFaceOppositeNormals = 1e-9;
-constexpr double kBspFaceCoplanarDistance = 1e-6;
-// Two leaf volumes are neighbours when their shared face has at least this area (square Quake
-// units; a real portal is at least about 1).
-constexpr double kBspPortalMinArea = 1e-3;
-
-// A face of a leaf volume with its plane: unit outward normal and offset (dot(n, p) = offset).
-struct PlanarFace {
-  const std::vector<Vec3>* poly;
-  Vec3 normal;
-  double offset;
-};
-
-PlanarFace planar(const std::vector<Vec3>& poly) {
-  Vec3 n{0, 0, 0};  // Newell's normal: exact direction for a planar polygon
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
-    n.x += (a.y - b.y) * (a.z + b.z);
-    n.y += (a.z - b.z) * (a.x + b.x);
-    n.z += (a.x - b.x) * (a.y + b.y);
-  }
-  n = n * (1.0 / length(n));
-  return {&poly, n, dot(n, poly[0])};
-}
-
-using P2 = std::array<double, 2>;
-
-double signed_area(const std::vector<P2>& p) {
-  double a = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    const P2& u = p[i];
-    const P2& v = p[(i + 1) % p.size()];
-    a += u[0] * v[1] - v[0] * u[1];
-  }
-  return 0.5 * a;
-}
-
-// Area of the intersection of two convex polygons, both counter-clockwise (Sutherland-Hodgman).
-double overlap_area(std::vector<P2> a, const std::vector<P2>& b) {
-  for (size_t i = 0; i < b.size() && a.size() >= 3; ++i) {
-    const P2& p = b[i];
-    const P2& q = b[(i + 1) % b.size()];
-    auto side = [&](const P2& x) {
-      return (q[0] - p[0]) * (x[1] - p[1]) - (q[1] - p[1]) * (x[0] - p[0]);
-    };
-    std::vector<P2> out;
-    for (size_t k = 0; k < a.size(); ++k) {
-      const P2& u = a[k];
-      const P2& v = a[(k + 1) % a.size()];
-      double su = side(u), sv = side(v);
-      if (su >= 0) out.push_back(u);
-      if ((su >= 0) != (sv >= 0)) {
-        double t = su / (su - sv);
-        out.push_back({u[0] + (v[0] - u[0]) * t, u[1] + (v[1] - u[1]) * t});
-      }
-    }
-    a = std::move(out);
-  }
-  return a.size() >= 3 ? signed_area(a) : 0.0;
-}
-
-// The polygon projected on the two axes other than `drop`, counter-clockwise.
-std::vector<P2> project(const std::vector<Vec3>& poly, int drop) {
-  const int u = drop == 0 ? 1 : 0, v = drop == 2 ? 1 : 2;
-  std::vector<P2> out;
-  for (const Vec3& p : poly) out.push_back({p[u], p[v]});
-  if (signed_area(out) < 0) std::reverse(out.begin(), out.end());
-  return out;
-}
-
-// True if a face of `a` and a face of `b` lie on one plane facing each other and overlap with
-// positive area (kBspPortalMinArea).
-bool share_face(const std::vector<PlanarFace>& a, const std::vector<PlanarFace>& b) {
-  for (const PlanarFace& fa : a)
-    for (const PlanarFace& fb : b) {
-      if (1.0 + dot(fa.normal, fb.normal) > kBspFaceOppositeNormals) continue;
-      bool coplanar = true;
-      for (const Vec3& v : *fb.poly)
-        coplanar = coplanar && std::fabs(dot(fa.normal, v) - fa.offset) <= kBspFaceCoplanarDistance;
-      if (!coplanar) continue;
-      int drop = 0;
-      for (int k = 1; k < 3; ++k)
-        if (std::fabs(fa.normal[k]) > std::fabs(fa.normal[drop])) drop = k;
-      // The projected area shrinks by |n[drop]| (at least 1/sqrt(3)); undo that.
-      double area = overlap_area(project(*fa.poly, drop), project(*fb.poly, drop)) /
-                    std::fabs(fa.normal[drop]);
-      if (area >= kBspPortalMinArea) return true;
-    }
-  return false;
-}
 
 // Segment end points closer than this (Quake units) are one point: an edge of two faces of one
 // polytope is computed once per face and agrees to about 1e-12 units; shorter segments are dropped.
@@ -165,14 +70,6 @@ void face_chords(const std::vector<Vec3>& poly, Vec3 n, double spacing, std::vec
     }
     if (any && length(b - a) > kBspSameEndpoint) out.push_back({a, b});
   }
-}
-
-bool boxes_touch(const Box3& a, const Box3& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.min[k] > b.max[k] + kBspFaceCoplanarDistance ||
-        b.min[k] > a.max[k] + kBspFaceCoplanarDistance)
-      return false;
-  return true;
 }
 
 }  // namespace
@@ -246,12 +143,10 @@ pvs::CellLayout bsp_leaf_layout(const QuakeBsp& bsp, const std::vector<uint32_t>
   // Each cell's volume: its leaf's pieces (one for a leaf reached once).
   const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(bsp);
   const size_t C = cell_leaves.size();
-  std::vector<std::vector<PlanarFace>> faces(C);
   std::vector<Box3> bounds(C);
   for (const BspLeafPiece& piece : pieces) {
     uint32_t c = L.leaf_cell[piece.leaf];
     if (c == pvs::kNoCell || piece.volume.empty()) continue;
-    for (const auto& f : piece.volume.faces) faces[c].push_back(planar(f));
     Box3 b = piece.volume.bounds();
     bounds[c].extend(b.min);
     bounds[c].extend(b.max);
@@ -266,13 +161,12 @@ pvs::CellLayout bsp_leaf_layout(const QuakeBsp& bsp, const std::vector<uint32_t>
     L.boxes[c] = {{q.min.x, q.min.z, -q.max.y}, {q.max.x, q.max.z, -q.min.y}};
   }
   L.neighbours.assign(C, {});
-  for (size_t a = 0; a < C; ++a)
-    for (size_t b = a + 1; b < C; ++b)
-      if (boxes_touch(bounds[a], bounds[b]) && share_face(faces[a], faces[b])) {
-        L.neighbours[a].push_back(uint32_t(b));
-        L.neighbours[b].push_back(uint32_t(a));
-      }
-  return L;  // neighbours sorted: a's list gets b in increasing order, and earlier a's first
+  for (const BspPortal& p : bsp_leaf_portals(pieces, cell_leaves)) {
+    const uint32_t a = L.leaf_cell[p.leaves[0]], b = L.leaf_cell[p.leaves[1]];
+    L.neighbours[a].push_back(b);
+    L.neighbours[b].push_back(a);
+  }
+  return L;  // neighbours sorted: portals come by (lower, higher) leaf, and leaves increase
 }
 
 std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double spacing) {
@@ -289,13 +183,72 @@ std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double sp
   if (spacing > 0)
     for (const std::vector<Vec3>& f : region.faces) {
       if (f.size() < 3) continue;
-      const PlanarFace pf = planar(f);
-      if (!std::isfinite(pf.normal.x)) continue;
-      face_chords(f, pf.normal, spacing, quake);
+      const Vec3 n = polygon_normal(f);
+      if (!std::isfinite(n.x)) continue;
+      face_chords(f, n, spacing, quake);
     }
   std::vector<Segment> out;
   out.reserve(quake.size());
   for (const Segment& s : quake) out.push_back({quake_to_scene(s.from), quake_to_scene(s.to)});
+  return out;
+}
+
+const char* bsp_bound_name(BspBound bound) {
+  return bound == BspBound::portal ? "portal" : bound == BspBound::map_vis ? "map-vis" : "none";
+}
+
+std::vector<std::vector<uint32_t>> bsp_bound_leaves(const QuakeBsp& bsp, BspBound bound,
+                                                    const std::vector<uint32_t>& leaves) {
+  std::vector<std::vector<uint32_t>> out;
+  if (bound == BspBound::map_vis) {
+    for (uint32_t l : leaves) {
+      std::vector<uint32_t> sees = bsp_leaf_sees(bsp, l);
+      if (!std::binary_search(sees.begin(), sees.end(), l))
+        sees.insert(std::upper_bound(sees.begin(), sees.end(), l), l);
+      out.push_back(std::move(sees));
+    }
+    return out;
+  }
+  const std::vector<uint32_t> all = bsp_cell_leaves(bsp);
+  if (bound == BspBound::none) {
+    std::vector<uint32_t> reached;
+    for (const BspLeafPiece& p : bsp_leaf_pieces(bsp)) reached.push_back(p.leaf);
+    std::sort(reached.begin(), reached.end());
+    reached.erase(std::unique(reached.begin(), reached.end()), reached.end());
+    return std::vector<std::vector<uint32_t>>(leaves.size(), reached);
+  }
+  const std::vector<std::vector<uint32_t>> flow =
+      bsp_portal_base_vis(bsp_leaf_portals(bsp_leaf_pieces(bsp), all), all);
+  for (uint32_t l : leaves)
+    out.push_back(flow[size_t(std::lower_bound(all.begin(), all.end(), l) - all.begin())]);
+  return out;
+}
+
+CellBound bsp_cell_bound(const QuakeBsp& bsp, BspBound bound, const std::vector<uint32_t>& leaves,
+                         const LoadOptions& scene) {
+  CellBound out;
+  if (bound == BspBound::none) return out;
+  const std::vector<BspFaceTriangles> faces = bsp_face_triangles(bsp, scene);
+  auto triangles_of = [&](uint32_t f, std::vector<uint32_t>& ids) {
+    for (uint32_t k = 0; k < faces[f].triangle_count; ++k)
+      ids.push_back(faces[f].first_triangle + k);
+  };
+  // A group per map leaf: the triangles of its marksurfaces.
+  out.group_triangles.resize(bsp.leaves.size());
+  std::vector<uint8_t> marked(faces.size(), 0);
+  for (uint32_t l = 0; l < bsp.leaves.size(); ++l) {
+    const BspLeaf& leaf = bsp.leaves[l];
+    for (uint32_t k = 0; k < leaf.marksurface_count; ++k)
+      triangles_of(bsp.marksurfaces[leaf.first_marksurface + k], out.group_triangles[l]);
+  }
+  for (uint32_t l : bsp_cell_leaves(bsp)) {
+    const BspLeaf& leaf = bsp.leaves[l];
+    for (uint32_t k = 0; k < leaf.marksurface_count; ++k)
+      marked[bsp.marksurfaces[leaf.first_marksurface + k]] = 1;
+  }
+  for (uint32_t f = 0; f < faces.size(); ++f)
+    if (!marked[f]) triangles_of(f, out.always);
+  out.cell_groups = bsp_bound_leaves(bsp, bound, leaves);
   return out;
 }
 
@@ -339,8 +292,10 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
       {"leaves_inset_less", thin},
       {"leaves_not_inset", uninset},
       {"bsp_models", options.scene.bsp_models == BspModels::all ? "all" : "world"},
-      {"bsp_liquids", liquids}};
+      {"bsp_liquids", liquids},
+      {"bound", bsp_bound_name(options.bound)}};
   cells.description = d.dump();
+  cells.bound = bsp_cell_bound(bsp, options.bound, leaves, options.scene);
   return cells;
 }
 

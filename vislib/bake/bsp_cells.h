@@ -3,11 +3,8 @@
 // map's planes in scene coordinates), the leaf of each cell, the bounding box of each cell's volume
 // (quake_bsp_volumes.h) and each cell's neighbours.
 //
-// Neighbours: the map file holds no portals (the compiler keeps them in a separate .prt file), so
-// two cells are neighbours when their leaves' volumes share a face of positive area: a face of
-// one and a face of the other on one plane with opposite normals whose overlap has at least
-// kBspPortalMinArea square units (tolerances named in bsp_cells.cpp). That is the portal the
-// compiler would put between them: a portal is the part of a node's plane where two leaves meet.
+// Neighbours: two cells are neighbours when their leaves share a portal (bsp_portals.h: their
+// volumes share a face of at least kBspPortalMinArea square units).
 #pragma once
 
 #include <cstdint>
@@ -51,6 +48,28 @@ constexpr double kBspFaceSpacing = 16.0;
 // narrower than 1e-6 units) give no segment. Deterministic.
 std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double spacing);
 
+// What a leaf's runs are restricted to (ViewCells::bound; docs/quake.md, "Restricting a leaf's
+// runs"): nothing (every triangle); our own portal flow (bsp_portal_base_vis over the portals of
+// every cell leaf, bsp_portals.h); or the map's own visibility row (bsp_leaf_sees, the leaf itself
+// added), only as conservative as the compiler's vis.
+enum class BspBound { none, portal, map_vis };
+// "none", "portal", "map-vis".
+const char* bsp_bound_name(BspBound bound);
+
+// The leaves (map leaf numbers, sorted) that each of `leaves` (an increasing subset of
+// bsp_cell_leaves) may see under `bound`, in the order of `leaves`; BspBound::none: every leaf
+// reached from model 0's head node. Deterministic.
+std::vector<std::vector<uint32_t>> bsp_bound_leaves(const QuakeBsp& bsp, BspBound bound,
+                                                    const std::vector<uint32_t>& leaves);
+
+// The triangle bound of cells whose leaves are `leaves` under `bound` (empty for BspBound::none):
+// cell c keeps the triangles (ids of the scene imported with `scene`, bsp_face_triangles) of the
+// faces in the marksurfaces of bsp_bound_leaves(bsp, bound, leaves)[c], and every triangle of a
+// face in no cell leaf's marksurfaces (other models, faces marked only in sky leaves), which no
+// bound drops. Deterministic.
+CellBound bsp_cell_bound(const QuakeBsp& bsp, BspBound bound, const std::vector<uint32_t>& leaves,
+                         const LoadOptions& scene);
+
 struct BspCellOptions {
   double face_spacing = kBspFaceSpacing;  // bsp_region_segments' spacing, >= 0 (0: edges only)
   // The leaves to bake, a subset of bsp_cell_leaves (increasing); empty: all of them.
@@ -58,12 +77,14 @@ struct BspCellOptions {
   // The import options the scene was loaded with (bsp_models, bsp_liquids), recorded in the
   // description so that a reader knows what the triangle ids index.
   LoadOptions scene;
+  BspBound bound = BspBound::none;  // the cells' bound (bsp_cell_bound)
 };
 
 // The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
 // bsp_region_segments(bsp_leaf_view_region(volume of its leaf), face_spacing), and a description
 // (JSON) recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
-// kBspLeafMinInset, the count of leaves inset less than kBspLeafInset) and the scene options.
+// kBspLeafMinInset, the count of leaves inset less than kBspLeafInset), the scene options and the
+// bound (`bound`: bsp_bound_name; the cells' bound is bsp_cell_bound).
 // Throws std::invalid_argument for leaves that are not an increasing subset of bsp_cell_leaves.
 // Deterministic.
 ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options);

@@ -6,6 +6,7 @@
 #include <cassert>
 #include <iterator>
 
+#include "vislib/bake/scene_subset.h"
 #include "vislib/base/cubemap.h"
 #include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
@@ -105,10 +106,59 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
   return groups_visibility(scene, rectangle_groups(layout, cell), cell, options, progress);
 }
 
+namespace {
+
+// `scene` cut to the triangles `ids` (sorted) of a cell's bound, with what its runs need: its own
+// BVH, and the full scene's lines of collinear edges carried over edge by edge, so that every kept
+// edge is computed from the same two points as in the full scene (edge_lines.h).
+struct BoundScene {
+  std::vector<uint32_t> ids;  // triangle id in `scene` of each triangle of the subset
+  Scene scene;
+  TriangleBvh bvh;
+  EdgeLines lines;
+};
+
+void make_bound_scene(const Scene& full, const RegionOptions& options, std::vector<uint32_t> ids,
+                      BoundScene& out) {
+  out.ids = std::move(ids);
+  out.scene = scene_subset(full, out.ids, Granularity::Triangle);
+  const size_t state = options.segment.state;
+  EdgeLines own;
+  const EdgeLines* lines = options.segment.edge_lines;
+  if (!lines) {
+    own = build_edge_lines(full, state);
+    lines = &own;
+  }
+  out.lines.lines = lines->lines;
+  if (!lines->edge_line.empty()) {
+    out.lines.edge_line.resize(3 * out.ids.size());
+    for (size_t t = 0; t < out.ids.size(); ++t)
+      for (size_t e = 0; e < 3; ++e)
+        out.lines.edge_line[3 * t + e] = lines->edge_line[3 * size_t(out.ids[t]) + e];
+  }
+  out.lines.state = state;
+  out.lines.triangle_count = out.scene.triangle_count();
+  out.lines.scene = &out.scene;
+  if (options.segment.bvh && bvh_applies(out.scene)) out.bvh = build_triangle_bvh(out.scene, state);
+}
+
+}  // namespace
+
 CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
-  return groups_visibility(scene, cell_segment_groups(cells, cell), cell, options, progress);
+  if (cells.bound.empty())
+    return groups_visibility(scene, cell_segment_groups(cells, cell), cell, options, progress);
+  assert(!scene.is_dynamic() && scene.sphere_count() == 0 && options.shared_runs == nullptr);
+  BoundScene b;
+  make_bound_scene(scene, options, cells.bound.triangles(cell), b);
+  RegionOptions o = options;
+  o.segment.bvh = b.bvh.nodes.empty() ? nullptr : &b.bvh;
+  o.segment.edge_lines = &b.lines;
+  CellVisibility v =
+      groups_visibility(b.scene, cell_segment_groups(cells, cell), cell, o, progress);
+  for (uint32_t& t : v.triangles) t = b.ids[t];  // increasing: the subset keeps the order
+  return v;
 }
 
 std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,

@@ -57,7 +57,12 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
                                const std::function<void(double)>& progress = {});
 
 // The same on the segment groups of cell_segment_groups(cells, cell): segments_visibility on each
-// group, united. Same contract (thread-safe, independent of the thread count).
+// group, united. Same contract (thread-safe, independent of the thread count). With a bound
+// (cells.bound not empty; the scene must then be static without spheres, and
+// options.shared_runs null), the runs see the scene cut to cells.bound.triangles(cell)
+// (scene_subset), with a BVH of their own when options.segment.bvh is set and every kept edge on
+// its line of the full scene (options.segment.edge_lines, else built from `scene`); the ids are
+// `scene`'s. The set is the unrestricted one when the bound holds every first hit of the region.
 CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress = {});
@@ -77,7 +82,8 @@ struct CellWitnessRay {
 // orientations and options) with witnesses (segment_visibility.h), and returns the witness rays
 // of those of `wanted` (sorted triangle ids) that a run sees, in increasing id; an id no run sees
 // has none. Group by group, stopping once every wanted id has one, so the cost is at most that of
-// cell_visibility with witnesses. options.shared_runs must be null. Deterministic, thread-safe.
+// cell_visibility with witnesses. options.shared_runs must be null. Runs on the whole scene
+// (cells.bound is not applied: an exact bound changes no set). Deterministic, thread-safe.
 std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,
                                               uint32_t cell, const RegionOptions& options,
                                               const std::vector<uint32_t>& wanted);

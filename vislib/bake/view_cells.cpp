@@ -20,6 +20,15 @@ pvs::Box to_pvs_box(const Box3& b) {
   return out;
 }
 
+std::vector<uint32_t> CellBound::triangles(uint32_t cell) const {
+  std::vector<uint32_t> out = always;
+  for (uint32_t g : cell_groups.at(cell))
+    out.insert(out.end(), group_triangles[g].begin(), group_triangles[g].end());
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 Box3 to_box3(const pvs::Box& b) {
   Box3 out;
   out.min = {b.min[0], b.min[1], b.min[2]};

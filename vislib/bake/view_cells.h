@@ -29,6 +29,22 @@
 
 namespace vislib {
 
+// A conservative bound of what each cell can see, to which its runs are restricted
+// (cell_visibility.h): cell c's runs see only triangles(c), candidates and occluders alike. Exact
+// when no triangle left out is ever a first hit from the cell's view region: removing a surface
+// that no ray from the region hits first changes no first hit (docs/quake.md). Stored as groups
+// (a BSP leaf's faces), so that a bound of many cells over many triangles stays small.
+struct CellBound {
+  // One list per cell of group indices (into group_triangles); empty: no bound (every triangle).
+  std::vector<std::vector<uint32_t>> cell_groups;
+  std::vector<std::vector<uint32_t>> group_triangles;  // triangle ids of each group
+  std::vector<uint32_t> always;                        // triangle ids kept for every cell
+  bool empty() const { return cell_groups.empty(); }
+  // The triangle ids of cell `cell` (< cell_groups.size()): the union of its groups' and
+  // `always`, sorted, unique.
+  std::vector<uint32_t> triangles(uint32_t cell) const;
+};
+
 // The cells of a bake and a JSON object (text) saying how they were placed, for the metadata of
 // the PVS file.
 struct ViewCells {
@@ -38,6 +54,8 @@ struct ViewCells {
   // the perimeters of its view region's rectangles (cell_visibility.h), for cells whose region
   // is not a box (BSP leaves: bsp_cells.h). Scene coordinates.
   std::vector<std::vector<Segment>> segments;
+  // Empty, or the triangles each cell's runs are restricted to (a static scene without spheres).
+  CellBound bound;
 };
 
 pvs::Box to_pvs_box(const Box3& b);
