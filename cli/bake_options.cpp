@@ -253,7 +253,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "A-B/K (every K-th from A), comma-separated");
   cmd->add_option("--bound", a.bound,
                   "bsp-leaves: restrict each leaf's runs to the faces of the leaves it may see: "
-                  "'portal' (our own portal flow, exact), 'map-vis' (the map's own vis, only as "
+                  "'portal' (our own portal flow), 'map-vis' (the map's own vis, only as "
                   "conservative as the map's compiler) or 'none' (docs/quake.md)")
       ->check(CLI::IsMember({"portal", "map-vis", "none"}))
       ->capture_default_str();

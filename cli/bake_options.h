@@ -35,7 +35,7 @@ struct BakeArgs {
   std::string cells;                              // --cells: "" (grid or walkable) or bsp-leaves
   double face_spacing = vislib::kBspFaceSpacing;  // --face-spacing (bsp-leaves), Quake units
   std::string leaves;                             // --leaves A-B (bsp-leaves)
-  std::string bound = "portal";                   // --bound portal|map-vis|none (bsp-leaves)
+  std::string bound = "none";                     // --bound portal|map-vis|none (bsp-leaves)
 };
 
 // Adds the options of `pvs bake` to `cmd`, storing into `a` (which must outlive `cmd`).

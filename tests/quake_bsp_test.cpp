@@ -739,27 +739,6 @@ void print(const char* map, const RayCheck& c) {
       c.missed_faces.size(), c.seconds);
 }
 
-}  // namespace
-
-// The map's own sets, held against rays: from random eyes inside every vis leaf of lqdm1 (a sealed
-// map without sky or liquids), random rays' first hits (Embree; each hit outside the set re-cast by
-// the double-precision brute-force first hit) must be triangles the engine draws from that leaf.
-// Checks the face -> triangle ids rule, the axis conversion and the leaf volumes together against
-// the compiler's conservative vis. Ambiguous re-casts (edges, grazing hits) are skipped, counted.
-// Budget: well under a second (Release).
-TEST(QuakeBspLibreQuake, Lqdm1RaysFromEveryLeafHitOnlyTrianglesTheEngineDraws) {
-  auto path = librequake("lqdm1.bsp");
-  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
-  const RayCheck c = check_rays(*path, 4, 64, 3601);
-  print("lqdm1", c);
-  EXPECT_EQ(c.leaves, 321u);
-  EXPECT_EQ(c.no_hit, 0u);  // the map is sealed
-  EXPECT_LE(c.ambiguous, c.rays / 1000);
-  for (const auto& [leaf, tri] : c.misses)
-    ADD_FAILURE() << "leaf " << leaf << " sees triangle " << tri
-                  << ", which the engine does not draw from there";
-}
-
 // The triangles of each cell leaf's portal bound in the map at `path` (bsp_cell_bound,
 // BspBound::portal), as check_rays' `allowed`.
 AllowedFn portal_bound_triangles(const std::string& path) {
@@ -772,57 +751,66 @@ AllowedFn portal_bound_triangles(const std::string& path) {
   };
 }
 
+// check_rays on lqdm1 (a sealed map without sky or liquids): every leaf, no ray leaving the map,
+// at most 1 ambiguous re-cast in 1000, no unambiguous hit outside `allowed` (`what` names it).
+void expect_lqdm1_rays(const std::string& path, uint64_t seed, const AllowedFn& allowed,
+                       const char* what) {
+  const RayCheck c = check_rays(path, 4, 64, seed, allowed);
+  print(what, c);
+  EXPECT_EQ(c.leaves, 321u);
+  EXPECT_EQ(c.no_hit, 0u);  // the map is sealed
+  EXPECT_LE(c.ambiguous, c.rays / 1000);
+  for (const auto& [leaf, tri] : c.misses)
+    ADD_FAILURE() << what << ": leaf " << leaf << " sees triangle " << tri << ", outside its set";
+}
+
+}  // namespace
+
+// The map's own sets, held against rays: from random eyes inside every vis leaf of lqdm1, random
+// rays' first hits (Embree; each hit outside the set re-cast by the double-precision brute-force
+// first hit) must be triangles the engine draws from that leaf. Checks the face -> triangle ids
+// rule, the axis conversion and the leaf volumes together against the compiler's conservative
+// vis. Ambiguous re-casts (edges, grazing hits) are skipped, counted. Budget: well under a second
+// (Release).
+TEST(QuakeBspLibreQuake, Lqdm1RaysFromEveryLeafHitOnlyTrianglesTheEngineDraws) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  expect_lqdm1_rays(*path, 3601, {}, "lqdm1");
+}
+
 // Our own portal flow, held against the same rays: every first hit from a leaf is a triangle of
-// its portal bound, so cutting the scene to the bound (the bake's restriction) changes no first hit
-// from the leaf. Budget: a few seconds (Release).
+// its portal bound, so cutting the scene to the bound (the bake's restriction) changes no first
+// hit from the leaf. Budget: a few seconds (Release).
 TEST(QuakeBspLibreQuake, Lqdm1RaysFromEveryLeafHitOnlyTrianglesOfItsPortalBound) {
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
-  const RayCheck c = check_rays(*path, 4, 64, 3605, portal_bound_triangles(*path));
-  print("lqdm1 (portal bound)", c);
-  EXPECT_EQ(c.leaves, 321u);
-  EXPECT_EQ(c.no_hit, 0u);
-  EXPECT_LE(c.ambiguous, c.rays / 1000);
-  for (const auto& [leaf, tri] : c.misses)
-    ADD_FAILURE() << "leaf " << leaf << " sees triangle " << tri << ", outside its portal bound";
+  expect_lqdm1_rays(*path, 3605, portal_bound_triangles(*path), "lqdm1 (portal bound)");
 }
 
-// The same on e1m2 and e2m3 (opt-in: VISLIB_LONG_TESTS=1; about a minute and a half here). A
-// sampled check with failure-rate thresholds: unambiguous hits the map's vis does not draw, and
-// rays that leave the map through a crack, each at most 1 in 10^4 rays. Ambiguous re-casts are
-// counted and their textures printed, not bounded: these maps hold coplanar face pairs (a face on
-// each side of a sky or liquid boundary) that Embree may take either of.
+// The same on e1m2 and e2m3, against the engine's sets and against our portal bound (opt-in:
+// VISLIB_LONG_TESTS=1; about three minutes here). A sampled check with failure-rate thresholds:
+// unambiguous hits outside the set, and rays that leave the map through a crack, each at most 1
+// in 10^4 rays. Ambiguous re-casts are counted and their textures printed, not bounded: these
+// maps hold coplanar face pairs (a face on each side of a sky or liquid boundary) that Embree may
+// take either of.
 TEST(QuakeBspLibreQuake, LongRaysFromEveryLeafOfE1m2AndE2m3) {
   VISLIB_REQUIRE_LONG_TESTS();
   for (const char* name : {"e1m2.bsp", "e2m3.bsp"}) {
     auto path = librequake(name);
     if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
-    const RayCheck c = check_rays(*path, 4, 64, 3602);
-    print(name, c);
-    EXPECT_LE(c.no_hit, c.rays / 10000) << name;
-    EXPECT_LE(c.misses.size(), c.rays / 10000) << name;
-    std::printf("%s: missed faces:", name);
-    for (uint32_t f : c.missed_faces) std::printf(" %u", f);
-    std::printf("\n%s: textures of ambiguous hits:", name);
-    for (const auto& [tex, k] : c.ambiguous_textures) std::printf(" %s %zu", tex.c_str(), k);
-    std::printf("\n");
-  }
-}
-
-// Our own portal flow on e1m2 and e2m3, held against the same rays with the same thresholds
-// (opt-in: VISLIB_LONG_TESTS=1; about a minute and a half here).
-TEST(QuakeBspLibreQuake, LongRaysFromEveryLeafOfE1m2AndE2m3HitOnlyTrianglesOfTheirPortalBound) {
-  VISLIB_REQUIRE_LONG_TESTS();
-  for (const char* name : {"e1m2.bsp", "e2m3.bsp"}) {
-    auto path = librequake(name);
-    if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
-    const RayCheck c = check_rays(*path, 4, 64, 3602, portal_bound_triangles(*path));
-    print(name, c);
-    EXPECT_LE(c.no_hit, c.rays / 10000) << name;
-    EXPECT_LE(c.misses.size(), c.rays / 10000) << name;
-    std::printf("%s: faces hit outside the portal bound:", name);
-    for (uint32_t f : c.missed_faces) std::printf(" %u", f);
-    std::printf("\n");
+    for (const bool portal : {false, true}) {
+      const std::string what = std::string(name) + (portal ? " (portal bound)" : "");
+      const RayCheck c =
+          check_rays(*path, 4, 64, 3602, portal ? portal_bound_triangles(*path) : AllowedFn{});
+      print(what.c_str(), c);
+      EXPECT_LE(c.no_hit, c.rays / 10000) << what;
+      EXPECT_LE(c.misses.size(), c.rays / 10000) << what;
+      std::printf("%s: missed faces:", what.c_str());
+      for (uint32_t f : c.missed_faces) std::printf(" %u", f);
+      std::printf("\n%s: textures of ambiguous hits:", what.c_str());
+      for (const auto& [tex, k] : c.ambiguous_textures) std::printf(" %s %zu", tex.c_str(), k);
+      std::printf("\n");
+    }
   }
 }
 
@@ -1037,9 +1025,9 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --bound all -o " + dir + "/x.pvs", &out),
             2);
   EXPECT_NE(out.find("--bound"), std::string::npos) << out;
-  // The default bound is the portal flow, recorded in the metadata.
+  // The default bound is none, recorded in the metadata.
   ASSERT_EQ(run_pvs("inspect --json " + dir + "/tiny.pvs", &out), 0) << out;
-  EXPECT_NE(out.find("\"bound\":\"portal\""), std::string::npos) << out;
+  EXPECT_NE(out.find("\"bound\": \"none\""), std::string::npos) << out;
   // --leaves: a list of A, A-B and A-B/K items; anything else exits 2 naming the option.
   for (const char* bad : {"5-", "x", "3-1", "1-4/0", "-3", "1,,2", "2 3"}) {
     EXPECT_EQ(
