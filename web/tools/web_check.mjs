@@ -150,8 +150,11 @@ async function main() {
       frames.push(rec);
     }
     let layout = null;
-    const shown = () => page.evaluate(() => ["overlay", "map", "help"].map(
-      (id) => getComputedStyle(document.getElementById(id)).display !== "none"));
+    // A page without the overlays (range.html) has nothing to lay out.
+    const shown = () => page.evaluate(() => ["overlay", "map", "help"].map((id) => {
+      const el = document.getElementById(id);
+      return el !== null && getComputedStyle(el).display !== "none";
+    }));
     if ((await shown()).every((v) => v)) {
       layout = await page.evaluate(overlayLayout);
       await page.keyboard.press("h");
