@@ -135,7 +135,7 @@ struct CheckFixture {
   std::string dir, city, pvs;
 };
 const CheckFixture& fixture() {
-  static const CheckFixture f = [] {
+  static const CheckFixture made = [] {
     CheckFixture f;
     f.dir = temp_dir("pvs_check_cli");
     f.city = f.dir + "/city.glb";
@@ -151,7 +151,7 @@ const CheckFixture& fixture() {
         << out;
     return f;
   }();
-  return f;
+  return made;
 }
 
 }  // namespace
