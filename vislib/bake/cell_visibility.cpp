@@ -82,8 +82,8 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   // The share of the progress bar the fixed groups take when rounds follow, and each round's
   // share of what is left (an estimate: rounds shrink as intervals close).
   constexpr double kFixedShare = 0.5, kRoundShare = 0.5;
-  double done_before = 0, share = adaptive ? kFixedShare / double(std::max<size_t>(1, fixed)) : 0;
-  if (!adaptive) share = 1.0 / double(std::max<size_t>(1, fixed));
+  double done_before = 0;
+  double share = (adaptive ? kFixedShare : 1.0) / double(std::max<size_t>(1, fixed));
   bool wanted = true;
   auto run_group = [&](const std::vector<Segment>& segs, size_t g) {
     const RegionOptions o = group_options(options, seed, g);
@@ -100,11 +100,9 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   std::vector<uint32_t> base;
   const uint32_t tris = uint32_t(scene.triangle_count());
   auto ids_of_run = [&](const RunRecord& r, std::vector<uint32_t>& out) {
-    std::vector<uint32_t> merged;
-    std::set_union(out.begin(), out.end(), r.visible.begin(), r.visible.end(),
-                   std::back_inserter(merged));
-    for (uint32_t sp : r.visible_spheres)
-      if (merged.empty() || merged.back() < tris + sp) merged.push_back(tris + sp);
+    std::vector<uint32_t> run = r.visible, merged;  // triangles, then spheres: sorted
+    for (uint32_t sp : r.visible_spheres) run.push_back(tris + sp);
+    std::set_union(out.begin(), out.end(), run.begin(), run.end(), std::back_inserter(merged));
     out = std::move(merged);
   };
   for (size_t g = 0; g < fixed && (wanted || adaptive); ++g) {
