@@ -188,8 +188,8 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   static const char* const kWalkableOnly[] = {"--walkable-from", "--agent-height", "--agent-radius",
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
-    for (const char* o :
-         {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor"})
+    for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
+                          "--chord-floor", "--sweep"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -224,7 +224,8 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     }
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
     o.scene = load_options_of(a.import);
-    return vislib::bsp_leaf_cells(bsp, o);
+    o.sweep = a.sweep == "portals" ? vislib::BspSweep::Portals : vislib::BspSweep::Faces;
+    return vislib::bsp_leaf_cells(bsp, o, &scene);
   }
   vislib::CellPlacement p = placement_of(a);
   if (a.walkable && ends_with_bsp(a.scene)) {
@@ -308,9 +309,16 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "'bsp-leaves': one cell per empty or liquid leaf of a Quake map's BSP tree "
                   "(docs/quake.md); default: a grid over --box or --walkable cells")
       ->check(CLI::IsMember({"bsp-leaves"}));
+  cmd->add_option("--sweep", a.sweep,
+                  "bsp-leaves: 'portals' (each portal between two leaves swept once for both, "
+                  "directions split by its plane, plus the triangles on or in each leaf) or "
+                  "'faces' (every face of each leaf's view region, walls included; docs/quake.md)")
+      ->check(CLI::IsMember({"portals", "faces"}))
+      ->capture_default_str();
   cmd->add_option("--face-spacing", a.face_spacing,
-                  "bsp-leaves: sweep each face of a leaf's view region with parallel segments at "
-                  "most this far apart (Quake units; 0 = the faces' edges only)")
+                  "bsp-leaves: sweep each swept polygon (a portal, or a face of a leaf's view "
+                  "region) with parallel segments at most this far apart (Quake units; 0 = its "
+                  "edges only)")
       ->check(in_range(0.0, 1e6))
       ->capture_default_str();
   cmd->add_option("--face-sweep", a.face_sweep,

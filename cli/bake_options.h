@@ -38,6 +38,7 @@ struct BakeArgs {
   double face_spacing = vislib::kBspFaceSpacing;  // --face-spacing (bsp-leaves), Quake units
   std::string leaves;                             // --leaves A-B (bsp-leaves)
   std::string face_sweep = "even";                // --face-sweep even|adaptive (bsp-leaves)
+  std::string sweep = "faces";                    // --sweep portals|faces (bsp-leaves)
   vislib::AdaptiveSpacing chords;                 // --chord-coarse, --chord-floor (adaptive)
   std::vector<std::string> walkable_from;         // --walkable-from x,y,z (repeatable)
   double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default

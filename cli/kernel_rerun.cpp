@@ -38,6 +38,9 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;
+  const nlohmann::json kind = find_key(md, "sweep");
+  if (kind.is_string() && kind.get<std::string>() == "portals")
+    co.sweep = vislib::BspSweep::Portals;
   ro_.segment.resolution = md["resolution"].get<int>();
   ro_.segment.near = md["near"].get<double>();
   co.near = ro_.segment.near;
@@ -54,7 +57,7 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     throw vislib::InputError(
         pvs, "metadata holds an invalid face_spacing, resolution, near, eps_len, eps_z or runs");
   try {
-    cells_ = vislib::bsp_leaf_cells(bsp, co);
+    cells_ = vislib::bsp_leaf_cells(bsp, co, &scene);
   } catch (const std::invalid_argument& e) {
     throw vislib::InputError(pvs,
                              std::string("its cells are not the map's leaf cells: ") + e.what());

@@ -1115,6 +1115,53 @@ TEST(QuakeBake, SetsHoldEveryTriangleARayFromTheRegionHitsOnAnyThreadCount) {
   }
 }
 
+// Portals: the tiny map's two leaves meet on one portal (z = 16), whose chords both cells run,
+// each with the directions that leave it (the normal points from the lower leaf, leaf 1, into the
+// upper); the bake computes each run once for both. Every ray from a region hits a triangle of
+// its cell's set (the triangles above and below are seen only through the portal or on the
+// leaf's own walls), the bytes do not depend on the thread count, and the sets are those of
+// baking each cell alone.
+TEST(QuakeBake, PortalSweepRunsEachPortalOnceForBothLeavesAndHoldsEveryRayFromTheRegions) {
+  const std::string dir = temp_dir("quake_bake_portals");
+  const std::string path = write_map(dir, "tiny.bsp", encode_bsp(tiny_map()));
+  for (BspLiquids liquids : {BspLiquids::opaque, BspLiquids::see_through}) {
+    const Scene scene = load(path, BspModels::world, liquids);
+    const QuakeBsp m = read_quake_bsp(path);
+    BspCellOptions o;
+    o.scene.bsp_liquids = liquids;
+    o.sweep = BspSweep::Portals;
+    EXPECT_THROW(bsp_leaf_cells(m, o), std::invalid_argument);  // no scene
+    const ViewCells cells = bsp_leaf_cells(m, o, &scene);
+    ASSERT_EQ(cells.segments.size(), 2u);
+    ASSERT_EQ(cells.segments[0].size(), cells.segments[1].size());
+    ASSERT_GT(cells.segments[0].size(), 4u);  // the portal's edges and chords
+    for (size_t i = 0; i < cells.segments[0].size(); ++i) {
+      const Segment &a = cells.segments[0][i], &b = cells.segments[1][i];
+      EXPECT_TRUE(a.from == b.from && a.to == b.to && a.side_normal == b.side_normal);
+      EXPECT_EQ(a.side, 0);
+      EXPECT_EQ(b.side, 1);
+      EXPECT_NEAR(dot(a.side_normal, quake_to_scene({0, 0, 1})), 1.0, 1e-12);
+      for (const Vec3& e : {a.from, a.to}) EXPECT_NEAR(scene_to_quake(e).z, 16.0, 1e-9);
+    }
+    EXPECT_EQ(nlohmann::json::parse(cells.description)["sweep"], "portals");
+    BakeSettings s;
+    s.region.segment.resolution = 32;
+    const std::string one = bake_file(scene, cells, s, dir + "/one.pvs", 1);
+    const std::string two = bake_file(scene, cells, s, dir + "/two.pvs", 2);
+    EXPECT_EQ(one, two);
+    const BakeReport report = bake(scene, cells, s, {}, {dir + "/r.pvs", dir + "/r.ckpt", false});
+    EXPECT_EQ(report.segment_runs_shared, cells.segments[0].size());
+    pvs::Reader r = pvs::Reader::from_memory(one);
+    for (uint32_t c = 0; c < 2; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, cells, c, s));
+    size_t rays = 0;
+    const auto misses = ray_misses(scene, m, cells, r, 16, 64, 3605, &rays);
+    EXPECT_GT(rays, 0u);
+    for (const auto& [c, tri] : misses)
+      ADD_FAILURE() << "cell " << c << " misses triangle " << tri << " (liquids " << int(liquids)
+                    << ")";
+  }
+}
+
 // The CLI: a .bsp baked over its leaves (inspect --at finds the leaf's cell); options that place
 // cells otherwise, or a scene that is not a map, exit 2 naming the option or the file.
 TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {

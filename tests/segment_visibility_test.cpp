@@ -367,3 +367,59 @@ TEST(RegionVisibility, EveryIdOfTheUnionHasAWitnessThatRecastsToIt) {
   }
   EXPECT_LE(ambiguous, r.visible.size() / 50 + 1);
 }
+
+// A run's directions split by a plane through the eye (SegmentOptions::side_normal): each side's
+// set is what the final lists of its pixels hold (directions classified here from the cube's own
+// axes), their union the whole run's; a run asked for one side (side_only) gives that side's set
+// and witnesses whose pixels lie on it. Without the split, a side would hold the other's ids.
+TEST(SegmentVisibility, DirectionSidesHoldWhatThePixelsOfEachSideOfThePlaneSee) {
+  const Scene s = random_soup(300, 31);
+  SegmentOptions o;
+  o.resolution = 32;
+  o.coplanar = CoplanarRule::First;  // a piece longer than eps_len is a visible stretch
+  o.orientation = random_orientation(5);
+  o.want_pieces = true;
+  const Vec3 v0{-2, 0, 0}, v1{2, 0.5, 0}, n{0.3, 1, -0.2};
+  const SegmentResult whole = segment_visibility(s, v0, v1, o);
+  std::set<uint32_t> expect[2];
+  const int N = o.resolution;
+  for (int f = 0; f < kCubeFaces; ++f)
+    for (int y = 0; y < N; ++y)
+      for (int x = 0; x < N; ++x) {
+        const Vec3 d = pixel_direction(face_axes(f, o.orientation), x, y, N);
+        for (const auto& p : whole.pieces[(size_t(f) * N + y) * N + x])
+          if (p.t1 - p.t0 > o.eps_len) expect[dot(d, n) >= 0 ? 0 : 1].insert(p.id);
+      }
+  ASSERT_FALSE(expect[0].empty());
+  ASSERT_FALSE(expect[1].empty());
+  o.side_normal = n;
+  const SegmentResult split = segment_visibility(s, v0, v1, o);
+  ASSERT_EQ(split.visible_sides.size(), 2u);
+  EXPECT_EQ(split.visible, whole.visible);
+  EXPECT_TRUE(same_lists(split.pieces, whole.pieces));
+  std::vector<uint32_t> only_0, only_1;
+  for (int side = 0; side < 2; ++side) {
+    EXPECT_EQ(split.visible_sides[size_t(side)],
+              std::vector<uint32_t>(expect[side].begin(), expect[side].end()))
+        << "side " << side;
+    SegmentOptions one = o;
+    one.want_pieces = false;
+    one.side_only = side;
+    one.want_witnesses = true;
+    const SegmentResult r = segment_visibility(s, v0, v1, one);
+    EXPECT_EQ(r.visible, split.visible_sides[size_t(side)]) << "side " << side;
+    ASSERT_EQ(r.witnesses.size(), r.visible.size());
+    for (const Witness& w : r.witnesses) {
+      const Vec3 d = pixel_direction(face_axes(w.face, o.orientation), w.x, w.y, N);
+      EXPECT_EQ(dot(d, n) >= 0, side == 0) << "witness of " << w.tri;
+    }
+  }
+  // The sides differ (the soup lies all around the segment), so the split is not a copy.
+  EXPECT_NE(split.visible_sides[0], split.visible_sides[1]);
+  SegmentOptions bad = o;
+  bad.want_witnesses = true;  // both sides: no witnesses
+  EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
+  bad = o;
+  bad.splits = {0.5};
+  EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
+}

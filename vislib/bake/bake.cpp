@@ -104,7 +104,8 @@ std::vector<SegmentEnds> all_edges(const ViewCells& cells) {
   std::vector<SegmentEnds> all;
   for (uint32_t c = 0; c < cells.layout.cell_count(); ++c)
     for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
-      for (const Segment& s : g) all.emplace_back(s.from, s.to);
+      for (const Segment& s : g)
+        if (s.side_normal == Vec3{0, 0, 0}) all.emplace_back(s.from, s.to);  // a portal's: no chain
   return all;
 }
 
@@ -166,8 +167,9 @@ BakeSettings resolved_settings(const Scene& scene, const ViewCells& cells,
   // --long-segments auto: L from a pilot over every cell of the layout (not only this shard's),
   // so that every shard and every resumed run chooses the same L (long_segments.h).
   BakeSettings settings = requested;
-  if (!cells.segments.empty()) {  // a cell's own segments are not shared with another's
-    settings.share_segments = false;
+  if (!cells.segments.empty()) {  // no chains of a cell's own segments
+    // A cell's own segments are shared with another's only when they are a portal's.
+    settings.share_segments = settings.share_segments && cells.shared_runs;
     settings.long_segments = 1;
   }
   if (settings.long_segments == 0) {
@@ -217,7 +219,7 @@ void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const Vi
   for (uint32_t c = 0; c < n; ++c) {
     if (!in_shard(c, shard) || recovered[c]) continue;
     for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
-      for (const Segment& s : g) shared_runs.expect(s.from, s.to);
+      for (const Segment& s : g) shared_runs.expect(s.from, s.to, s.side_normal);
   }
   // The pilot's runs of the chosen L are runs of this bake: not computed again.
   for (LongSegmentChoice::Run& run : report.long_segment_choice.runs)

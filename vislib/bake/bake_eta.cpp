@@ -1,29 +1,16 @@
 // bake_eta.cpp: the expected work of the cells of a bake and the ETA it gives (bake_eta.h).
 #include "vislib/bake/bake_eta.h"
 
-#include <array>
 #include <cassert>
 #include <cmath>
-#include <cstring>
 #include <set>
 
 #include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/kernel/region_visibility.h"
+#include "vislib/kernel/segment_run_cache.h"
 
 namespace vislib {
-
-namespace {
-
-// The bits of a segment's end points: shared runs match them exactly (segment_run_cache.h).
-std::array<uint64_t, 6> key_of(const Segment& s) {
-  const double v[6] = {s.from.x, s.from.y, s.from.z, s.to.x, s.to.y, s.to.z};
-  std::array<uint64_t, 6> k;
-  std::memcpy(k.data(), v, sizeof v);
-  return k;
-}
-
-}  // namespace
 
 std::vector<double> expected_cell_work(const pvs::CellLayout& layout,
                                        const std::vector<uint8_t>& bake, int runs,
@@ -58,12 +45,14 @@ std::vector<double> expected_cell_work(const std::vector<std::vector<Segment>>& 
   const double mean = total / double(count);
   const double fixed = kRunFixedEdges * mean;
   const double unit = mean + fixed;
-  std::set<std::array<uint64_t, 6>> computed;  // run 0 of these segments is counted already
+  std::set<SegmentRunCache::Key> computed;  // run 0 of these segments is counted already
   for (size_t c = 0; c < n; ++c) {
     if (!bake[c]) continue;
     for (const Segment& s : segments[c]) {
       const double run = (length(s.to - s.from) + fixed) / unit;
-      const bool first = !share_segments || computed.insert(key_of(s)).second;
+      const bool first =
+          !share_segments ||
+          computed.insert(SegmentRunCache::key_of(s.from, s.to, s.side_normal)).second;
       work[c] += run * double(runs - 1 + (first ? 1 : 0));
     }
   }

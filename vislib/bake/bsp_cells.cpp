@@ -10,107 +10,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "vislib/bake/bsp_portals.h"
 #include "vislib/scene/quake_bsp_volumes.h"
 
 namespace vislib {
 
 namespace {
-
-// Two faces of BSP leaf volumes (Quake units) lie on one plane, facing each other, when their
-// unit normals are opposite to within this (1 + dot of the normals) and each vertex of one is
-// within kBspFaceCoplanarDistance of the other's plane (vislib/bake/bsp_cells.h). The volumes
-// come from the same float planes, so a shared face agrees to about 1e-12 units.
-constexpr double kBspFaceOppositeNormals = 1e-9;
-constexpr double kBspFaceCoplanarDistance = 1e-6;
-// Two leaf volumes are neighbours when their shared face has at least this area (square Quake
-// units; a real portal is at least about 1).
-constexpr double kBspPortalMinArea = 1e-3;
-
-// A face of a leaf volume with its plane: unit outward normal and offset (dot(n, p) = offset).
-struct PlanarFace {
-  const std::vector<Vec3>* poly;
-  Vec3 normal;
-  double offset;
-};
-
-PlanarFace planar(const std::vector<Vec3>& poly) {
-  Vec3 n{0, 0, 0};  // Newell's normal: exact direction for a planar polygon
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const Vec3& a = poly[i];
-    const Vec3& b = poly[(i + 1) % poly.size()];
-    n.x += (a.y - b.y) * (a.z + b.z);
-    n.y += (a.z - b.z) * (a.x + b.x);
-    n.z += (a.x - b.x) * (a.y + b.y);
-  }
-  n = n * (1.0 / length(n));
-  return {&poly, n, dot(n, poly[0])};
-}
-
-using P2 = std::array<double, 2>;
-
-double signed_area(const std::vector<P2>& p) {
-  double a = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    const P2& u = p[i];
-    const P2& v = p[(i + 1) % p.size()];
-    a += u[0] * v[1] - v[0] * u[1];
-  }
-  return 0.5 * a;
-}
-
-// Area of the intersection of two convex polygons, both counter-clockwise (Sutherland-Hodgman).
-double overlap_area(std::vector<P2> a, const std::vector<P2>& b) {
-  for (size_t i = 0; i < b.size() && a.size() >= 3; ++i) {
-    const P2& p = b[i];
-    const P2& q = b[(i + 1) % b.size()];
-    auto side = [&](const P2& x) {
-      return (q[0] - p[0]) * (x[1] - p[1]) - (q[1] - p[1]) * (x[0] - p[0]);
-    };
-    std::vector<P2> out;
-    for (size_t k = 0; k < a.size(); ++k) {
-      const P2& u = a[k];
-      const P2& v = a[(k + 1) % a.size()];
-      double su = side(u), sv = side(v);
-      if (su >= 0) out.push_back(u);
-      if ((su >= 0) != (sv >= 0)) {
-        double t = su / (su - sv);
-        out.push_back({u[0] + (v[0] - u[0]) * t, u[1] + (v[1] - u[1]) * t});
-      }
-    }
-    a = std::move(out);
-  }
-  return a.size() >= 3 ? signed_area(a) : 0.0;
-}
-
-// The polygon projected on the two axes other than `drop`, counter-clockwise.
-std::vector<P2> project(const std::vector<Vec3>& poly, int drop) {
-  const int u = drop == 0 ? 1 : 0, v = drop == 2 ? 1 : 2;
-  std::vector<P2> out;
-  for (const Vec3& p : poly) out.push_back({p[u], p[v]});
-  if (signed_area(out) < 0) std::reverse(out.begin(), out.end());
-  return out;
-}
-
-// True if a face of `a` and a face of `b` lie on one plane facing each other and overlap with
-// positive area (kBspPortalMinArea).
-bool share_face(const std::vector<PlanarFace>& a, const std::vector<PlanarFace>& b) {
-  for (const PlanarFace& fa : a)
-    for (const PlanarFace& fb : b) {
-      if (1.0 + dot(fa.normal, fb.normal) > kBspFaceOppositeNormals) continue;
-      bool coplanar = true;
-      for (const Vec3& v : *fb.poly)
-        coplanar = coplanar && std::fabs(dot(fa.normal, v) - fa.offset) <= kBspFaceCoplanarDistance;
-      if (!coplanar) continue;
-      int drop = 0;
-      for (int k = 1; k < 3; ++k)
-        if (std::fabs(fa.normal[k]) > std::fabs(fa.normal[drop])) drop = k;
-      // The projected area shrinks by |n[drop]| (at least 1/sqrt(3)); undo that.
-      double area = overlap_area(project(*fa.poly, drop), project(*fb.poly, drop)) /
-                    std::fabs(fa.normal[drop]);
-      if (area >= kBspPortalMinArea) return true;
-    }
-  return false;
-}
 
 // Segment end points closer than this (Quake units) are one point: an edge of two faces of one
 // polytope is computed once per face and agrees to about 1e-12 units; shorter segments are dropped.
@@ -126,9 +31,9 @@ std::vector<FaceSweep> region_sweeps(const ConvexPolytope& region) {
   std::vector<FaceSweep> out;
   for (const std::vector<Vec3>& f : region.faces) {
     if (f.size() < 3) continue;
-    const PlanarFace pf = planar(f);
-    if (!std::isfinite(pf.normal.x)) continue;
-    if (auto s = face_sweep_of(f, pf.normal, kBspSameEndpoint)) out.push_back(std::move(*s));
+    const Vec3 n = polygon_normal(f);
+    if (!std::isfinite(n.x)) continue;
+    if (auto s = face_sweep_of(f, n, kBspSameEndpoint)) out.push_back(std::move(*s));
   }
   return out;
 }
@@ -139,14 +44,6 @@ FaceSweep scene_sweep(FaceSweep s) {
   s.along = quake_to_scene(s.along);
   s.across = quake_to_scene(s.across);
   return s;
-}
-
-bool boxes_touch(const Box3& a, const Box3& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.min[k] > b.max[k] + kBspFaceCoplanarDistance ||
-        b.min[k] > a.max[k] + kBspFaceCoplanarDistance)
-      return false;
-  return true;
 }
 
 }  // namespace
@@ -220,12 +117,10 @@ pvs::CellLayout bsp_leaf_layout(const QuakeBsp& bsp, const std::vector<uint32_t>
   // Each cell's volume: its leaf's pieces (one for a leaf reached once).
   const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(bsp);
   const size_t C = cell_leaves.size();
-  std::vector<std::vector<PlanarFace>> faces(C);
   std::vector<Box3> bounds(C);
   for (const BspLeafPiece& piece : pieces) {
     uint32_t c = L.leaf_cell[piece.leaf];
     if (c == pvs::kNoCell || piece.volume.empty()) continue;
-    for (const auto& f : piece.volume.faces) faces[c].push_back(planar(f));
     Box3 b = piece.volume.bounds();
     bounds[c].extend(b.min);
     bounds[c].extend(b.max);
@@ -240,12 +135,11 @@ pvs::CellLayout bsp_leaf_layout(const QuakeBsp& bsp, const std::vector<uint32_t>
     L.boxes[c] = {{q.min.x, q.min.z, -q.max.y}, {q.max.x, q.max.z, -q.min.y}};
   }
   L.neighbours.assign(C, {});
-  for (size_t a = 0; a < C; ++a)
-    for (size_t b = a + 1; b < C; ++b)
-      if (boxes_touch(bounds[a], bounds[b]) && share_face(faces[a], faces[b])) {
-        L.neighbours[a].push_back(uint32_t(b));
-        L.neighbours[b].push_back(uint32_t(a));
-      }
+  for (const BspPortal& p : bsp_leaf_portals(pieces, cell_leaves)) {
+    const uint32_t a = L.leaf_cell[p.leaves[0]], b = L.leaf_cell[p.leaves[1]];
+    L.neighbours[a].push_back(b);
+    L.neighbours[b].push_back(a);
+  }
   return L;  // neighbours sorted: a's list gets b in increasing order, and earlier a's first
 }
 
@@ -271,8 +165,77 @@ std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double sp
   return out;
 }
 
-ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
+namespace {
+
+// The vertex mean of a convex polytope's faces (a point inside it).
+Vec3 polytope_centre(const ConvexPolytope& p) {
+  Vec3 c{0, 0, 0};
+  size_t n = 0;
+  for (const std::vector<Vec3>& f : p.faces)
+    for (const Vec3& v : f) {
+      c = c + v;
+      ++n;
+    }
+  return c * (1.0 / double(std::max<size_t>(n, 1)));
+}
+
+// The portal runs of the cells (BspSweep::Portals, bsp_leaf_cells): each portal's edges and
+// chords, or its sweep, for each of its two leaves that is a cell of `cells`, with the leaf's side.
+void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<uint32_t>& all,
+                     const BspCellOptions& options, const Scene& scene, ViewCells& cells) {
+  // Each leaf's volume, when it is one piece (a leaf of several keeps no clearance from its
+  // planes: its portals are swept whole on its side).
+  std::vector<const ConvexPolytope*> volume(cells.layout.leaf_cell.size(), nullptr);
+  std::vector<uint8_t> pieces_of(volume.size(), 0);
+  for (const BspLeafPiece& piece : pieces)
+    if (!piece.volume.empty() && piece.leaf < volume.size()) {
+      volume[piece.leaf] = &piece.volume;
+      pieces_of[piece.leaf] = uint8_t(std::min(2, pieces_of[piece.leaf] + 1));
+    }
+  const ConvexPolytope none;
+  const double clearance = kNearClearanceFactor * options.near;
+  for (const BspPortal& p : bsp_leaf_portals(pieces, all)) {
+    if (bsp_portal_covered(p, scene)) continue;  // closed: each side sees the surface only
+    auto side_volume = [&](int s) -> const ConvexPolytope& {
+      const uint32_t l = p.leaves[s];
+      return pieces_of[l] == 1 ? *volume[l] : none;
+    };
+    const std::vector<Vec3> clear =
+        bsp_portal_clear_part(p, side_volume(0), side_volume(1), clearance);
+    if (clear.empty()) continue;  // nothing of it is clear of the walls: only they are seen
+    std::vector<Segment> segs;    // Quake coordinates
+    for (size_t i = 0; i < clear.size(); ++i) {
+      const Vec3 a = clear[i], b = clear[(i + 1) % clear.size()];
+      if (length(b - a) > kBspSameEndpoint) segs.push_back({a, b});
+    }
+    const std::optional<FaceSweep> sweep = face_sweep_of(clear, p.normal, kBspSameEndpoint);
+    if (sweep && !options.adaptive && options.face_spacing > 0) {
+      const std::vector<Segment> c = even_chords(*sweep, options.face_spacing, kBspSameEndpoint);
+      segs.insert(segs.end(), c.begin(), c.end());
+    }
+    const Vec3 normal = quake_to_scene(p.normal);
+    for (int side = 0; side < 2; ++side) {
+      const uint32_t c = cells.layout.leaf_cell[p.leaves[side]];
+      if (c == pvs::kNoCell) continue;  // a leaf not baked
+      for (const Segment& s : segs)
+        cells.segments[c].push_back({quake_to_scene(s.from), quake_to_scene(s.to), normal, side});
+      if (sweep && options.adaptive) {
+        FaceSweep f = scene_sweep(*sweep);
+        f.side_normal = normal;
+        f.side = side;
+        cells.sweeps[c].push_back(std::move(f));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, const Scene* scene) {
   assert(options.face_spacing >= 0);
+  const bool portals = options.sweep == BspSweep::Portals;
+  if (portals && !scene)
+    throw std::invalid_argument("bsp_leaf_cells: a portal sweep needs the map's scene");
   const std::vector<uint32_t> all = bsp_cell_leaves(bsp);
   std::vector<uint32_t> leaves = options.leaves.empty() ? all : options.leaves;
   for (size_t i = 0; i < leaves.size(); ++i)
@@ -283,9 +246,17 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
   ViewCells cells;
   cells.layout = bsp_leaf_layout(bsp, leaves);
   cells.segments.resize(leaves.size());
+  if (options.adaptive) cells.sweeps.resize(leaves.size());
   uint32_t thin = 0, uninset = 0, clipped = 0;
   std::vector<double> near_limit(leaves.size(), std::numeric_limits<double>::infinity());
-  for (const BspLeafPiece& piece : bsp_leaf_pieces(bsp)) {
+  const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(bsp);
+  if (portals) {
+    add_portal_runs(pieces, all, options, *scene, cells);
+    cells.own.resize(leaves.size());
+    cells.regions.resize(leaves.size());
+    cells.shared_runs = true;
+  }
+  for (const BspLeafPiece& piece : pieces) {
     const uint32_t c = cells.layout.leaf_cell[piece.leaf];
     if (c == pvs::kNoCell || piece.volume.empty()) continue;
     const BspViewRegion region = bsp_leaf_view_region(piece.volume, options.near);
@@ -295,14 +266,27 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
       ++clipped;
       near_limit[c] = std::min(near_limit[c], region.near_limit);
     }
+    if (portals) {
+      const Vec3 eye = quake_to_scene(polytope_centre(region.volume));
+      if (cells.regions[c].empty()) cells.regions[c] = polytope_to_scene(region.volume);
+      std::vector<ViewCells::OwnTriangle>& own = cells.own[c];
+      for (const VolumeTriangle& t : bsp_volume_triangles(*scene, polytope_to_scene(piece.volume)))
+        own.push_back({t.tri, eye, (t.point - eye) * (1.0 / length(t.point - eye))});
+      continue;
+    }
     std::vector<Segment> s =
         bsp_region_segments(region.volume, options.adaptive ? 0.0 : options.face_spacing);
     cells.segments[c].insert(cells.segments[c].end(), s.begin(), s.end());
-    if (options.adaptive) {
-      cells.sweeps.resize(leaves.size());
+    if (options.adaptive)
       for (const FaceSweep& f : region_sweeps(region.volume))
         cells.sweeps[c].push_back(scene_sweep(f));
-    }
+  }
+  for (std::vector<ViewCells::OwnTriangle>& own : cells.own) {  // a leaf of several pieces
+    std::stable_sort(own.begin(), own.end(),
+                     [](const auto& a, const auto& b) { return a.tri < b.tri; });
+    own.erase(std::unique(own.begin(), own.end(),
+                          [](const auto& a, const auto& b) { return a.tri == b.tri; }),
+              own.end());
   }
   if (options.adaptive) cells.sweep_spacing = *options.adaptive;
   if (clipped > 0) cells.near_limit = std::move(near_limit);
@@ -315,12 +299,15 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options) {
       {"leaf_subset", !options.leaves.empty()},
       {"face_spacing", options.face_spacing},
       {"face_sweep", options.adaptive ? "adaptive" : "even"},
+      {"sweep", portals ? "portals" : "faces"},
       {"face_spacing_units", "quake"},
       {"region",
        "leaf volume inset by inset units (halved down to the larger of min_inset and "
        "clearance for thin leaves, then clearance; a leaf thinner than twice the clearance by "
-       "half its largest inset, its near distance clipped to that over clearance_factor); its "
-       "edges and chords of each face parallel to its longest edge at most face_spacing apart"},
+       "half its largest inset, its near distance clipped to that over clearance_factor); "
+       "sweep faces: its edges and chords of each face parallel to its longest edge at most "
+       "face_spacing apart; sweep portals: each portal's edges and chords, directions leaving "
+       "the leaf, and the triangles on or in the leaf's volume"},
       {"inset", kBspLeafInset},
       {"min_inset", kBspLeafMinInset},
       {"clearance_factor", kNearClearanceFactor},

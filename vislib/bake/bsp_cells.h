@@ -53,8 +53,19 @@ constexpr double kBspFaceSpacing = 16.0;
 // narrower than 1e-6 units) give no segment. Deterministic.
 std::vector<Segment> bsp_region_segments(const ConvexPolytope& region, double spacing);
 
+// What a leaf's runs sweep (docs/quake.md "Portals"):
+//  Portals: the portals between leaves (bsp_portals.h), each swept once for its two leaves, a run's
+//    directions split by the portal's plane (Segment::side_normal): each leaf takes the directions
+//    that leave it; plus the triangles on or in the leaf's volume (ViewCells::own). The runs keep
+//    the bake's near distance, so that the two leaves share them (near_limit bounds the eyes'
+//    near only).
+//  Faces: every face of the leaf's view region, walls included, in every direction.
+enum class BspSweep { Portals, Faces };
+
 struct BspCellOptions {
-  double face_spacing = kBspFaceSpacing;  // bsp_region_segments' spacing, >= 0 (0: edges only)
+  // The spacing of the chords across each swept polygon (a portal, or a face of the view region),
+  // >= 0 (0: its edges only).
+  double face_spacing = kBspFaceSpacing;
   // The leaves to bake, a subset of bsp_cell_leaves (increasing); empty: all of them.
   std::vector<uint32_t> leaves;
   // The import options the scene was loaded with (bsp_models, bsp_liquids), recorded in the
@@ -67,16 +78,25 @@ struct BspCellOptions {
   // The bake's near distance (Quake units, > 0): each view region keeps its eyes clear of the
   // leaf's surfaces by kNearClearanceFactor times it (bsp_leaf_view_region).
   double near = kDefaultNear;
+  BspSweep sweep = BspSweep::Faces;
 };
 
 // The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
-// bsp_region_segments(bsp_leaf_view_region(volume of its leaf, near), face_spacing), the cells'
+// (BspSweep::Faces) bsp_region_segments(bsp_leaf_view_region(volume of its leaf, near),
+// face_spacing), or (BspSweep::Portals) for each portal of its leaf in bsp_leaf_portals order
+// (among all of bsp_cell_leaves, whichever are baked) the polygon's edges and, with face_spacing >
+// 0 and no adaptive sweep, its even chords (face_sweep.h), all in scene coordinates with the
+// portal's normal and the leaf's side; with an adaptive sweep, the portal's FaceSweep; and
+// ViewCells::own from bsp_volume_triangles of its volume, each with a witness eye at the vertex
+// mean of the view region. Portals need `scene`, the map as loaded with options.scene
+// (std::invalid_argument without it). The cells'
 // near_limit (only when some leaf's region clips the near distance), and a description (JSON)
 // recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
 // kBspLeafMinInset, the clearance, the counts of leaves inset less than kBspLeafInset, not inset
 // and with a clipped near distance) and the scene options.
 // Throws std::invalid_argument for leaves that are not an increasing subset of bsp_cell_leaves.
 // Deterministic.
-ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options);
+ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options,
+                         const Scene* scene = nullptr);
 
 }  // namespace vislib

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <iterator>
+#include <optional>
 
 #include "vislib/bake/face_sweep.h"
 #include "vislib/base/cubemap.h"
@@ -53,10 +55,11 @@ RegionOptions group_options(const RegionOptions& options, uint64_t cell_seed, si
   return o;
 }
 
-// `options` for cell `cell` of `cells`: its near distance clipped to the cell's near_limit.
+// `options` for cell `cell` of `cells`: its near distance clipped to the cell's near_limit, unless
+// the runs are shared between cells (ViewCells::shared_runs: not eyes of this cell).
 RegionOptions cell_options(const ViewCells& cells, uint32_t cell, const RegionOptions& options) {
   RegionOptions o = options;
-  if (!cells.near_limit.empty())
+  if (!cells.near_limit.empty() && !cells.shared_runs)
     o.segment.near = std::min(o.segment.near, cells.near_limit.at(cell));
   return o;
 }
@@ -122,6 +125,23 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
                  });
 }
 
+// The middle of the points q - s d (s >= 0) inside `region`, if any.
+std::optional<Vec3> back_into(const ConvexPolytope& region, Vec3 q, Vec3 d) {
+  double lo = 0, hi = INFINITY;
+  for (const HalfSpace& h : region.halfspaces) {
+    // dot(n, q - s d) <= offset  <=>  -s dot(n, d) <= offset - dot(n, q)
+    const double a = -dot(h.normal, d), b = h.offset - dot(h.normal, q);
+    if (a > 0)
+      hi = std::min(hi, b / a);
+    else if (a < 0)
+      lo = std::max(lo, b / a);
+    else if (b < 0)
+      return std::nullopt;
+  }
+  if (!(lo < hi) || !std::isfinite(hi)) return std::nullopt;
+  return q - d * (0.5 * (lo + hi));
+}
+
 // The union of the cell's groups (run_cell_groups).
 CellVisibility groups_visibility(const Scene& scene, const ViewCells* cells,
                                  const std::vector<std::vector<Segment>>& groups, uint32_t cell,
@@ -171,8 +191,16 @@ CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout
 CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint32_t cell,
                                const RegionOptions& options,
                                const std::function<void(double)>& progress) {
-  return groups_visibility(scene, &cells, cell_segment_groups(cells, cell), cell,
-                           cell_options(cells, cell, options), progress);
+  CellVisibility v = groups_visibility(scene, &cells, cell_segment_groups(cells, cell), cell,
+                                       cell_options(cells, cell, options), progress);
+  if (!cells.own.empty() && !cells.own.at(cell).empty()) {
+    std::vector<uint32_t> own, merged;
+    for (const ViewCells::OwnTriangle& t : cells.own[cell]) own.push_back(t.tri);
+    std::set_union(v.triangles.begin(), v.triangles.end(), own.begin(), own.end(),
+                   std::back_inserter(merged));
+    v.triangles = std::move(merged);
+  }
+  return v;
 }
 
 std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,
@@ -185,6 +213,24 @@ std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCell
   std::vector<CellWitnessRay> out;
   std::vector<uint8_t> found(wanted.size(), 0);
   size_t left = wanted.size(), first_segment = 0;
+  if (!cells.own.empty())  // the cell's own triangles: their ray from the view region
+    for (const ViewCells::OwnTriangle& t : cells.own.at(cell)) {
+      const auto it = std::lower_bound(wanted.begin(), wanted.end(), t.tri);
+      if (it == wanted.end() || *it != t.tri) continue;
+      found[size_t(it - wanted.begin())] = 1;
+      --left;
+      CellWitnessRay w;
+      w.tri = t.tri;
+      w.eye = t.eye;
+      w.dir = t.dir;
+      w.segment = kOwnTriangleSegment;
+      out.push_back(w);
+    }
+  if (left == 0) {
+    std::sort(out.begin(), out.end(),
+              [](const CellWitnessRay& a, const CellWitnessRay& b) { return a.tri < b.tri; });
+    return out;
+  }
   run_cell_groups(
       scene, &cells, cell_segment_groups(cells, cell), cell, with_witnesses, {},
       [&](const std::vector<Segment>& segs, const RegionResult& rr, const RegionOptions& o) {
@@ -198,8 +244,19 @@ std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCell
           const Segment& s = segs[w.segment];
           const Mat3& R = rr.runs[w.segment * size_t(o.runs) + size_t(w.run)].orientation;
           const Vec3 d = pixel_direction(face_axes(w.witness.face, R), w.witness.x, w.witness.y, n);
-          out.push_back({rr.visible[i], s.from + (s.to - s.from) * w.witness.t,
-                         d * (1.0 / length(d)), first_segment + w.segment, w.run, w.witness.t});
+          Vec3 eye = s.from + (s.to - s.from) * w.witness.t;
+          if (!cells.regions.empty() && !cells.regions.at(cell).empty()) {
+            // A shared run's eye lies on the region's boundary: back along the ray into the region.
+            const std::optional<Vec3> inside = back_into(cells.regions[cell], eye, d);
+            if (!inside) {  // the ray does not pass through the region: no witness of the cell
+              found[size_t(it - wanted.begin())] = 0;
+              ++left;
+              continue;
+            }
+            eye = *inside;
+          }
+          out.push_back({rr.visible[i], eye, d * (1.0 / length(d)), first_segment + w.segment,
+                         w.run, w.witness.t});
         }
         first_segment += segs.size();
         return left > 0;

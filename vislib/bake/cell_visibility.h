@@ -3,8 +3,8 @@
 // A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeter of
 // the view region's bottom and top rectangles (the paper's perimeter heuristic, §4.1, applied at
 // the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell; or, for
-// cells that carry their own segments (ViewCells::segments: a BSP leaf's faces swept,
-// bsp_cells.h), the union of runs on those.
+// cells that carry their own segments (ViewCells::segments: a BSP leaf's faces or portals swept,
+// bsp_cells.h), the union of runs on those and of the cell's own triangles (ViewCells::own).
 #pragma once
 
 #include <cstdint>
@@ -64,7 +64,9 @@ CellVisibility cell_visibility(const Scene& scene, const ViewCells& cells, uint3
 
 // A witness of a cell's visible set as one ray: the triangle, the eye on the cell's segment
 // (segment: index into the concatenated groups of cell_segment_groups; t along it) and the unit
-// direction through the centre of the witness pixel of the run that saw it (scene coordinates).
+// direction through the centre of the witness pixel of the run that saw it (scene coordinates);
+// for a triangle of ViewCells::own, its ray, with segment kOwnTriangleSegment.
+constexpr size_t kOwnTriangleSegment = size_t(-1);
 struct CellWitnessRay {
   uint32_t tri = 0;
   Vec3 eye, dir;
@@ -75,9 +77,10 @@ struct CellWitnessRay {
 
 // Re-runs cell `cell`'s from-segment runs as cell_visibility does (the same segment groups, seeds,
 // orientations and options) with witnesses (segment_visibility.h), and returns the witness rays
-// of those of `wanted` (sorted triangle ids) that a run sees, in increasing id; an id no run sees
-// has none. Group by group, stopping once every wanted id has one, so the cost is at most that of
-// cell_visibility with witnesses. options.shared_runs must be null. Deterministic, thread-safe.
+// of those of `wanted` (sorted triangle ids) that a run sees, or that are the cell's own
+// (ViewCells::own), in increasing id; an id no run sees has none. Group by group, stopping once
+// every wanted id has one, so the cost is at most that of cell_visibility with witnesses.
+// options.shared_runs must be null. Deterministic, thread-safe.
 std::vector<CellWitnessRay> cell_witness_rays(const Scene& scene, const ViewCells& cells,
                                               uint32_t cell, const RegionOptions& options,
                                               const std::vector<uint32_t>& wanted);

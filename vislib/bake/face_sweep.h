@@ -26,6 +26,9 @@ struct FaceSweep {
   std::vector<Vec3> face;
   Vec3 along, across;
   double lo = 0, hi = 0;
+  // The directions its chords count (Segment::side_normal and side; zero: all): a portal's.
+  Vec3 side_normal{0, 0, 0};
+  int side = 0;
 };
 
 // Chords shorter than this (scene units) are points and are not run (a chord at a face's vertex);
@@ -39,8 +42,8 @@ std::optional<FaceSweep> face_sweep_of(const std::vector<Vec3>& face, Vec3 norma
                                        double min_length);
 
 // The chord of `sweep` at h (lo <= h <= hi): from the face's boundary point with the smallest to
-// the one with the largest coordinate along the chords. Nothing when it is shorter than
-// `min_length` (at a vertex of the face, say).
+// the one with the largest coordinate along the chords, with the sweep's side_normal and side.
+// Nothing when it is shorter than `min_length` (at a vertex of the face, say).
 std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_length);
 
 // The even sweep: chords at h = lo + k (hi - lo) / n, k = 1 .. n - 1, with n = ceil((hi - lo) /

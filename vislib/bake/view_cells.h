@@ -27,6 +27,7 @@
 #include "vislib/bake/face_sweep.h"
 #include "vislib/bake/walkable_reach.h"
 #include "vislib/kernel/region_visibility.h"
+#include "vislib/scene/quake_bsp_volumes.h"
 #include "vislib/scene/scene.h"
 
 namespace vislib {
@@ -49,6 +50,21 @@ struct ViewCells {
   // segments, which then hold the region's edges (cell_visibility.h).
   std::vector<std::vector<FaceSweep>> sweeps;
   AdaptiveSpacing sweep_spacing;
+  // Empty, or one list per cell (increasing ids): triangles the cell's eyes see without its runs,
+  // united into its set (a BSP leaf's own boundary and contents when its runs sweep its portals:
+  // bsp_cells.h), each with a witness ray from a point of the view region.
+  struct OwnTriangle {
+    uint32_t tri = 0;
+    Vec3 eye, dir;  // scene coordinates; dir a unit vector
+  };
+  std::vector<std::vector<OwnTriangle>> own;
+  // The cells' runs are shared between cells (a portal's, whose directions are split between its
+  // two leaves): they keep the bake's near distance, and near_limit bounds the eyes' near only.
+  bool shared_runs = false;
+  // Empty, or one per cell: its view region (scene coordinates) when its runs lie outside it (a
+  // portal's): a run's witness, an eye on the portal, is moved back along its ray into the
+  // region, so that it is a ray from an eye of the cell (cell_witness_rays).
+  std::vector<ConvexPolytope> regions;
 };
 
 pvs::Box to_pvs_box(const Box3& b);

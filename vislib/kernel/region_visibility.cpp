@@ -69,13 +69,17 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       so.orientation = run_orientation(options.seed, s, k);
       so.want_pieces = false;
       const Segment& seg = result.segments[s];
+      const bool sided = !(seg.side_normal == Vec3{0, 0, 0});
+      so.side_normal = seg.side_normal;
+      so.side_only = witnesses && sided ? seg.side : -1;
       SegmentResult sr;
       bool computed = true;
       // Phases for a caller that times them (phase_times.h): a run computed here, or one another
       // thread computes (whose tiles this thread joins while it waits).
-      // A planned long segment keeps no witnesses per part: such regions compute their own.
+      // A planned long segment keeps no witnesses per part, nor a run split by a plane one per
+      // side: such regions compute their own.
       if (options.shared_runs && k == 0 &&
-          !(witnesses && options.shared_runs->chains_planned() > 0)) {
+          !(witnesses && (sided || options.shared_runs->chains_planned() > 0))) {
         PhaseScope waiting(Phase::SharedWait);
         auto shared = options.shared_runs->get(
             seg.from, seg.to,
@@ -85,13 +89,14 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
               o.splits = splits;
               return segment_visibility(scene, a, b, o);
             },
-            &computed);
+            &computed, seg.side_normal);
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;
       } else {
         PhaseScope running(Phase::Run);
         sr = segment_visibility(scene, seg.from, seg.to, so);
       }
+      if (sided && !witnesses) sr.visible = std::move(sr.visible_sides.at(size_t(seg.side)));
       PhaseScope merging(Phase::Merge);
       if (witnesses) {
         // sr.witnesses: one per visible triangle (id order), then one per visible sphere.

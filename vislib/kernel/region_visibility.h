@@ -18,8 +18,15 @@ namespace vislib {
 
 enum class Granularity { Triangle, Object };
 
+// A segment of eyes. With `side_normal` not zero, only the directions on side `side` of the plane
+// through the eye with that normal count (SegmentOptions::side_normal: side 0 is dot(d, n) >= 0,
+// side 1 is dot(d, n) <= 0): a portal's chord, whose run serves the leaves on both sides
+// (docs/quake.md "Portals"). Its runs are computed with both sides split, so that the shared run
+// cache hands one run to both; with witnesses, with the one side.
 struct Segment {
   Vec3 from, to;
+  Vec3 side_normal{0, 0, 0};
+  int side = 0;
 };
 
 // Perimeter segments of `box` (min <= max on every axis), in a fixed documented order: edges

@@ -9,8 +9,9 @@
 
 namespace vislib {
 
-SegmentRunCache::Key SegmentRunCache::key_of(Vec3 from, Vec3 to) {
-  const double v[6] = {from.x, from.y, from.z, to.x, to.y, to.z};
+SegmentRunCache::Key SegmentRunCache::key_of(Vec3 from, Vec3 to, Vec3 side_normal) {
+  const double v[9] = {from.x, from.y,        from.z,        to.x,         to.y,
+                       to.z,   side_normal.x, side_normal.y, side_normal.z};
   Key k;
   std::memcpy(k.data(), v, sizeof v);
   return k;
@@ -98,9 +99,9 @@ void SegmentRunCache::plan_chains(const std::vector<SegmentEnds>& segments, int 
   }
 }
 
-void SegmentRunCache::expect(Vec3 from, Vec3 to) {
+void SegmentRunCache::expect(Vec3 from, Vec3 to, Vec3 side_normal) {
   std::lock_guard<std::mutex> lock(mutex_);
-  const Key key = key_of(from, to);
+  const Key key = key_of(from, to, side_normal);
   auto ref = chain_of_.find(key);
   if (ref == chain_of_.end()) {
     // A segment in no planned chain: a run of one part.
@@ -174,10 +175,10 @@ void SegmentRunCache::provide(Vec3 from, Vec3 to, const std::vector<double>& spl
 }
 
 std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, const RunFn& compute,
-                                                          bool* computed) {
+                                                          bool* computed, Vec3 side_normal) {
   if (computed) *computed = true;
   std::unique_lock<std::mutex> lock(mutex_);
-  auto ref = chain_of_.find(key_of(from, to));
+  auto ref = chain_of_.find(key_of(from, to, side_normal));
   if (ref == chain_of_.end()) {
     // Never announced: nothing to share.
     lock.unlock();

@@ -60,8 +60,10 @@ class SegmentRunCache {
   // does not depend on the shard or on a resumed checkpoint. Call before expect().
   void plan_chains(const std::vector<SegmentEnds>& segments, int max_parts);
 
-  // Registers one future get() of the world-aligned run on (from, to). Not thread-safe with get().
-  void expect(Vec3 from, Vec3 to);
+  // Registers one future get() of the world-aligned run on (from, to), with its directions split
+  // by the plane of normal `side_normal` when that is not zero (Segment::side_normal: the run
+  // holds both sides, each user takes its own). Not thread-safe with get().
+  void expect(Vec3 from, Vec3 to, Vec3 side_normal = {0, 0, 0});
 
   // The result of the world-aligned run on (from, to): `compute` runs on the first call
   // (tbb::collaborative_call_once: isolated, so that the computing thread never picks up a task
@@ -69,8 +71,9 @@ class SegmentRunCache {
   // instead of waiting idle), later callers get the stored result. A segment of a planned chain
   // gets its part of the chain's run. `*computed` says whether this call ran compute(). A use that
   // was not announced is computed and not stored. An exception from compute() reaches every caller.
+  // `side_normal` as for expect().
   std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to, const RunFn& compute,
-                                           bool* computed = nullptr);
+                                           bool* computed = nullptr, Vec3 side_normal = {0, 0, 0});
 
   // Hands the cache a run computed elsewhere (the pilot of --long-segments auto): `whole`, the
   // result of compute(from, to, splits), for the planned chain from `from` to `to` with these
@@ -88,9 +91,11 @@ class SegmentRunCache {
   size_t entries_held() const;  // results awaiting a later use
   size_t chains_planned() const { return planned_; }
 
+  // What identifies a run: the bits of from, to and the side normal (runs match them exactly).
+  using Key = std::array<uint64_t, 9>;
+  static Key key_of(Vec3 from, Vec3 to, Vec3 side_normal = {0, 0, 0});
+
  private:
-  using Key = std::array<uint64_t, 6>;  // the bits of from and to
-  static Key key_of(Vec3 from, Vec3 to);
   using Parts = std::vector<std::shared_ptr<const SegmentResult>>;
   // One kernel run: a planned chain of segments (split at the junctions), or a single segment
   // (no splits, one part) announced by expect().

@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cassert>
 #include <chrono>
@@ -320,6 +321,11 @@ class StaticKind {
     if (!opt.bvh)
       faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
     has_see_through_ = scene.has_see_through();
+    if (!(opt.side_normal == Vec3{0, 0, 0})) {
+      sides_ = true;
+      all_sides_ = opt.side_only < 0 ? 3 : 1;
+      for (int f = 0; f < kCubeFaces; ++f) side_axes_[size_t(f)] = face_axes(f, opt.orientation);
+    }
   }
 
   static constexpr bool kHasBvh = true;
@@ -416,7 +422,8 @@ class StaticKind {
     const bool witnesses = !found.witness_len.empty();
     for (size_t i = 0; i < sc.see_through.size(); ++i) {
       const Pending& b = sc.see_through[i];
-      if (!witnesses && part_bounds_.empty() && found.seen(b.id)) continue;  // nothing to add
+      if (!witnesses && part_bounds_.empty() && found.seen(b.id) == all_sides_)
+        continue;  // nothing to add
       const Vec2* hull = &sc.see_through_hulls[i * kMaxFootprintPoints];
       const StaticTriangle& st = b.st;
       for (int y = b.y0; y <= b.y1; ++y) {
@@ -426,6 +433,8 @@ class StaticKind {
         x1 = std::min(x1, rect.x1);
         const double tc = pixel_centers_[size_t(y)];
         for (int x = x0; x <= x1; ++x) {
+          const uint8_t sides = side_mask(face, x, y);
+          if (sides == 0) continue;
           const size_t k = rect.index(x, y);
           const Vec3 d = axes.F + axes.S * pixel_centers_[size_t(x)] + axes.T * tc;
           const double far = sc.far[k];
@@ -449,7 +458,7 @@ class StaticKind {
                                          const double len = t1 - t0;
                                          if (!(len > opt_.eps_len)) return;
                                          if (!witnesses) {
-                                           found.add(b.id, 1);
+                                           found.add(b.id, sides);
                                            return;
                                          }
                                          Witness w;
@@ -555,15 +564,21 @@ class StaticKind {
       if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
       return;
     }
+    const int N = opt_.resolution;
+    const uint8_t sides = side_mask(face, x, y);
+    if (sides == 0) {  // a pixel of the side not asked for
+      if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
+      return;
+    }
     const bool witnesses = !found.witness_len.empty();
-    auto settled = [&](uint32_t id) { return !witnesses && found.seen(id) != 0; };
+    auto settled = [&](uint32_t id) { return !witnesses && (found.seen(id) & sides) == sides; };
     for_each_visible(
         l, sc.ties[k],
         [&](uint32_t id, double t0, double t1) {
           double len = t1 - t0;
           if (!(len > opt_.eps_len)) return;
           if (!witnesses) {  // the mark alone (no witness to build and compare)
-            found.add(id, 1);
+            found.add(id, sides);
             return;
           }
           Witness w;
@@ -575,11 +590,25 @@ class StaticKind {
           found.mark(id, len, w);
         },
         settled);
-    const int N = opt_.resolution;
     if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
   }
 
  private:
+  // The sides (SegmentOptions::side_normal) pixel (x, y) of `face` counts for, as the mark's
+  // bits: 1 (side 0), 2 (side 1) or 3 (both, on the plane) when the sides are split; 1 when it
+  // is on the side asked for (side_only), 0 when not; 1 without sides.
+  uint8_t side_mask(int face, int x, int y) const {
+    if (!sides_) return 1;
+    const FaceAxes& a = side_axes_[size_t(face)];
+    const double sc = pixel_centers_[size_t(x)], tc = pixel_centers_[size_t(y)];
+    const Vec3 d = a.F + a.S * sc + a.T * tc;
+    const double dn = dot(d, opt_.side_normal);
+    const double tol = kSideTolerance * std::sqrt(1 + sc * sc + tc * tc) * length(opt_.side_normal);
+    const uint8_t mask = uint8_t((dn >= -tol ? 1 : 0) | (dn <= tol ? 2 : 0));
+    if (opt_.side_only < 0) return mask;
+    return uint8_t(mask >> opt_.side_only & 1);
+  }
+
   void relative_corners(size_t t, Vec3* rel) const {
     auto c = scene_.corners(uint32_t(t), opt_.state);
     const Vec3 r[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
@@ -593,6 +622,9 @@ class StaticKind {
   EdgeLines own_lines_;  // built for this call when the caller passes none
   const EdgeLines* lines_ = nullptr;
   std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
+  bool sides_ = false;               // side_normal given
+  uint8_t all_sides_ = 1;            // the mark of an id seen on every side that counts
+  std::array<FaceAxes, kCubeFaces> side_axes_{};  // world axes of each face (sides_ only)
   bool keep_ties_ = false;
   bool has_see_through_ = false;
   double far_scale_ = 1.0;
@@ -614,6 +646,16 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
           std::to_string(kMaxSplitParts - 1));
     if (scene.sphere_count() > 0 || scene.is_dynamic())
       throw std::invalid_argument("a segment can be split only in a static scene without spheres");
+  }
+  if (!(opt.side_normal == Vec3{0, 0, 0})) {
+    if (!opt.splits.empty() || scene.sphere_count() > 0 || scene.is_dynamic())
+      throw std::invalid_argument(
+          "directions can be split by a plane only in a static scene without spheres, on a "
+          "segment that is not split");
+    if (opt.side_only < -1 || opt.side_only > 1)
+      throw std::invalid_argument("side_only must be -1 (both sides), 0 or 1");
+    if (opt.side_only < 0 && opt.want_witnesses)
+      throw std::invalid_argument("witnesses need one side (side_only 0 or 1), not both");
   }
   if (scene.sphere_count() > 0 || scene.is_dynamic()) {
     if (scene.has_see_through()) throw std::invalid_argument(kSeeThroughStaticOnly);
@@ -653,6 +695,12 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
       result.visible.push_back(uint32_t(t));
       if (opt.want_witnesses && opt.splits.empty()) result.witnesses.push_back(best[t]);
     }
+  if (!(opt.side_normal == Vec3{0, 0, 0}) && opt.side_only < 0) {
+    result.visible_sides.resize(2);
+    for (uint32_t t : result.visible)
+      for (size_t i = 0; i < 2; ++i)
+        if (seen[t] >> i & 1) result.visible_sides[i].push_back(t);
+  }
   if (!opt.splits.empty()) {
     result.visible_parts.resize(opt.splits.size() + 1);
     for (uint32_t t : result.visible)

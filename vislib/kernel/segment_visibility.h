@@ -86,9 +86,24 @@ struct SegmentOptions {
   // many segments on one scene build them once). Built for another scene or state: refused
   // (std::invalid_argument).
   const EdgeLines* edge_lines = nullptr;
+  // Directions split by a plane through the eye (static scenes; not with `splits`): when
+  // `side_normal` is not zero, a pixel whose world direction d has dot(d, side_normal) >=
+  // -kSideTolerance |d| |side_normal| is on side 0 and one with dot(d, side_normal) <=
+  // kSideTolerance |d| |side_normal| on side 1 (a pixel within the tolerance of the plane is on
+  // both). With side_only < 0 the result holds visible_sides (no witnesses: std::invalid_argument);
+  // with side_only 0 or 1 only that side's pixels mark ids and give witnesses, so `visible` is
+  // that side's set. The lists (`pieces`) are those of the whole cube either way. A ray from an
+  // eye that leaves a convex region through a portal point q goes on as the ray from q in the
+  // same direction, whose direction points out of the region: a portal's run serves the regions
+  // on both sides, each with the directions that leave it (docs/quake.md "Portals").
+  Vec3 side_normal{0, 0, 0};
+  int side_only = -1;
 };
 
 constexpr size_t kMaxSplitParts = 8;
+// Pixels whose direction lies within this of a side plane (a cosine: |dot(d, n)| / (|d| |n|)) are
+// on both sides, so that rounding never drops a pixel from the side it belongs to.
+constexpr double kSideTolerance = 1e-9;
 
 struct SegmentStats {
   uint64_t pair_tests = 0;     // (triangle, pixel) coverage evaluations
@@ -131,6 +146,9 @@ struct SegmentResult {
   std::vector<Witness> witnesses;         // if requested: one per visible id, in id order
   // With options.splits: the sorted triangle ids visible from each part (visible is their union).
   std::vector<std::vector<uint32_t>> visible_parts;
+  // With options.side_normal and side_only < 0: the sorted triangle ids visible at the pixels of
+  // side 0 and of side 1 (visible is their union).
+  std::vector<std::vector<uint32_t>> visible_sides;
   // If requested: final list of pixel (face, x, y) at index (face * N + y) * N + x.
   std::vector<PieceList> pieces;
   // If requested, for dynamic scenes in Diagonal mode (instead of `pieces`): same indexing; ids
