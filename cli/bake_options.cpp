@@ -215,7 +215,8 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     assert(map);
     const vislib::QuakeBsp& bsp = *map;
     vislib::BspCellOptions o;
-    o.face_spacing = a.face_spacing;
+    o.face_spacing = a.face_spacing.value_or(
+        a.sweep == "portals" ? vislib::kBspPortalSpacing : vislib::kBspFaceSpacing);
     o.near = a.near;
     if (a.face_sweep == "adaptive") {
       if (!(a.chords.floor <= a.chords.coarse))
@@ -318,9 +319,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--face-spacing", a.face_spacing,
                   "bsp-leaves: sweep each swept polygon (a portal, or a face of a leaf's view "
                   "region) with parallel segments at most this far apart (Quake units; 0 = its "
-                  "edges only)")
-      ->check(in_range(0.0, 1e6))
-      ->capture_default_str();
+                  "edges only; default 8 with --sweep portals, 16 with faces)")
+      ->check(in_range(0.0, 1e6));
   cmd->add_option("--face-sweep", a.face_sweep,
                   "bsp-leaves: 'even' (chords --face-spacing apart) or 'adaptive' (coarse chords, "
                   "one inserted between two neighbours while it sees ids neither sees, down to "

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,10 +36,11 @@ struct BakeArgs {
   std::string bvh = "on";                         // --bvh on|off
   std::string long_segments = "1";                // --long-segments: 1..8 or auto
   std::string cells;                              // --cells: "" (grid or walkable) or bsp-leaves
-  double face_spacing = vislib::kBspFaceSpacing;  // --face-spacing (bsp-leaves), Quake units
+  // --face-spacing (bsp-leaves), Quake units; unset: kBspPortalSpacing or kBspFaceSpacing.
+  std::optional<double> face_spacing;
   std::string leaves;                             // --leaves A-B (bsp-leaves)
   std::string face_sweep = "even";                // --face-sweep even|adaptive (bsp-leaves)
-  std::string sweep = "faces";                    // --sweep portals|faces (bsp-leaves)
+  std::string sweep = "portals";                  // --sweep portals|faces (bsp-leaves)
   vislib::AdaptiveSpacing chords;                 // --chord-coarse, --chord-floor (adaptive)
   std::vector<std::string> walkable_from;         // --walkable-from x,y,z (repeatable)
   double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default

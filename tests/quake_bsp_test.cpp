@@ -1180,6 +1180,26 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   ASSERT_EQ(run_pvs("merge -q " + dir + "/s1.pvs " + dir + "/s0.pvs -o " + dir + "/m.pvs", &out), 0)
       << out;
   EXPECT_EQ(read_file(dir + "/m.pvs"), read_file(dir + "/tiny.pvs"));
+  // The default sweep is the portals'; --sweep faces and the spacings' defaults are recorded.
+  auto cells_of = [&](const std::string& options) {
+    EXPECT_EQ(run_pvs("bake -q " + map + " --cells bsp-leaves --res 16 " + options + " -o " + dir +
+                          "/d.pvs",
+                      &out),
+              0)
+        << out;
+    pvs::Reader r = pvs::Reader::from_memory(read_file(dir + "/d.pvs"));
+    return nlohmann::json::parse(r.info().metadata)["cells"];
+  };
+  nlohmann::json c = cells_of("");
+  EXPECT_EQ(c["sweep"], "portals");
+  EXPECT_EQ(c["face_spacing"], kBspPortalSpacing);
+  c = cells_of("--sweep faces");
+  EXPECT_EQ(c["sweep"], "faces");
+  EXPECT_EQ(c["face_spacing"], kBspFaceSpacing);
+  EXPECT_EQ(cells_of("--sweep faces --face-spacing 4")["face_spacing"], 4.0);
+  EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --sweep edges -o " + dir + "/x.pvs", &out),
+            2);
+  EXPECT_NE(out.find("--sweep"), std::string::npos) << out;
   // Leaf 2 (water, above z = 16): Quake (32, 48, 24) is scene (32, 24, -48).
   ASSERT_EQ(run_pvs("inspect --json " + dir + "/tiny.pvs --at 32,24,-48", &out), 0) << out;
   EXPECT_NE(out.find("\"leaf\": 2"), std::string::npos) << out;
