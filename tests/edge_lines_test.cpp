@@ -54,6 +54,24 @@ TEST(EdgeLines, TheRunsAreTheSameWhateverTheThreadCount) {
   EXPECT_EQ(one.lines, many.lines);
 }
 
+// The points are joined range by range in bounded memory (kEdgeLinesIncidentBudget): ranges of
+// one point each (a budget below any degree still takes one) and of a few hundred points give
+// the runs of one range holding every point.
+TEST(EdgeLines, TheRunsAreTheSameWhateverTheIncidentListsBudget) {
+  CityOptions o;
+  o.blocks_x = o.blocks_z = 1;
+  o.panel_size = 2;
+  o.seed = 6;
+  const Scene s = generate_city(o);
+  const EdgeLines whole = build_edge_lines(s, 0, s.triangle_count() * 6);
+  ASSERT_FALSE(whole.lines.empty());
+  for (size_t budget : {size_t(1), size_t(2000)}) {
+    const EdgeLines ranged = build_edge_lines(s, 0, budget);
+    EXPECT_EQ(ranged.edge_line, whole.edge_line) << "budget " << budget;
+    EXPECT_EQ(ranged.lines, whole.lines) << "budget " << budget;
+  }
+}
+
 TEST(EdgeLines, SharedEdgesAloneAndCollinearEdgesThatNeverTouchMakeNoRun) {
   // Two triangles sharing one whole edge, and a third on the same line but apart: each edge keeps
   // its own points (bit-identical on the shared edge already).

@@ -45,7 +45,7 @@ Vec3 direction_key(Vec3 d) {
 
 }  // namespace
 
-EdgeLines build_edge_lines(const Scene& scene, size_t state) {
+EdgeLines build_edge_lines(const Scene& scene, size_t state, size_t incident_budget) {
   EdgeLines el;
   el.scene = &scene;
   el.state = state;
@@ -54,16 +54,19 @@ EdgeLines build_edge_lines(const Scene& scene, size_t state) {
   if (n == 0) return el;
   if (state >= scene.positions.size())
     throw std::invalid_argument("edge lines: key state " + std::to_string(state) + " out of range");
-  if (n > (size_t(1) << 30)) throw std::invalid_argument("too many triangles for the edge lines");
+  // Edge ids (3 per triangle) stay below 2^31: the run marks take the top bit.
+  if (3 * n >= (size_t(1) << 31))
+    throw std::invalid_argument("too many triangles for the edge lines");
   const std::vector<Vec3>& pos = scene.positions[state];
   for (const Vec3& p : pos)
     if (!is_finite(p)) return el;  // no order to build on; the kernel refuses such scenes anyway
 
   // Points: distinct positions, numbered in lexicographic order (so the smaller id of an edge's
-  // endpoints is its canonical P, and the extreme ids of a run are its line's ends).
+  // endpoints is its canonical P, and the extreme ids of a run are its line's ends), each kept as
+  // one vertex of that position (4 bytes a point rather than its 24).
   const size_t V = pos.size();
   std::vector<uint32_t> point(V);
-  std::vector<Vec3> point_pos;
+  std::vector<uint32_t> point_vertex;
   {
     std::vector<uint32_t> by_pos(V);
     std::iota(by_pos.begin(), by_pos.end(), 0u);
@@ -73,11 +76,12 @@ EdgeLines build_edge_lines(const Scene& scene, size_t state) {
       return a < b;
     });
     for (size_t i = 0; i < V; ++i) {
-      if (i == 0 || pos[by_pos[i]] != pos[by_pos[i - 1]]) point_pos.push_back(pos[by_pos[i]]);
-      point[by_pos[i]] = uint32_t(point_pos.size() - 1);
+      if (i == 0 || pos[by_pos[i]] != pos[by_pos[i - 1]]) point_vertex.push_back(by_pos[i]);
+      point[by_pos[i]] = uint32_t(point_vertex.size() - 1);
     }
   }
-  const size_t np = point_pos.size();
+  const size_t np = point_vertex.size();
+  auto point_pos = [&](uint32_t p) { return pos[point_vertex[p]]; };
 
   // Edge 3t + e as its point pair a <= b (a == b: degenerate, joins nothing).
   const size_t ne = 3 * n;
@@ -90,95 +94,125 @@ EdgeLines build_edge_lines(const Scene& scene, size_t state) {
 
   // Join collinear edges around each point: every pair while few, else neighbours in direction
   // order (runs through a point with more edges than the cap can then be missed, never invented).
+  // The points are taken in ranges whose incident lists hold at most `incident_budget`
+  // entries (each range scans every edge once more), so that memory stays bounded.
   Sets sets(ne);
   {
-    std::vector<uint32_t> start(np + 1, 0);
+    std::vector<uint32_t> degree(np, 0);
     uint32_t a, b;
     for (uint32_t id = 0; id < uint32_t(ne); ++id) {
       ends(id, a, b);
-      if (a != b) ++start[a + 1], ++start[b + 1];
+      if (a != b) ++degree[a], ++degree[b];
     }
-    for (size_t p = 0; p < np; ++p) start[p + 1] += start[p];
-    std::vector<uint32_t> incident(start[np]);
-    {
+    std::vector<uint32_t> start, incident;
+    std::vector<std::pair<Vec3, uint32_t>> around;
+    for (size_t p0 = 0; p0 < np;) {
+      size_t p1 = p0, entries = 0;  // the range [p0, p1): at least one point
+      while (p1 < np && (p1 == p0 || entries + degree[p1] <= incident_budget))
+        entries += degree[p1++];
+      start.assign(p1 - p0 + 1, 0);
+      for (size_t p = p0; p < p1; ++p) start[p - p0 + 1] = start[p - p0] + degree[p];
+      incident.resize(entries);
       std::vector<uint32_t> fill(start.begin(), start.end() - 1);
       for (uint32_t id = 0; id < uint32_t(ne); ++id) {
         ends(id, a, b);
-        if (a != b) incident[fill[a]++] = id, incident[fill[b]++] = id;
+        if (a == b) continue;
+        if (a >= p0 && a < p1) incident[fill[a - p0]++] = id;
+        if (b >= p0 && b < p1) incident[fill[b - p0]++] = id;
       }
-    }
-    std::vector<std::pair<Vec3, uint32_t>> around;
-    for (size_t p = 0; p < np; ++p) {
-      const uint32_t* first = incident.data() + start[p];
-      const size_t k = start[p + 1] - start[p];
-      if (k < 2) continue;
-      const Vec3 X = point_pos[p];
-      auto away = [&](uint32_t id) {
-        uint32_t u, v;
-        ends(id, u, v);
-        return point_pos[u == p ? v : u] - X;
-      };
-      auto collinear = [](Vec3 d1, Vec3 d2) { return cross(d1, d2) == Vec3{0, 0, 0}; };
-      if (k <= kEdgeLinesPairCap) {
-        for (size_t i = 0; i < k; ++i)
-          for (size_t j = i + 1; j < k; ++j)
-            if (collinear(away(first[i]), away(first[j]))) sets.unite(first[i], first[j]);
-        continue;
+      for (size_t p = p0; p < p1; ++p) {
+        const uint32_t* first = incident.data() + start[p - p0];
+        const size_t k = degree[p];
+        if (k < 2) continue;
+        const Vec3 X = point_pos(uint32_t(p));
+        auto away = [&](uint32_t id) {
+          uint32_t u, v;
+          ends(id, u, v);
+          return point_pos(u == p ? v : u) - X;
+        };
+        auto collinear = [](Vec3 d1, Vec3 d2) { return cross(d1, d2) == Vec3{0, 0, 0}; };
+        if (k <= kEdgeLinesPairCap) {
+          for (size_t i = 0; i < k; ++i)
+            for (size_t j = i + 1; j < k; ++j)
+              if (collinear(away(first[i]), away(first[j]))) sets.unite(first[i], first[j]);
+          continue;
+        }
+        around.clear();
+        for (size_t i = 0; i < k; ++i) around.push_back({direction_key(away(first[i])), first[i]});
+        std::sort(around.begin(), around.end(), [](const auto& x, const auto& y) {
+          if (x.first != y.first) return lex_less(x.first, y.first);
+          return x.second < y.second;
+        });
+        for (size_t i = 1; i < k; ++i)
+          if (collinear(away(around[i - 1].second), away(around[i].second)))
+            sets.unite(around[i - 1].second, around[i].second);
       }
-      around.clear();
-      for (size_t i = 0; i < k; ++i) around.push_back({direction_key(away(first[i])), first[i]});
-      std::sort(around.begin(), around.end(), [](const auto& x, const auto& y) {
-        if (x.first != y.first) return lex_less(x.first, y.first);
-        return x.second < y.second;
-      });
-      for (size_t i = 1; i < k; ++i)
-        if (collinear(away(around[i - 1].second), away(around[i].second)))
-          sets.unite(around[i - 1].second, around[i].second);
+      p0 = p1;
     }
   }
 
-  // The edges of sets of two or more, as (root, id), by root; per run its extreme points, and
-  // whether it holds two distinct edges (a run of one edge, or of copies of one shared edge,
-  // computes its coefficients from its own points already).
-  size_t grouped = 0;
-  for (uint32_t id = 0; id < uint32_t(ne); ++id) grouped += sets.find(id) != id;
-  std::vector<uint64_t> members;
-  members.reserve(2 * grouped);  // the members, then at most as many roots
-  for (uint32_t id = 0; id < uint32_t(ne); ++id) {
-    const uint32_t r = sets.find(id);
-    if (r != id) members.push_back(uint64_t(r) << 32 | id);
-  }
-  if (members.empty()) return el;
-  {
-    const size_t k = members.size();  // the roots themselves (repeats removed below)
-    for (size_t i = 0; i < k; ++i) {
-      const uint64_t r = members[i] >> 32;
-      if (i == 0 || (members[i - 1] >> 32) != r) members.push_back(r << 32 | r);
-    }
-  }
-  tbb::parallel_sort(members.begin(), members.end());
-  members.erase(std::unique(members.begin(), members.end()), members.end());
-  for (size_t i = 0; i < members.size();) {
-    const uint64_t r = members[i] >> 32;
-    size_t j = i;
+  // Runs: the sets of two or more edges, numbered by their root (the set's smallest id), in place
+  // in the parent array: a root with members gets kRunFlag | its run, a member its root. Per run
+  // its extreme points, and whether it holds two distinct edges (a run of one edge, or of copies
+  // of one shared edge, computes its coefficients from its own points already).
+  constexpr uint32_t kRunFlag = 0x80000000u;  // edge ids stay below 2^31 (at most 3 * 2^30)
+  std::vector<uint32_t>& parent = sets.parent;
+  for (uint32_t id = 0; id < uint32_t(ne); ++id) parent[id] = sets.find(id);  // roots are smaller
+  for (uint32_t id = 0; id < uint32_t(ne); ++id)
+    if (parent[id] != id) parent[parent[id]] |= kRunFlag;  // marks a root with members
+  struct Run {
     uint32_t lo = UINT32_MAX, hi = 0, a0 = 0, b0 = 0;
     bool distinct = false;
-    for (; j < members.size() && (members[j] >> 32) == r; ++j) {
-      uint32_t a, b;
-      ends(uint32_t(members[j]), a, b);
-      if (j == i) a0 = a, b0 = b;
-      distinct = distinct || a != a0 || b != b0;
-      lo = std::min(lo, a);
-      hi = std::max(hi, b);
+  };
+  std::vector<Run> runs;
+  size_t run_count = 0;  // vectors of the exact size: a doubling one would hold twice as much
+  for (uint32_t id = 0; id < uint32_t(ne); ++id) run_count += parent[id] == (id | kRunFlag);
+  runs.reserve(run_count);
+  for (uint32_t id = 0; id < uint32_t(ne); ++id)
+    if (parent[id] == (id | kRunFlag)) {
+      parent[id] = kRunFlag | uint32_t(runs.size());
+      runs.emplace_back();
     }
-    if (distinct) {
-      if (el.edge_line.empty()) el.edge_line.assign(ne, EdgeLines::kNone);
-      const uint32_t l = uint32_t(el.lines.size());
-      el.lines.push_back({point_pos[lo], point_pos[hi]});
-      for (size_t m = i; m < j; ++m) el.edge_line[uint32_t(members[m])] = l;
+  auto run_of = [&](uint32_t id) {
+    const uint32_t v = parent[id];
+    return (v & kRunFlag) ? v & ~kRunFlag : parent[v] & ~kRunFlag;
+  };
+  if (runs.empty()) return el;
+  for (uint32_t id = 0; id < uint32_t(ne); ++id) {
+    const uint32_t v = parent[id];
+    if (!(v & kRunFlag) && v == id) continue;  // an edge of no run
+    Run& r = runs[run_of(id)];
+    uint32_t a, b;
+    ends(id, a, b);
+    if (v & kRunFlag) {  // the root: the first edge of its run
+      r.a0 = a;
+      r.b0 = b;
     }
-    i = j;
+    r.distinct = r.distinct || a != r.a0 || b != r.b0;
+    r.lo = std::min(r.lo, a);
+    r.hi = std::max(r.hi, b);
   }
+  // Lines for the runs of distinct edges, in root order; a run's lo becomes its line (or kNone).
+  point = {};
+  el.lines.reserve(
+      size_t(std::count_if(runs.begin(), runs.end(), [](const Run& r) { return r.distinct; })));
+  for (Run& r : runs) {
+    if (r.distinct) {
+      el.lines.push_back({point_pos(r.lo), point_pos(r.hi)});
+      r.lo = uint32_t(el.lines.size() - 1);
+    } else {
+      r.lo = EdgeLines::kNone;
+    }
+  }
+  if (el.lines.empty()) return el;
+  point_vertex = {};
+  // The parent array becomes edge_line: from the last id down, so that a member reads its root's
+  // run before the root (its smaller id) is overwritten.
+  for (uint32_t id = uint32_t(ne); id-- > 0;) {
+    const uint32_t v = parent[id];
+    parent[id] = (!(v & kRunFlag) && v == id) ? EdgeLines::kNone : runs[run_of(id)].lo;
+  }
+  el.edge_line = std::move(parent);
   return el;
 }
 

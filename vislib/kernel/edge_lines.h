@@ -63,12 +63,16 @@ struct EdgeLines {
   size_t edge_count() const;
 };
 
-// Peak memory while building: about 4 bytes per vertex, 28 per distinct point and 16 per edge,
-// plus 8 per edge that joins a run (the 1M-triangle city: measured in docs/performance.md).
-// Deterministic; O(V log V + E + sum over vertices of (incident edges)^2, capped per vertex at
-// kEdgeLinesPairCap incident edges, beyond which only edges adjacent in direction order are
-// compared).
+// Memory while building, beyond the result (4 bytes an edge, 48 a run): 8 bytes a vertex, 8 a
+// distinct point and 20 a run of edges, plus incident lists of at most kEdgeLinesIncidentBudget
+// entries (4 bytes each), the points being taken in ranges that fit it (each range reads every
+// edge once more). Deterministic; O(V log V + E * ranges + sum over points of (incident
+// edges)^2, capped per point at kEdgeLinesPairCap incident edges, beyond which only edges
+// adjacent in direction order are compared).
 constexpr size_t kEdgeLinesPairCap = 64;
-EdgeLines build_edge_lines(const Scene& scene, size_t state = 0);
+constexpr size_t kEdgeLinesIncidentBudget = size_t(16) << 20;  // 64 MB of incident lists
+// `incident_budget` (>= 1; entries) sets the ranges' size: the result does not depend on it.
+EdgeLines build_edge_lines(const Scene& scene, size_t state = 0,
+                           size_t incident_budget = kEdgeLinesIncidentBudget);
 
 }  // namespace vislib
