@@ -24,6 +24,7 @@
 #include "tests/test_support.h"
 #include "vislib/bake/bake.h"
 #include "vislib/bake/bsp_cells.h"
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/embree_scene.h"
@@ -926,6 +927,17 @@ std::vector<std::pair<uint32_t, uint32_t>> ray_misses(const Scene& scene, const 
   return misses;
 }
 
+// 16 eyes a cell, 64 rays each (ray_misses): a failure for every first hit missing from the set.
+void expect_every_ray_in_the_sets(const Scene& scene, const QuakeBsp& m, const ViewCells& cells,
+                                  pvs::Reader& r, uint64_t seed, BspLiquids liquids) {
+  size_t rays = 0;
+  const auto misses = ray_misses(scene, m, cells, r, 16, 64, seed, &rays);
+  EXPECT_GT(rays, 0u);
+  for (const auto& [c, tri] : misses)
+    ADD_FAILURE() << "cell " << c << " misses triangle " << tri << " (liquids " << int(liquids)
+                  << ")";
+}
+
 }  // namespace
 
 // A region's segments: its 12 box edges once each (every edge belongs to two faces), then per
@@ -1106,12 +1118,7 @@ TEST(QuakeBake, SetsHoldEveryTriangleARayFromTheRegionHitsOnAnyThreadCount) {
       const double p[3] = {centre.x, centre.y, centre.z};
       EXPECT_EQ(r.info().layout.find_cell(p), std::optional<uint32_t>(c));
     }
-    size_t rays = 0;
-    const auto misses = ray_misses(scene, m, cells, r, 16, 64, 3603, &rays);
-    EXPECT_GT(rays, 0u);
-    for (const auto& [c, tri] : misses)
-      ADD_FAILURE() << "cell " << c << " misses triangle " << tri << " (liquids " << int(liquids)
-                    << ")";
+    expect_every_ray_in_the_sets(scene, m, cells, r, 3603, liquids);
   }
 }
 
@@ -1153,12 +1160,25 @@ TEST(QuakeBake, PortalSweepRunsEachPortalOnceForBothLeavesAndHoldsEveryRayFromTh
     EXPECT_EQ(report.segment_runs_shared, cells.segments[0].size());
     pvs::Reader r = pvs::Reader::from_memory(one);
     for (uint32_t c = 0; c < 2; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, cells, c, s));
-    size_t rays = 0;
-    const auto misses = ray_misses(scene, m, cells, r, 16, 64, 3605, &rays);
-    EXPECT_GT(rays, 0u);
-    for (const auto& [c, tri] : misses)
-      ADD_FAILURE() << "cell " << c << " misses triangle " << tri << " (liquids " << int(liquids)
-                    << ")";
+    expect_every_ray_in_the_sets(scene, m, cells, r, 3605, liquids);
+    // Witnesses: a portal run's eye lies on the portal and is moved back along its ray into the
+    // cell's region, or gives none when the ray does not pass through it (here every run's
+    // witness lies on the portal's edges, beyond the region's 1-unit inset: only the leaves' own
+    // triangles, on or in their volumes, get one). Each lies in the region and re-casts.
+    const std::vector<ConvexPolytope> regions = cell_regions(m, cells);
+    RegionOptions ro = s.region;
+    for (uint32_t c = 0; c < 2; ++c) {
+      const std::vector<uint32_t> set = r.read_cell(c);
+      const std::vector<CellWitnessRay> w = cell_witness_rays(scene, cells, c, ro, set);
+      EXPECT_EQ(w.size(), cells.own[c].size()) << "cell " << c;
+      size_t recast = 0;
+      for (const CellWitnessRay& x : w) {
+        EXPECT_TRUE(strictly_inside(regions[c], scene_to_quake(x.eye), 0)) << "triangle " << x.tri;
+        const OracleSample hit = brute_force_first_hit(scene, 0, x.eye, x.dir, kDefaultNear);
+        recast += hit.tri == x.tri;
+      }
+      EXPECT_GE(recast * 10, w.size() * 9) << "cell " << c;  // ties aside, each re-casts
+    }
   }
 }
 
