@@ -215,8 +215,8 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     assert(map);
     const vislib::QuakeBsp& bsp = *map;
     vislib::BspCellOptions o;
-    o.face_spacing = a.face_spacing.value_or(
-        a.sweep == "portals" ? vislib::kBspPortalSpacing : vislib::kBspFaceSpacing);
+    o.face_spacing = a.face_spacing.value_or(a.sweep == "portals" ? vislib::kBspPortalSpacing
+                                                                  : vislib::kBspFaceSpacing);
     o.near = a.near;
     if (a.face_sweep == "adaptive") {
       if (!(a.chords.floor <= a.chords.coarse))

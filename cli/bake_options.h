@@ -33,16 +33,16 @@ struct BakeArgs {
   int states = 1;
   ImportArgs import;
   std::string preset = "default";
-  std::string bvh = "on";                         // --bvh on|off
-  std::string long_segments = "1";                // --long-segments: 1..8 or auto
-  std::string cells;                              // --cells: "" (grid or walkable) or bsp-leaves
+  std::string bvh = "on";           // --bvh on|off
+  std::string long_segments = "1";  // --long-segments: 1..8 or auto
+  std::string cells;                // --cells: "" (grid or walkable) or bsp-leaves
   // --face-spacing (bsp-leaves), Quake units; unset: kBspPortalSpacing or kBspFaceSpacing.
   std::optional<double> face_spacing;
-  std::string leaves;                             // --leaves A-B (bsp-leaves)
-  std::string face_sweep = "even";                // --face-sweep even|adaptive (bsp-leaves)
-  std::string sweep = "portals";                  // --sweep portals|faces (bsp-leaves)
-  vislib::AdaptiveSpacing chords;                 // --chord-coarse, --chord-floor (adaptive)
-  std::vector<std::string> walkable_from;         // --walkable-from x,y,z (repeatable)
+  std::string leaves;                      // --leaves A-B (bsp-leaves)
+  std::string face_sweep = "even";         // --face-sweep even|adaptive (bsp-leaves)
+  std::string sweep = "portals";           // --sweep portals|faces (bsp-leaves)
+  vislib::AdaptiveSpacing chords;          // --chord-coarse, --chord-floor (adaptive)
+  std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default
 };
 
