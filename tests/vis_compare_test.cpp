@@ -675,16 +675,16 @@ void expect_every_extra_settled(const nlohmann::json& t, const std::string& map)
 
 }  // namespace
 
-// The whole of lqdm1 baked through the CLI at N = 64 (default face spacing, -j 2) and held
+// The whole of lqdm1 baked through the CLI at N = 64 (the default sweep: portals, chords 8 units
+// apart; -j 2) and held
 // against the map's vis. Every extra is settled: none is left unconfirmed and no kernel witness
 // is false (the map's T-junctions leaked through cracks before edges took their runs' lines:
-// edge_lines.h). Our sampled misses (measured: 15 rays of 31.6 million) are triangles seen only
-// between two chords of the 16-unit sweep (docs/quake.md, "Our sampled misses"): bounded, not
-// zero, at this spacing (the opt-in test below bakes at 4, where they are zero). Release builds
-// only: the sanitizers multiply the bake's cost, and the 4-leaf bake of quake_bsp_test.cpp covers
-// the same code under them. Time budget: printed; 390 CPU s for the bake (about 3.3 minutes wall
-// on two idle cores, 16.5 on the loaded host where it was measured) and 6 CPU s for the
-// comparison.
+// edge_lines.h). Our sampled misses (measured: 23 rays of 31.6 million; the face sweep at 16 units
+// left 15) are triangles seen only between two chords (docs/quake.md, "Portals"): bounded, not
+// zero, at this spacing (the opt-in test below sweeps the faces at 4, where they are zero). Release
+// builds only: the sanitizers multiply the bake's cost, and the 4-leaf bake of quake_bsp_test.cpp
+// covers the same code under them. Time budget: printed; 236 CPU s for the bake (about 2 minutes
+// wall on two idle cores; measured on a host shared with a build) and 6 CPU s for the comparison.
 constexpr int kLqdm1N64MissBound = 32;  // sampled rays, of 31,555,584
 TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMisses) {
 #if defined(__SANITIZE_ADDRESS__)
@@ -694,7 +694,7 @@ TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMiss
 #ifndef NDEBUG
   GTEST_SKIP() << "the whole-map bake is a release-suite test";
 #endif
-  auto j = bake_and_compare("lqdm1.bsp", "--res 64", "3.5 minutes on two idle cores");
+  auto j = bake_and_compare("lqdm1.bsp", "--res 64", "2.5 minutes on two idle cores");
   if (!j) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   const auto& t = (*j)["totals"];
   ASSERT_FALSE(t.empty());
@@ -708,8 +708,8 @@ TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMiss
 // no sampled ray (4 eyes a leaf, 126 million rays) sees a triangle missing from ours.
 TEST(VisCompareLibreQuake, LongLqdm1WholeSweptAt4UnitsHasNoSampledMiss) {
   VISLIB_REQUIRE_LONG_TESTS();
-  auto j =
-      bake_and_compare("lqdm1.bsp", "--res 128 --face-spacing 4", "35 minutes on two idle cores");
+  auto j = bake_and_compare("lqdm1.bsp", "--res 128 --sweep faces --face-spacing 4",
+                            "35 minutes on two idle cores");
   if (!j) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   const auto& t = (*j)["totals"];
   ASSERT_FALSE(t.empty());
@@ -720,16 +720,17 @@ TEST(VisCompareLibreQuake, LongLqdm1WholeSweptAt4UnitsHasNoSampledMiss) {
 }
 
 // e1m2 and e2m3 baked by us on a spread sample (every 40th leaf number; liquids see-through, as
-// their vis treated them) at N = 128 and the default spacing (opt-in: VISLIB_LONG_TESTS=1; budget
-// printed: about 1,100 CPU s for both, most of it the kernel-witness re-runs). Every extra is
-// settled (confirmed, coincident or a tie, never unconfirmed or a false witness). Our sampled
+// their vis treated them) at N = 128, the faces swept at 16 units (opt-in: VISLIB_LONG_TESTS=1;
+// budget printed: about 1,100 CPU s for both, most of it the kernel-witness re-runs). Every extra
+// is settled (confirmed, coincident or a tie, never unconfirmed or a false witness). Our sampled
 // misses, the sweep's gaps at 16 units, are bounded at 1 ray in a million (measured: 7 of 24.8
 // million on e1m2, 1 of 18.5 million on e2m3); theirs are zero.
 TEST(VisCompareLibreQuake, LongE1m2AndE2m3SampleBakesSettleEveryExtra) {
   VISLIB_REQUIRE_LONG_TESTS();
   for (const char* map : {"e1m2.bsp", "e2m3.bsp"}) {
-    auto j = bake_and_compare(map, "--bsp-liquids see-through --leaves 1-4000/40 --res 128",
-                              "10 minutes a map on two idle cores");
+    auto j = bake_and_compare(
+        map, "--bsp-liquids see-through --leaves 1-4000/40 --res 128 --sweep faces",
+        "10 minutes a map on two idle cores");
     if (!j) GTEST_SKIP() << "../shared/scenes/librequake is absent";
     const auto& t = (*j)["totals"];
     ASSERT_FALSE(t.empty()) << map;
