@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <string>
 
 #include "cli/bake_options.h"
@@ -22,6 +23,7 @@
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/kernel/segment_run_cache.h"
 #include "vislib/kernel/segment_visibility.h"
 
 namespace pvs_cli {
@@ -147,12 +149,22 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     throw Exit{2};
   }
   if (a.dry_run) {
-    size_t segments = 0;  // mean over the cells, rounded down
+    size_t segments = 0;                              // mean over the cells, rounded down
+    std::set<vislib::SegmentRunCache::Key> distinct;  // runs shared between cells count once
     for (uint32_t c = 0; c < n; ++c)
-      for (const auto& g : vislib::cell_segment_groups(cells, c)) segments += g.size();
-    std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s\n", n,
+      for (const auto& g : vislib::cell_segment_groups(cells, c)) {
+        segments += g.size();
+        if (cells.shared_runs)
+          for (const vislib::Segment& s : g)
+            distinct.insert(vislib::SegmentRunCache::key_of(s.from, s.to, s.side_normal));
+      }
+    std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s", n,
                 kind_name(cells), (n + shard.count - 1 - shard.index) / shard.count, shard.index,
                 shard.count, segments / n, a.runs, cells.segments.empty() ? "" : " (mean)");
+    if (cells.shared_runs)
+      std::printf("; %zu distinct segments in all (a portal's serve both of its leaves)",
+                  distinct.size());
+    std::printf("\n");
     return;
   }
   if (a.resume && !file_exists(checkpoint) && show_progress())

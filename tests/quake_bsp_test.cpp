@@ -1210,6 +1210,12 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
     pvs::Reader r = pvs::Reader::from_memory(read_file(dir + "/d.pvs"));
     return nlohmann::json::parse(r.info().metadata)["cells"];
   };
+  ASSERT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --dry-run -o " + dir + "/d.pvs", &out), 0)
+      << out;
+  // One portal, its chords run once for both leaves.
+  EXPECT_NE(out.find("distinct segments in all (a portal's serve both of its leaves)"),
+            std::string::npos)
+      << out;
   nlohmann::json c = cells_of("");
   EXPECT_EQ(c["sweep"], "portals");
   EXPECT_EQ(c["face_spacing"], kBspPortalSpacing);
