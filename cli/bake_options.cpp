@@ -88,6 +88,7 @@ vislib::CellPlacement placement_of(const BakeArgs& a) {
   p.agent_height = given(a.agent_height);
   p.agent_radius = given(a.agent_radius);
   p.agent_step = given(a.agent_step);
+  p.band_levels = a.band_levels;
   return p;
 }
 
@@ -197,8 +198,9 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
     parse_starts(a);
     return;
   }
-  for (const char* o : {"--walkable", "--box", "--grid", "--cell-size", "--eye-height",
-                        "--walkable-from", "--agent-height", "--agent-radius", "--agent-step"})
+  for (const char* o :
+       {"--walkable", "--box", "--grid", "--cell-size", "--eye-height", "--band-levels",
+        "--walkable-from", "--agent-height", "--agent-radius", "--agent-step"})
     if (cmd.count(o))
       throw CLI::ValidationError(o,
                                  "cannot be combined with --cells bsp-leaves (the cells are "
@@ -348,6 +350,13 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->check(positive());
   cmd->add_option("--eye-height", a.eye,
                   "Eye band h0,h1 above the floor / the cell bottom (walkable default 1.5,1.8)");
+  cmd->add_option("--band-levels", a.band_levels,
+                  "Grid and walkable cells: the runs are the perimeters of the eye band's "
+                  "rectangles at this many heights, bottom to top evenly spaced (2: the bottom and "
+                  "the top, the paper's rule; more miss less of what eyes inside the band see, at "
+                  "about levels / 2 times the cost; default 3 for walkable cells, 2 for a grid; "
+                  "docs/bake.md \"Eye band\")")
+      ->check(CLI::Range(vislib::kPaperBandLevels, vislib::kMaxBandLevels));
   cmd->add_option("--max-slope", a.max_slope, "Walkable: steepest floor, degrees from horizontal")
       ->check(in_range(0.0, 90.0))
       ->capture_default_str();

@@ -43,6 +43,7 @@ struct BakeArgs {
   std::string sweep = "portals";           // --sweep portals|faces (bsp-leaves)
   vislib::AdaptiveSpacing chords;          // --chord-coarse, --chord-floor (adaptive)
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
+  std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default
 };
 

@@ -129,8 +129,8 @@ void run_inspect(const InspectArgs& a) {
       // A BSP leaf cell: its segments sweep the leaf's region (the file's metadata says how).
       j["leaf"] = info.layout.cell_leaf[c];
     } else {
-      for (const auto& s :
-           vislib::cell_boundary_segments(vislib::to_box3(info.layout.view_region(c))))
+      for (const auto& s : vislib::cell_boundary_segments(
+               vislib::to_box3(info.layout.view_region(c)), vislib::band_levels_of(info.metadata)))
         segs.push_back(
             {{"from", {s.from.x, s.from.y, s.from.z}}, {"to", {s.to.x, s.to.y, s.to.z}}});
     }

@@ -1,5 +1,6 @@
 // Tests of the bake (library): byte-identical output for any thread count, shards merged into
-// the same bytes, edges shared between cells computed once, resume from a
+// the same bytes, edges shared between cells computed once, an eye band swept at more heights
+// than its bottom and top seeing what eyes between them see, resume from a
 // checkpoint (including one torn at any byte), refusal of another bake's checkpoint, and the scene
 // fingerprint and subset the PVS relies on.
 #include "vislib/bake/bake.h"
@@ -15,15 +16,18 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "tests/scene_builders.h"
 #include "tests/test_support.h"
 #include "vislib/bake/bake_eta.h"
 #include "vislib/bake/bake_report.h"
 #include "vislib/bake/cell_set.h"
+#include "vislib/bake/cell_visibility.h"
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/long_segments.h"
 #include "vislib/bake/scene_subset.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/eval/ray_reference.h"
 #include "vislib/kernel/segment_run_cache.h"
 #include "vislib/kernel/triangle_bvh.h"
 #include "vislib/scene/generate.h"
@@ -883,4 +887,59 @@ TEST(SegmentRunCache, ConcurrentUsesOfAChainComputeItOnceAndReleaseEveryPart) {
             std::vector<uint32_t>{1});
   EXPECT_TRUE(computed);
   EXPECT_EQ(computations.load(), 2);
+}
+
+TEST(BandLevels, AnEdgeAtMidBandSeesThroughSlitsThatTheBottomAndTopPerimetersCannot) {
+  // Two walls across z (at 5 and 10) with a slit at y 1.4..1.6 each, and a target behind them at
+  // the slits' height. The cell's eye band is y 1..2 over [-1, 1]^2: a line from y 1 (or 2)
+  // through both slits would need a slope in [0.4, 0.6] / d1 and in [0.4, 0.6] / (d1 + 5) at
+  // once, impossible for d1 <= 6, while the horizontal line at y 1.5 passes both.
+  Scene scene;
+  for (double z : {5.0, 10.0}) {
+    vislib_test::add_quad(scene, {-50, -50, z}, {50, -50, z}, {50, 1.4, z}, {-50, 1.4, z});
+    vislib_test::add_quad(scene, {-50, 1.6, z}, {50, 1.6, z}, {50, 50, z}, {-50, 50, z});
+  }
+  const uint32_t target = uint32_t(scene.triangle_count());
+  vislib_test::add_quad(scene, {-2, 1.3, 20}, {2, 1.3, 20}, {2, 1.7, 20}, {-2, 1.7, 20});
+  // The oracle: an eye inside the band sees the target.
+  const OracleSample hit = brute_force_first_hit(scene, 0, {0.3, 1.5, 0}, {0, 0, 1}, 1e-3);
+  ASSERT_FALSE(hit.ambiguous);
+  ASSERT_TRUE(hit.tri == target || hit.tri == target + 1);
+
+  Box3 box;
+  box.extend({-1, 0, -1});
+  box.extend({1, 3, 1});
+  ViewCells cells = grid_cells(box, 1, 1, 1, EyeBand{1, 2});
+  RegionOptions o;
+  o.segment.resolution = 128;
+  o.runs = 1;
+  o.seed = 3;
+  auto sees_target = [&](const CellVisibility& v) {
+    return std::binary_search(v.triangles.begin(), v.triangles.end(), target) ||
+           std::binary_search(v.triangles.begin(), v.triangles.end(), target + 1);
+  };
+  const CellVisibility two = cell_visibility(scene, cells, 0, o);
+  EXPECT_FALSE(sees_target(two)) << "the bottom and top perimeters see through both slits";
+  EXPECT_EQ(two.segments.size(), 8u);
+  cells.band_levels = 3;
+  const CellVisibility three = cell_visibility(scene, cells, 0, o);
+  EXPECT_TRUE(sees_target(three));
+  ASSERT_EQ(three.segments.size(), 12u);
+  for (size_t k = 4; k < 8; ++k) {  // the middle rectangle, bottom first
+    EXPECT_EQ(three.segments[k].from.y, 1.5);
+    EXPECT_EQ(three.segments[k].to.y, 1.5);
+  }
+  // Everything the paper's rule sees is still seen (its segments are among these).
+  EXPECT_TRUE(std::includes(three.triangles.begin(), three.triangles.end(), two.triangles.begin(),
+                            two.triangles.end()));
+  // Placed cells record a choice other than the paper's.
+  CellPlacement p;
+  p.box = box;
+  p.grid = std::array<uint32_t, 3>{1, 1, 1};
+  p.eye = EyeBand{1, 2};
+  EXPECT_EQ(nlohmann::json::parse(place_view_cells(scene, p).description).count("band_levels"), 0u);
+  p.band_levels = 3;
+  const ViewCells placed = place_view_cells(scene, p);
+  EXPECT_EQ(placed.band_levels, 3);
+  EXPECT_EQ(nlohmann::json::parse(placed.description).at("band_levels"), 3);
 }

@@ -194,7 +194,8 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
   EXPECT_NE(out.find("enclosed by the scene"), std::string::npos) << out;
   ASSERT_NE(out.find('{'), std::string::npos) << out;
   json c = json::parse(out.substr(out.find('{')));
-  EXPECT_EQ(c["boundary_segments"].size(), 8u);
+  // Walkable cells: the perimeters of the band's bottom, middle and top (kWalkableBandLevels).
+  EXPECT_EQ(c["boundary_segments"].size(), 12u);
   EXPECT_GT(c["visible_count"].get<int>(), 0);
   EXPECT_EQ(c["visible"].size(), c["visible_count"].get<size_t>());
   vislib::Scene exported = vislib::load_scene(glb);

@@ -17,20 +17,32 @@ namespace vislib {
 
 namespace {
 
-// The bottom and top rectangles of a view region (the bottom alone when it is flat in y).
-std::vector<Box3> bottom_and_top(const Box3& region) {
-  Box3 bottom = region, top = region;
-  bottom.max.y = region.min.y;
-  top.min.y = region.max.y;
-  if (region.max.y > region.min.y) return {bottom, top};
-  return {bottom};
+// The rectangles of a view region at `levels` heights evenly spaced from its bottom to its top
+// (the bottom alone when it is flat in y).
+std::vector<Box3> band_rectangles(const Box3& region, int levels) {
+  assert(levels >= 2);
+  if (!(region.max.y > region.min.y)) {
+    Box3 bottom = region;
+    bottom.max.y = region.min.y;
+    return {bottom};
+  }
+  std::vector<Box3> out;
+  for (int k = 0; k < levels; ++k) {
+    Box3 r = region;
+    r.min.y = r.max.y = k == 0            ? region.min.y
+                        : k == levels - 1 ? region.max.y
+                                          : region.min.y + (region.max.y - region.min.y) *
+                                                               double(k) / double(levels - 1);
+    out.push_back(r);
+  }
+  return out;
 }
 
 }  // namespace
 
-std::vector<Segment> cell_boundary_segments(const Box3& view_region) {
+std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels) {
   std::vector<Segment> out;
-  for (const Box3& rect : bottom_and_top(view_region)) {
+  for (const Box3& rect : band_rectangles(view_region, levels)) {
     auto s = perimeter_segments(rect);
     out.insert(out.end(), s.begin(), s.end());
   }
@@ -41,8 +53,8 @@ uint64_t cell_seed(uint64_t seed, uint32_t cell) {
   return Rng::derive(seed, cell);
 }
 
-std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell) {
-  return bottom_and_top(to_box3(layout.view_region(cell)));
+std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell, int levels) {
+  return band_rectangles(to_box3(layout.view_region(cell)), levels);
 }
 
 namespace {
@@ -168,9 +180,11 @@ CellVisibility groups_visibility(const Scene& scene, const ViewCells* cells,
   return out;
 }
 
-std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout, uint32_t cell) {
+std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout, uint32_t cell,
+                                                   int levels = kPaperBandLevels) {
   std::vector<std::vector<Segment>> groups;
-  for (const Box3& rect : cell_rectangles(layout, cell)) groups.push_back(perimeter_segments(rect));
+  for (const Box3& rect : cell_rectangles(layout, cell, levels))
+    groups.push_back(perimeter_segments(rect));
   return groups;
 }
 
@@ -178,7 +192,7 @@ std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout
 
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell) {
   if (!cells.segments.empty()) return {cells.segments.at(cell)};
-  return rectangle_groups(cells.layout, cell);
+  return rectangle_groups(cells.layout, cell, cells.band_levels);
 }
 
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,

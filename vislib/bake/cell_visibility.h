@@ -19,10 +19,11 @@
 
 namespace vislib {
 
-// The segments a cell's visibility is computed on: the four sides of the view region's bottom
-// rectangle (y = min.y) then those of its top rectangle (y = max.y), each in the order of
-// perimeter_segments; only the four of the bottom when the region is flat in y.
-std::vector<Segment> cell_boundary_segments(const Box3& view_region);
+// The segments a box cell's visibility is computed on: the four sides of each rectangle of the
+// view region at `levels` (>= 2) heights evenly spaced from its bottom (y = min.y) to its top
+// (y = max.y), bottom first, each in the order of perimeter_segments; only the four of the bottom
+// when the region is flat in y. The paper's rule is the bottom and the top (kPaperBandLevels).
+std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels = kPaperBandLevels);
 
 // Seed of cell `cell`'s runs for a bake seeded `seed`; the bottom rectangle's runs use
 // Rng::derive(cell_seed, 0), the top's Rng::derive(cell_seed, 1).
@@ -35,14 +36,15 @@ struct CellVisibility {
   double seconds = 0;               // kernel seconds
 };
 
-// The rectangles whose perimeters cell_visibility runs: the bottom and top of the cell's view
-// region (one when the region is flat in y).
-std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell);
+// The rectangles whose perimeters cell_visibility runs: those of cell_boundary_segments (the
+// bottom and top of the cell's view region, and levels - 2 between; one when it is flat in y).
+std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell,
+                                  int levels = kPaperBandLevels);
 
 // The segments cell `cell`'s visibility is computed on, in groups: group g's runs are seeded
 // Rng::derive(cell_seed(seed, cell), g) (segments_visibility). Cells with their own segments
 // (cells.segments not empty): cells.segments[cell], one group. Otherwise the perimeter segments
-// of each of cell_rectangles(cells.layout, cell), one group per rectangle.
+// of each of cell_rectangles(cells.layout, cell, cells.band_levels), one group per rectangle.
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell);
 
 // Visible triangles of cell `cell` of `layout` (a grid or box list: BSP leaf cells carry their

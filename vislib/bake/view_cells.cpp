@@ -323,7 +323,22 @@ ViewCells walkable_cells(const Scene& scene, const WalkableOptions& options) {
   return cells;
 }
 
-ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
+namespace {
+
+// Placed cells whose runs are the perimeters of their eye band at `levels` heights; a choice other
+// than the paper's is recorded in the description ("band_levels").
+ViewCells with_band_levels(ViewCells cells, int levels) {
+  assert(levels >= kPaperBandLevels);
+  cells.band_levels = levels;
+  if (levels != kPaperBandLevels) {
+    nlohmann::json d = nlohmann::json::parse(cells.description);
+    d["band_levels"] = levels;
+    cells.description = d.dump();
+  }
+  return cells;
+}
+
+ViewCells placed_cells(const Scene& scene, const CellPlacement& p) {
   const std::optional<Box3>& box = p.box;
   if (p.walkable) {
     if (p.grid)
@@ -372,6 +387,23 @@ ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
   if (count > kMaxPlacedCells)
     throw PlacementError(PlacementProblem::TooManySizedCells, "more than 10^7 grid cells");
   return grid_cells_by_size(*box, p.cell_size, p.eye);
+}
+
+}  // namespace
+
+ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
+  return with_band_levels(
+      placed_cells(scene, p),
+      p.band_levels.value_or(p.walkable ? kWalkableBandLevels : kPaperBandLevels));
+}
+
+int band_levels_of(const std::string& metadata) {
+  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
+  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return kPaperBandLevels;
+  const auto k = md["cells"].find("band_levels");
+  if (k == md["cells"].end() || !k->is_number_integer()) return kPaperBandLevels;
+  const int64_t levels = k->get<int64_t>();
+  return levels >= kPaperBandLevels && levels <= kMaxBandLevels ? int(levels) : kPaperBandLevels;
 }
 
 }  // namespace vislib
