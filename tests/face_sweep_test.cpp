@@ -50,7 +50,7 @@ struct FakeScene {
   std::function<std::vector<uint32_t>(double)> see;
   std::vector<std::vector<double>> rounds;
   ChordRound round() {
-    return [this](const std::vector<Segment>& chords) {
+    return [this](const std::vector<Segment>& chords, const std::vector<size_t>&) {
       rounds.emplace_back();
       std::vector<std::vector<uint32_t>> out;
       for (const Segment& c : chords) {
@@ -66,7 +66,7 @@ struct FakeScene {
 // probe between each two neighbours, and stops: far fewer than an even sweep at the floor.
 TEST(FaceSweep, AdaptiveSweepOverAFlatWallStopsAfterTheFirstProbes) {
   FakeScene flat{[](double) { return std::vector<uint32_t>{1, 2}; }, {}};
-  const size_t run = adaptive_sweep({wide()}, {32, 4}, {1, 2}, kSweepMinChord, flat.round());
+  const size_t run = adaptive_sweep({wide()}, {32, 4}, {{1, 2}}, kSweepMinChord, flat.round());
   ASSERT_EQ(flat.rounds.size(), 2u);
   EXPECT_EQ(flat.rounds[0].size(), 3u);  // ceil(100 / 32) = 4 intervals: 3 coarse chords
   EXPECT_EQ(flat.rounds[1].size(), 4u);  // one probe in each interval
@@ -87,7 +87,7 @@ TEST(FaceSweep, AdaptiveSweepInsertsChordsWhereTheSetChangesAndFindsASlit) {
   };
   auto found_slit = [&](const AdaptiveSpacing& spacing, size_t* runs) {
     FakeScene scene{see, {}};
-    *runs = adaptive_sweep({wide()}, spacing, {1}, kSweepMinChord, scene.round());
+    *runs = adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, scene.round());
     std::set<double> all;
     for (const auto& r : scene.rounds) all.insert(r.begin(), r.end());
     bool slit = false;

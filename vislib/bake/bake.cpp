@@ -220,6 +220,10 @@ void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const Vi
     if (!in_shard(c, shard) || recovered[c]) continue;
     for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
       for (const Segment& s : g) shared_runs.expect(s.from, s.to, s.side_normal);
+    // A portal's adaptive chords, the same for both of its leaves: one user per leaf computed.
+    if (!cells.sweeps.empty())
+      for (const FaceSweep& f : cells.sweeps[c])
+        if (!(f.side_normal == Vec3{0, 0, 0})) shared_runs.expect_family(sweep_family_key(f));
   }
   // The pilot's runs of the chosen L are runs of this bake: not computed again.
   for (LongSegmentChoice::Run& run : report.long_segment_choice.runs)

@@ -12,6 +12,7 @@
 #include "vislib/base/cubemap.h"
 #include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
+#include "vislib/kernel/segment_run_cache.h"
 
 namespace vislib {
 
@@ -39,6 +40,11 @@ std::vector<Box3> band_rectangles(const Box3& region, int levels) {
 }
 
 }  // namespace
+
+SegmentRunCache::Key sweep_family_key(const FaceSweep& sweep) {
+  assert(sweep.face.size() >= 2);
+  return SegmentRunCache::key_of(sweep.face[0], sweep.face[1], sweep.side_normal);
+}
 
 std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels) {
   std::vector<Segment> out;
@@ -100,8 +106,10 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   double done_before = 0;
   double share = (adaptive ? kFixedShare : 1.0) / double(std::max<size_t>(1, fixed));
   bool wanted = true;
-  auto run_group = [&](const std::vector<Segment>& segs, size_t g) {
-    const RegionOptions o = group_options(options, seed, g);
+  auto run_group = [&](const std::vector<Segment>& segs, size_t g,
+                       std::vector<uint32_t> users = {}) {
+    RegionOptions o = group_options(options, seed, g);
+    o.segment_users = std::move(users);
     std::function<void(size_t, size_t)> run_done;
     if (progress)
       run_done = [&](size_t done, size_t total) {
@@ -112,7 +120,6 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     wanted = consume(segs, rr, o) && wanted;
     return rr;
   };
-  std::vector<uint32_t> base;
   const uint32_t tris = uint32_t(scene.triangle_count());
   auto ids_of_run = [&](const RunRecord& r, std::vector<uint32_t>& out) {
     std::vector<uint32_t> run = r.visible, merged;  // triangles, then spheres: sorted
@@ -120,19 +127,85 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     std::set_union(out.begin(), out.end(), run.begin(), run.end(), std::back_inserter(merged));
     out = std::move(merged);
   };
+  // A portal's sweep (sided: both of its leaves sweep it) is judged by what run 0 sees on both
+  // sides (side 0's triangle ids, then side 1's offset by the id count), from a base of what its
+  // polygon's edges see so, so that both leaves insert the same chords and the second takes the
+  // first's runs from the cache (sweep_family_key, SegmentRunCache::expect_family).
+  static const std::vector<FaceSweep> kNoSweeps;
+  const std::vector<FaceSweep>& sweeps = adaptive ? cells->sweeps[cell] : kNoSweeps;
+  std::vector<std::vector<uint32_t>> bases(sweeps.size());
+  std::vector<uint32_t> users(sweeps.size(), 0);
+  bool any_sided = false;
+  for (size_t f = 0; f < sweeps.size(); ++f) {
+    const bool sided = !(sweeps[f].side_normal == Vec3{0, 0, 0});
+    any_sided = any_sided || sided;
+    if (sided && options.shared_runs)
+      users[f] = options.shared_runs->family_users(sweep_family_key(sweeps[f]));
+  }
+  const uint32_t ids = tris + uint32_t(scene.sphere_count());
+  auto both_sides = [&](const RunRecord& r, int side, std::vector<uint32_t>& out) {
+    const std::vector<uint32_t>& s0 = side == 0 ? r.visible : r.visible_other_side;
+    const std::vector<uint32_t>& s1 = side == 0 ? r.visible_other_side : r.visible;
+    std::vector<uint32_t> run = s0, merged;
+    for (uint32_t t : s1) run.push_back(ids + t);
+    std::set_union(out.begin(), out.end(), run.begin(), run.end(), std::back_inserter(merged));
+    out = std::move(merged);
+  };
+  // The runs that judge: `rr`, or with witnesses (whose sided runs keep their own side only) run 0
+  // of `segs` again without them.
+  std::vector<RunRecord> rerun;
+  auto judging = [&](const std::vector<Segment>& segs,
+                     const RegionResult& rr) -> const std::vector<RunRecord>& {
+    if (!(any_sided && options.segment.want_witnesses)) return rr.runs;
+    RegionOptions o = options;
+    o.segment.want_witnesses = false;
+    o.runs = 1;
+    o.shared_runs = nullptr;
+    rerun = segments_visibility(scene, segs, o).runs;
+    return rerun;
+  };
+  // Whether segment `s` is an edge of the sweep's polygon (bit for bit: both are made from the
+  // same points).
+  auto edge_of = [](const Segment& s, const FaceSweep& f) {
+    bool from = false, to = false;
+    for (const Vec3& v : f.face) {
+      from = from || v == s.from;
+      to = to || v == s.to;
+    }
+    return from && to && s.side_normal == f.side_normal;
+  };
+  std::vector<uint32_t> base;
   for (size_t g = 0; g < fixed && (wanted || adaptive); ++g) {
     const RegionResult rr = run_group(groups[g], g);
-    if (adaptive)
-      for (const RunRecord& r : rr.runs) ids_of_run(r, base);
+    if (!adaptive) continue;
+    for (const RunRecord& r : rr.runs) ids_of_run(r, base);
+    if (!any_sided) continue;
+    for (const RunRecord& r : judging(groups[g], rr)) {
+      const Segment& s = groups[g].at(r.segment);
+      if (r.run != 0 || s.side_normal == Vec3{0, 0, 0}) continue;
+      for (size_t f = 0; f < sweeps.size(); ++f)
+        if (edge_of(s, sweeps[f])) both_sides(r, s.side, bases[f]);
+    }
   }
   if (!adaptive) return;
+  for (size_t f = 0; f < sweeps.size(); ++f)
+    if (sweeps[f].side_normal == Vec3{0, 0, 0}) bases[f] = base;
   size_t round = 0;
-  adaptive_sweep(cells->sweeps[cell], cells->sweep_spacing, base, kSweepMinChord,
-                 [&](const std::vector<Segment>& segs) {
+  adaptive_sweep(sweeps, cells->sweep_spacing, bases, kSweepMinChord,
+                 [&](const std::vector<Segment>& segs, const std::vector<size_t>& sweep_of) {
                    share = (1.0 - done_before) * kRoundShare;
-                   const RegionResult rr = run_group(segs, fixed + round++);
+                   std::vector<uint32_t> segment_users(segs.size());
+                   for (size_t i = 0; i < segs.size(); ++i) segment_users[i] = users[sweep_of[i]];
+                   const RegionResult rr =
+                       run_group(segs, fixed + round++, std::move(segment_users));
                    std::vector<std::vector<uint32_t>> seen(segs.size());
-                   for (const RunRecord& r : rr.runs) ids_of_run(r, seen.at(r.segment));
+                   for (const RunRecord& r : judging(segs, rr)) {
+                     const Segment& s = segs.at(r.segment);
+                     if (s.side_normal == Vec3{0, 0, 0})
+                       ids_of_run(r, seen[r.segment]);
+                     else if (r.run == 0)
+                       both_sides(r, s.side, seen[r.segment]);
+                   }
                    return seen;
                  });
 }

@@ -15,6 +15,7 @@
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/vec.h"
 #include "vislib/kernel/region_visibility.h"
+#include "vislib/kernel/segment_run_cache.h"
 #include "vislib/scene/scene.h"
 
 namespace vislib {
@@ -24,6 +25,12 @@ namespace vislib {
 // (y = max.y), bottom first, each in the order of perimeter_segments; only the four of the bottom
 // when the region is flat in y. The paper's rule is the bottom and the top (kPaperBandLevels).
 std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels = kPaperBandLevels);
+
+// The family of runs of a portal's adaptive sweep (SegmentRunCache::expect_family): its chords
+// are the same for both of its leaves (run_cell_groups judges them by both sides), so a bake
+// registers one user per leaf it computes. The key of the sweep's first polygon edge and its
+// side normal (the same FaceSweep but for `side` on both leaves).
+SegmentRunCache::Key sweep_family_key(const FaceSweep& sweep);
 
 // Seed of cell `cell`'s runs for a bake seeded `seed`; the bottom rectangle's runs use
 // Rng::derive(cell_seed, 0), the top's Rng::derive(cell_seed, 1).

@@ -82,12 +82,14 @@ std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double 
 }
 
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
-                      const std::vector<uint32_t>& base, double min_length,
+                      const std::vector<std::vector<uint32_t>>& bases, double min_length,
                       const ChordRound& run_round) {
   assert(spacing.floor > 0 && spacing.floor <= spacing.coarse);
-  // Every position's set, by index (0: `base`, what a face's extreme positions and a degenerate
-  // chord see); an open interval is one whose midpoint the next round probes.
-  std::vector<std::vector<uint32_t>> sets = {base};
+  assert(bases.size() == sweeps.size());
+  // Every position's set, by index (f < sweeps.size(): face f's base, what its extreme positions
+  // and a degenerate chord of it see); an open interval is one whose midpoint the next round
+  // probes.
+  std::vector<std::vector<uint32_t>> sets = bases;
   struct Interval {
     size_t face;
     double a, b;
@@ -107,19 +109,23 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     for (int k = 0; k <= steps; ++k) grid[f].push_back(even_position(sweeps[f], k, steps));
     for (int k = 1; k < steps; ++k) probes.push_back({f, grid[f][size_t(k)]});
   }
-  // Runs `probes` as one round; returns the set index of each (0 for a degenerate chord).
+  // Runs `probes` as one round; returns the set index of each (its face's base for a degenerate
+  // chord).
   size_t run = 0;
   auto run_probes = [&]() {
     std::vector<Segment> segs;
-    std::vector<size_t> which;
-    for (size_t i = 0; i < probes.size(); ++i)
+    std::vector<size_t> which, sweep_of;
+    std::vector<size_t> index(probes.size());
+    for (size_t i = 0; i < probes.size(); ++i) {
+      index[i] = probes[i].face;
       if (auto c = face_chord(sweeps[probes[i].face], probes[i].h, min_length)) {
         segs.push_back(*c);
         which.push_back(i);
+        sweep_of.push_back(probes[i].face);
       }
-    std::vector<size_t> index(probes.size(), 0);
+    }
     if (segs.empty()) return index;
-    std::vector<std::vector<uint32_t>> seen = run_round(segs);
+    std::vector<std::vector<uint32_t>> seen = run_round(segs, sweep_of);
     assert(seen.size() == segs.size());
     run += segs.size();
     for (size_t j = 0; j < which.size(); ++j) {
@@ -132,7 +138,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     const std::vector<size_t> index = run_probes();
     size_t p = 0;
     for (size_t f = 0; f < sweeps.size(); ++f) {
-      std::vector<size_t> at(grid[f].size(), 0);
+      std::vector<size_t> at(grid[f].size(), f);
       for (size_t k = 1; k + 1 < grid[f].size(); ++k) at[k] = index[p++];
       for (size_t k = 0; k + 1 < grid[f].size(); ++k)
         if (grid[f][k + 1] - grid[f][k] > spacing.floor)

@@ -53,7 +53,7 @@ std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double 
 
 // The spacings of the adaptive sweep (the sweeps' units): the first chords lie at most `coarse`
 // apart (the even sweep's positions); a chord is inserted midway between two neighbours (a face's
-// own extreme positions count as neighbours that see `base`, below) whose distance is larger
+// own extreme positions count as neighbours that see its base, below) whose distance is larger
 // than `floor`, and kept on the grid of halvings, while the last one inserted there saw an id
 // that neither neighbour saw. 0 < floor <= coarse.
 struct AdaptiveSpacing {
@@ -61,18 +61,21 @@ struct AdaptiveSpacing {
   double floor = 4;
 };
 
-// Sees one round of chords: `chords` (run as one group of segments) and, for each chord, the
-// sorted ids it saw (triangles, then spheres offset by the triangle count: any sorted id space
-// does). Called once per round, in round order; returns the per-chord sets.
-using ChordRound = std::function<std::vector<std::vector<uint32_t>>(const std::vector<Segment>&)>;
+// Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
+// sweep each lies on, and returns for each chord the sorted ids it saw (any sorted id space does:
+// triangles, then spheres offset by the triangle count, say). Called once per round, in round
+// order.
+using ChordRound = std::function<std::vector<std::vector<uint32_t>>(
+    const std::vector<Segment>& chords, const std::vector<size_t>& sweep_of)>;
 
 // Runs the adaptive sweep of `sweeps` together, round by round: round 0 holds every face's even
 // chords at `spacing.coarse`, round r + 1 the midpoints of the intervals that round r (or, for
-// round 1, the coarse grid with its ends) left open. `base` (sorted) is what the face's extreme
-// positions see (the region's edges). Deterministic: the chords of each round are in face order,
-// then increasing position. Returns the number of chords run.
+// round 1, the coarse grid with its ends) left open. `bases[f]` (sorted; one per sweep) is what
+// face f's extreme positions see (the region's edges, say). A face's chords depend only on it,
+// its base and what its own chords see. Deterministic: the chords of each round are in face
+// order, then increasing position. Returns the number of chords run.
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
-                      const std::vector<uint32_t>& base, double min_length,
+                      const std::vector<std::vector<uint32_t>>& bases, double min_length,
                       const ChordRound& run_round);
 
 }  // namespace vislib

@@ -89,14 +89,19 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
               o.splits = splits;
               return segment_visibility(scene, a, b, o);
             },
-            &computed, seg.side_normal);
+            &computed, seg.side_normal,
+            options.segment_users.empty() ? 0 : options.segment_users.at(s));
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;
       } else {
         PhaseScope running(Phase::Run);
         sr = segment_visibility(scene, seg.from, seg.to, so);
       }
-      if (sided && !witnesses) sr.visible = std::move(sr.visible_sides.at(size_t(seg.side)));
+      std::vector<uint32_t> other_side;
+      if (sided && !witnesses) {
+        other_side = std::move(sr.visible_sides.at(size_t(1 - seg.side)));
+        sr.visible = std::move(sr.visible_sides.at(size_t(seg.side)));
+      }
       PhaseScope merging(Phase::Merge);
       if (witnesses) {
         // sr.witnesses: one per visible triangle (id order), then one per visible sphere.
@@ -133,6 +138,7 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       rec.orientation = so.orientation;
       rec.visible = std::move(sr.visible);
       rec.visible_spheres = std::move(sr.visible_spheres);
+      rec.visible_other_side = std::move(other_side);
       rec.stats = sr.stats;
       rec.union_size_after = union_size;
       rec.seconds_after = result.seconds;

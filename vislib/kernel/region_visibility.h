@@ -49,6 +49,10 @@ struct RegionOptions {
   // regions using the same options (segment_run_cache.h; the bake shares cells' common edges).
   // A run served from the cache counts 0 kernel seconds. Not part of the result's identity.
   SegmentRunCache* shared_runs = nullptr;
+  // Empty, or one per segment: with shared_runs, run 0 of a segment not announced to it is kept
+  // for this many users in all when > 1 (SegmentRunCache::get's `users`: the two leaves of a
+  // portal, whose adaptive chords are the same for both).
+  std::vector<uint32_t> segment_users;
 };
 
 struct RunRecord {
@@ -57,6 +61,9 @@ struct RunRecord {
   Mat3 orientation;
   std::vector<uint32_t> visible;          // triangle ids of this run
   std::vector<uint32_t> visible_spheres;  // sphere indices of this run
+  // A run split by a plane (Segment::side_normal) without witnesses: the triangle ids of the
+  // other side's directions (`visible` holds the segment's own side); empty otherwise.
+  std::vector<uint32_t> visible_other_side;
   SegmentStats stats;
   size_t union_size_after = 0;  // triangles in the union after this run
   double seconds_after = 0;     // cumulative kernel seconds after this run

@@ -174,11 +174,33 @@ void SegmentRunCache::provide(Vec3 from, Vec3 to, const std::vector<double>& spl
   }
 }
 
+void SegmentRunCache::expect_family(const Key& family) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  ++family_users_[family];
+}
+
+uint32_t SegmentRunCache::family_users(const Key& family) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const auto it = family_users_.find(family);
+  return it == family_users_.end() ? 0 : it->second;
+}
+
 std::shared_ptr<const SegmentResult> SegmentRunCache::get(Vec3 from, Vec3 to, const RunFn& compute,
-                                                          bool* computed, Vec3 side_normal) {
+                                                          bool* computed, Vec3 side_normal,
+                                                          uint32_t users) {
   if (computed) *computed = true;
   std::unique_lock<std::mutex> lock(mutex_);
-  auto ref = chain_of_.find(key_of(from, to, side_normal));
+  const Key key = key_of(from, to, side_normal);
+  auto ref = chain_of_.find(key);
+  if (ref == chain_of_.end() && users > 1) {
+    // The first use of a family's run: announced now for all of its users.
+    Chain c;
+    c.from = from;
+    c.to = to;
+    c.remaining.assign(1, users);
+    ref = chain_of_.emplace(key, ChainRef{uint32_t(chains_.size()), 0}).first;
+    chains_.push_back(std::move(c));
+  }
   if (ref == chain_of_.end()) {
     // Never announced: nothing to share.
     lock.unlock();

@@ -23,6 +23,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <exception>
 #include <functional>
 #include <map>
@@ -50,6 +51,10 @@ std::vector<double> chain_splits(const std::vector<SegmentEnds>& stretch, size_t
 
 class SegmentRunCache {
  public:
+  // What identifies a run: the bits of from, to and the side normal (runs match them exactly).
+  using Key = std::array<uint64_t, 9>;
+  static Key key_of(Vec3 from, Vec3 to, Vec3 side_normal = {0, 0, 0});
+
   // Computes the world-aligned run on (from, to), split at `splits` when not empty.
   using RunFn = std::function<SegmentResult(Vec3 from, Vec3 to, const std::vector<double>& splits)>;
 
@@ -65,15 +70,25 @@ class SegmentRunCache {
   // holds both sides, each user takes its own). Not thread-safe with get().
   void expect(Vec3 from, Vec3 to, Vec3 side_normal = {0, 0, 0});
 
+  // Registers one future user of a family of runs not known in advance (a portal's adaptive
+  // chords, face_sweep.h: both of its leaves choose the same chords from the same runs), by the
+  // family's key (key_of of any two points and the normal that identify it). Not thread-safe
+  // with get().
+  void expect_family(const Key& family);
+  // How many users of `family` were registered (0: none).
+  uint32_t family_users(const Key& family) const;
+
   // The result of the world-aligned run on (from, to): `compute` runs on the first call
   // (tbb::collaborative_call_once: isolated, so that the computing thread never picks up a task
   // that waits for this very entry; concurrent callers for the same run join its parallel work
   // instead of waiting idle), later callers get the stored result. A segment of a planned chain
   // gets its part of the chain's run. `*computed` says whether this call ran compute(). A use that
-  // was not announced is computed and not stored. An exception from compute() reaches every caller.
-  // `side_normal` as for expect().
+  // was not announced is computed and not stored, unless `users` > 1: then it is announced by this
+  // call as used `users` times in all (a run of a family, family_users), and kept for the others.
+  // An exception from compute() reaches every caller. `side_normal` as for expect().
   std::shared_ptr<const SegmentResult> get(Vec3 from, Vec3 to, const RunFn& compute,
-                                           bool* computed = nullptr, Vec3 side_normal = {0, 0, 0});
+                                           bool* computed = nullptr, Vec3 side_normal = {0, 0, 0},
+                                           uint32_t users = 0);
 
   // Hands the cache a run computed elsewhere (the pilot of --long-segments auto): `whole`, the
   // result of compute(from, to, splits), for the planned chain from `from` to `to` with these
@@ -90,10 +105,6 @@ class SegmentRunCache {
   double wait_seconds() const { return 1e-9 * double(wait_ns_.load()); }
   size_t entries_held() const;  // results awaiting a later use
   size_t chains_planned() const { return planned_; }
-
-  // What identifies a run: the bits of from, to and the side normal (runs match them exactly).
-  using Key = std::array<uint64_t, 9>;
-  static Key key_of(Vec3 from, Vec3 to, Vec3 side_normal = {0, 0, 0});
 
  private:
   using Parts = std::vector<std::shared_ptr<const SegmentResult>>;
@@ -120,9 +131,10 @@ class SegmentRunCache {
   static std::shared_ptr<Parts> split_parts(SegmentResult whole, bool split);
 
   mutable std::mutex mutex_;
-  std::vector<Chain> chains_;
+  std::deque<Chain> chains_;          // a deque: get() appends while others hold references
   std::map<Key, ChainRef> chain_of_;  // every segment announced or planned
   size_t planned_ = 0;                // chains of two or more segments
+  std::map<Key, uint32_t> family_users_;
   std::atomic<uint64_t> computed_{0}, shared_{0}, wait_ns_{0};
 };
 
