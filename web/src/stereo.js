@@ -6,25 +6,31 @@
 //  - eyes: at -+ IPD/2 along the view's right vector, parallel, the same symmetric frustum
 //    (stereo_pair without toe-in or shift); vertical field of view `fov` (default 90, as pvs
 //    view), near plane 0.01 (kDefaultNear);
-//  - reprojection (reproject_exact): one point per source pixel; its world point from the depth
-//    buffer through the inverse view-projection (a background pixel is a direction: it keeps its
-//    direction), projected with the full perspective divide into the other eye and splatted onto
-//    the pixel whose centre is nearest; the nearest view depth wins (a z-buffer), nothing is
-//    written into a hole, so a background sample landing in a gap is kept (holes not poisoned);
+//  - reprojection (reproject_exact's splatting): each source sample goes to the target pixel whose
+//    centre is nearest, the nearest view depth wins (a z-buffer), nothing is written into a hole,
+//    so a background sample landing in a gap is kept (holes not poisoned); `reproject=mesh`
+//    (default; parallel eyes) warps the source as a grid of cells and gathers exactly only around
+//    the edges between surfaces (MESH_VS), `gather` (parallel eyes) gathers every pixel
+//    (GATHER_FS), `points` splats one point per source pixel, its world point from the depth
+//    buffer through the inverse view-projection (a background pixel is a direction), projected
+//    with the full perspective divide into the other eye (any pair of cameras);
 //  - patchers (`patch=`): `yoro` (patch_yoro: Alg. 3 with Eq. 6 fixed: the kernel starts at the
 //    hole run's farther filled end and walks away from the hole, nearest column first, 3 rows,
 //    skipping foreground samples nearer than the edge by more than 5%; weights rem (1/2 + 0.3 t),
-//    t = |u - e| / run width; runs longer than kMaxRun or with no filled end are left to `median`'s
-//    rule: the nearest filled pixel of the row), `render` (the holes only, drawn from the
+//    t = |u - e| / run width, stopped once the weight left is below 2^-10 (the columns after it
+//    move no channel by a quarter step); runs longer than kMaxRun or with no filled end are left
+//    to `median`'s rule: the nearest filled pixel of the row), `render` (the holes only, drawn from the
 //    target eye under a stencil of the filled pixels: the GPU counterpart of `rays`, which re-casts
 //    only the hole pixels), `none` (holes stay black).
 // Per frame (window.viewer.step(i)) the page also renders both eyes (two renders) and both eyes in
 // one OVR_multiview2 pass, and times the three, each `reps` times (the record's ms_* are medians),
-// and measures the produced eye against the true render of that eye: PSNR, pixels off by more
-// than 8 steps, hole pixels before patching.
+// the passes of single-render stereo alone (one render, reprojection, patch) and a full-screen copy
+// (the least a pass writing every target pixel costs), and measures the produced eye against the
+// true render of that eye: PSNR, pixels off by more than 8 steps, hole pixels before patching.
 //
 // URL parameters: size=WxH (an eye), fov, ipd (metres, default 0.064), upm, dominant=left|right
-// (default left), patch=yoro|render|none (default yoro), reps=N, plus scene, pvs, path (points
+// (default left), patch=yoro|render|none (default yoro), reproject=mesh|gather|points (default
+// mesh), reps=N, plus scene, pvs, path (points
 // EYE@LOOK: EYE is the point between the eyes) and overlay=0.
 import {parsePath, vec3} from "./path.js";
 import {loadScene, diagonal} from "./scene_load.js";
