@@ -9,7 +9,7 @@
 #                     [--shading reference|materials] [--popping K] [--near-far r1,r2 [--centre x,y,z] [--env-size N]
 #                      [--lookup eye|cylinder] [--clovr]] [--prefetch MARGIN]
 #                     [--mode ods|stereo] [--ods-size W] [--ipd M] [--units-per-metre S]
-#                     [--pole-merge s,e,x[:s,e,x]] [--tessellation dynamic|K] [--reps N]
+#                     [--pole-merge s,e,x[:s,e,x]] [--tessellation dynamic|K] [--tess-segment DEG] [--reps N]
 #                     [--dominant left|right] [--patch yoro|render|none] [--reproject gather|points]
 #                     [--reference IMG]
 # --mode ods: each path point is the centre of an ODS pair (WebGPU; docs/web.md): the PNGs are
@@ -73,6 +73,7 @@ while [[ $# -gt 0 ]]; do
     --units-per-metre) extra+="&upm=$2" ;;
     --pole-merge) extra+="&polemerge=$2" ;;
     --tessellation) extra+="&tess=$2" ;;
+    --tess-segment) extra+="&tessdeg=$2" ;;
     --reps) extra+="&reps=$2" ;;
     --dominant) extra+="&dominant=$2" ;;
     --patch) extra+="&patch=$2" ;;

@@ -13,7 +13,7 @@
 import {objectColour} from "./glb.js";
 import {parsePath, vec3} from "./path.js";
 import {loadScene} from "./scene_load.js";
-import {OdsGpu, odsDevice} from "./ods_gpu.js";
+import {ALG1_PAPER, OdsGpu, odsDevice} from "./ods_gpu.js";
 
 // pvs view's --pole-merge syntax: "s,e,x" for both poles or "s,e,x:s,e,x" top:bottom.
 export function parsePoleMerge(text) {
@@ -99,7 +99,9 @@ export class OdsViewer {
     if (!(ipdM >= 0 && upm > 0)) throw new Error("ipd=M >= 0 and upm=S > 0");
     const tess = params.get("tess") || "dynamic";
     this.settings = {ipd: ipdM * upm, merge: parsePoleMerge(params.get("polemerge")),
-                     tessellation: tess === "dynamic" ? 0 : Number(tess)};
+                     tessellation: tess === "dynamic" ? 0 : Number(tess),
+                     alg1: {...ALG1_PAPER, segment: Number(params.get("tessdeg") || ALG1_PAPER.segment)}};
+    if (!(this.settings.alg1.segment > 0)) throw new Error("tessdeg=DEG > 0");
     this.tessName = tess;
     this.reps = Number(params.get("reps") || 0);
     Object.assign(this, await loadScene(params));
@@ -190,6 +192,7 @@ export class OdsViewer {
                  disc_in_cell_view_region: this.disc.inRegion, triangles_drawn: this.disc.ids.length,
                  triangles_total: this.total, small_triangle_slots: r.slots,
                  inside_circle: r.inside_circle, ms, ms_reps: times, tessellation: this.tessName,
+                 tess_segment_deg: this.settings.alg1.segment,
                  ods_size: [this.width, this.width / 2], ipd: this.settings.ipd,
                  bytes_fetched: this.disc.bytes, range_requests: this.disc.requests, adapter: this.adapter};
     this.showOverlay(rec);

@@ -33,6 +33,10 @@
 
 import {diagonal} from "./scene_load.js";
 
+// Alg. 1's constants as the paper gives them (degrees): a segment per 8 degrees of projected edge,
+// the pole multiplier max(2.8284 / 90 * |lat|, 1), at most 64 segments an edge.
+export const ALG1_PAPER = {segment: 8, poleSlope: 2.8284 / 90, maxLevel: 64};
+
 const WGSL_COMMON = /* wgsl */ `
 const PI = 3.14159265358979;
 struct Params {
@@ -41,6 +45,7 @@ struct Params {
   bottom: vec4f,   // the same for the bottom pole
   count: u32, staticLevel: u32, eye: f32, capacity: u32,
   width: f32, height: f32, rowOffset: f32, maxRange: f32,
+  tess: vec4f,     // Alg. 1's constants: target segment (degrees), pole multiplier's slope, max level
 };
 @group(0) @binding(0) var<uniform> P: Params;
 @group(0) @binding(1) var<storage, read> pos: array<f32>;
@@ -96,9 +101,9 @@ fn edgeLevel(a: vec2f, b: vec2f, mid: vec2f) -> f32 {
   let dlat = max(abs(a.y - b.y), max(abs(a.y - mid.y), abs(b.y - mid.y))) * k;
   let maxLat = max(abs(a.y), max(abs(b.y), abs(mid.y))) * k;
   let edge = sqrt(dlon * dlon + 0.25 * dlat * dlat);
-  let dd = max(0.125 * edge, 1.0);
-  let pole = max((2.8284 / 90.0) * maxLat, 1.0);
-  return min(pole * dd, 64.0);
+  let dd = max(edge / P.tess.x, 1.0);
+  let pole = max(P.tess.y * maxLat, 1.0);
+  return min(pole * dd, P.tess.z);
 }
 fn ll(d: vec3f) -> vec2f { return vec2f(lonOf(d), latOf(d)); }
 
@@ -372,7 +377,7 @@ export class OdsGpu {
     this.pos = storage(scene.positions);
     this.colours = storage(colours);
     this.maxRange = 4 * diagonal(scene.positions) + 1;  // > any range from a centre near the scene
-    this.params = [0, 1].map(() => d.createBuffer({size: 80, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST}));
+    this.params = [0, 1].map(() => d.createBuffer({size: 96, usage: GPUBufferUsage.UNIFORM | GPUBufferUsage.COPY_DST}));
     this.draw = d.createBuffer({size: 32, usage: GPUBufferUsage.STORAGE | GPUBufferUsage.INDIRECT | GPUBufferUsage.COPY_SRC | GPUBufferUsage.COPY_DST});
     this.drawRead = d.createBuffer({size: 32, usage: GPUBufferUsage.MAP_READ | GPUBufferUsage.COPY_DST});
     const module = (code) => {
@@ -440,12 +445,14 @@ export class OdsGpu {
     if (!(level >= 0 && level <= 64)) throw new Error(`tessellation ${settings.tessellation}: 0 (dynamic) or 1..64`);
     const merge = settings.merge || {};
     for (let eye = 0; eye < 2; ++eye) {
-      const buf = new ArrayBuffer(80), f = new Float32Array(buf), u = new Uint32Array(buf);
+      const buf = new ArrayBuffer(96), f = new Float32Array(buf), u = new Uint32Array(buf);
       f.set([centre[0], centre[1], centre[2], settings.ipd / 2], 0);
       f.set(sideParams(merge.top), 4);
       f.set(sideParams(merge.bottom), 8);
       u[12] = this.count; u[13] = level; f[14] = eye === 0 ? -1 : 1; u[15] = this.capacity;
       f.set([this.width, this.height, eye === 0 ? 0 : this.height, this.maxRange], 16);
+      const a = settings.alg1 || ALG1_PAPER;
+      f.set([a.segment, a.poleSlope, a.maxLevel, 0], 20);
       d.queue.writeBuffer(this.params[eye], 0, buf);
     }
     if (this.count === 0) {

@@ -6,25 +6,31 @@
 //  - eyes: at -+ IPD/2 along the view's right vector, parallel, the same symmetric frustum
 //    (stereo_pair without toe-in or shift); vertical field of view `fov` (default 90, as pvs
 //    view), near plane 0.01 (kDefaultNear);
-//  - reprojection (reproject_exact): one point per source pixel; its world point from the depth
-//    buffer through the inverse view-projection (a background pixel is a direction: it keeps its
-//    direction), projected with the full perspective divide into the other eye and splatted onto
-//    the pixel whose centre is nearest; the nearest view depth wins (a z-buffer), nothing is
-//    written into a hole, so a background sample landing in a gap is kept (holes not poisoned);
+//  - reprojection (reproject_exact's splatting): each source sample goes to the target pixel whose
+//    centre is nearest, the nearest view depth wins (a z-buffer), nothing is written into a hole,
+//    so a background sample landing in a gap is kept (holes not poisoned); `reproject=mesh`
+//    (default; parallel eyes) warps the source as a grid of cells and gathers exactly only around
+//    the edges between surfaces (MESH_VS), `gather` (parallel eyes) gathers every pixel
+//    (GATHER_FS), `points` splats one point per source pixel, its world point from the depth
+//    buffer through the inverse view-projection (a background pixel is a direction), projected
+//    with the full perspective divide into the other eye (any pair of cameras);
 //  - patchers (`patch=`): `yoro` (patch_yoro: Alg. 3 with Eq. 6 fixed: the kernel starts at the
 //    hole run's farther filled end and walks away from the hole, nearest column first, 3 rows,
 //    skipping foreground samples nearer than the edge by more than 5%; weights rem (1/2 + 0.3 t),
-//    t = |u - e| / run width; runs longer than kMaxRun or with no filled end are left to `median`'s
-//    rule: the nearest filled pixel of the row), `render` (the holes only, drawn from the
+//    t = |u - e| / run width, stopped once the weight left is below 2^-10 (the columns after it
+//    move no channel by a quarter step); runs longer than kMaxRun or with no filled end are left
+//    to `median`'s rule: the nearest filled pixel of the row), `render` (the holes only, drawn from the
 //    target eye under a stencil of the filled pixels: the GPU counterpart of `rays`, which re-casts
 //    only the hole pixels), `none` (holes stay black).
 // Per frame (window.viewer.step(i)) the page also renders both eyes (two renders) and both eyes in
 // one OVR_multiview2 pass, and times the three, each `reps` times (the record's ms_* are medians),
-// and measures the produced eye against the true render of that eye: PSNR, pixels off by more
-// than 8 steps, hole pixels before patching.
+// the passes of single-render stereo alone (one render, reprojection, patch) and a full-screen copy
+// (the least a pass writing every target pixel costs), and measures the produced eye against the
+// true render of that eye: PSNR, pixels off by more than 8 steps, hole pixels before patching.
 //
 // URL parameters: size=WxH (an eye), fov, ipd (metres, default 0.064), upm, dominant=left|right
-// (default left), patch=yoro|render|none (default yoro), reps=N, plus scene, pvs, path (points
+// (default left), patch=yoro|render|none (default yoro), reproject=mesh|gather|points (default
+// mesh), reps=N, plus scene, pvs, path (points
 // EYE@LOOK: EYE is the point between the eyes) and overlay=0.
 import {parsePath, vec3} from "./path.js";
 import {loadScene, diagonal} from "./scene_load.js";
@@ -140,23 +146,117 @@ void main() {
   int s = int(side);
   int lo = s > 0 ? p.x : max(0, p.x - ${MAX_DISPARITY});
   int hi = s > 0 ? min(w - 1, p.x + ${MAX_DISPARITY}) : p.x;
-  int r = 0, r0 = ${MAX_DISPARITY};
+  // Per source block, the pixels whose offset |xs - xt| lies within the block's disparity
+  // bounds (the pre-pass's, widened by one): only they can land in pixel xt.
+  float best = -1.0;
+  int bx = -1;
   for (int b = lo / ${BLOCK}; b <= hi / ${BLOCK}; ++b) {
     vec2 m = texelFetch(blocks, ivec2(b, p.y), 0).rg * 255.0;
-    r = max(r, int(round(m.r)));
-    r0 = min(r0, int(round(m.g)));
+    int kmax = int(round(m.r)), kmin = int(round(m.g));
+    int b0 = b * ${BLOCK}, b1 = min(w, b0 + ${BLOCK}) - 1;
+    int x0 = s > 0 ? max(b0, p.x + kmin) : max(b0, p.x - kmax);
+    int x1 = s > 0 ? min(b1, p.x + kmax) : min(b1, p.x - kmin);
+    for (int xs = x0; xs <= x1; ++xs) {
+      float d = D / viewDepth(srcDepth, ivec2(xs, p.y));
+      if (d > best && int(floor(float(xs) + 0.5 - side * d)) == p.x) { best = d; bx = xs; }
+    }
   }
-  for (int k = r; k >= r0; --k) {  // largest disparity first: the first hit is the nearest
-    int xs = p.x + s * k;
-    if (xs < 0 || xs >= w) continue;
-    float d = D / viewDepth(srcDepth, ivec2(xs, p.y));
-    if (int(floor(float(xs) + 0.5 - side * d)) != p.x) continue;
-    o = vec4(texelFetch(srcColour, ivec2(xs, p.y), 0).rgb, 1.0);
-    gl_FragDepth = texelFetch(srcDepth, ivec2(xs, p.y), 0).r;
+  if (bx >= 0) {  // the largest disparity landing here: the nearest sample
+    o = vec4(texelFetch(srcColour, ivec2(bx, p.y), 0).rgb, 1.0);
+    gl_FragDepth = texelFetch(srcDepth, ivec2(bx, p.y), 0).r;
     return;
   }
   discard;
 }`;
+// reproject=mesh (parallel eyes, as the gather): the source eye as a grid of CELL x CELL pixel
+// cells, vertices at pixel centres (the image's borders at its edges). Where the disparity
+// over a cell's (CELL + 1)^2 pixels is the cell's two triangles' linear interpolation of its
+// corners' to within MESH_TOLERANCE pixels (a plane is exactly: d = D / z is affine on the
+// screen over a plane), the cell is drawn warped to the other eye (each vertex moved by its
+// disparity, the colour fetched at the interpolated source position: the splat's pixel to
+// within the tolerance, a magnified surface without the splat's cracks); elsewhere (an edge
+// between surfaces) the target pixels the cell's samples can reach, [x0 - dmax - 1, x1 - dmin +
+// 1] on its rows, are marked (stencil 2) and computed by the exact gather, which sees every
+// source sample, warped cells' included. The warped cells draw outside the marks only.
+const CELL = 8, MESH_TOLERANCE = 0.25;
+const CELL_FS = `#version 300 es
+precision highp float;
+uniform highp sampler2D srcDepth;
+${DEPTH_GLSL}
+out vec4 o;
+void main() {
+  ivec2 c = ivec2(gl_FragCoord.xy), size = textureSize(srcDepth, 0);
+  ivec2 p0 = c * ${CELL}, p1 = min(p0 + ${CELL}, size - 1);
+  vec2 span = vec2(p1 - p0);
+  float d00 = D / viewDepth(srcDepth, p0), d10 = D / viewDepth(srcDepth, ivec2(p1.x, p0.y));
+  float d01 = D / viewDepth(srcDepth, ivec2(p0.x, p1.y)), d11 = D / viewDepth(srcDepth, p1);
+  float lo = 1e30, hi = 0.0, err = 0.0;
+  for (int v = 0; v <= ${CELL}; ++v)
+    for (int u = 0; u <= ${CELL}; ++u) {
+      ivec2 q = min(p0 + ivec2(u, v), p1);
+      float d = D / viewDepth(srcDepth, q);
+      vec2 t = vec2(q - p0) / max(span, vec2(1.0));
+      float pred = t.x >= t.y ? d00 + (d10 - d00) * t.x + (d11 - d10) * t.y
+                              : d00 + (d01 - d00) * t.y + (d11 - d01) * t.x;
+      err = max(err, abs(d - pred));
+      lo = min(lo, d);
+      hi = max(hi, d);
+    }
+  o = vec4(err <= ${MESH_TOLERANCE} ? 1.0 : 0.0, max(floor(lo) - 1.0, 0.0) / 255.0,
+           min(ceil(hi) + 1.0, 255.0) / 255.0, 1.0);
+}`;
+// Six vertices a cell (its two triangles); `marks` 1: the marks of the cells that are not
+// drawn warped, 0: the warped cells. A cell of the other kind goes outside the clip volume.
+const MESH_VS = `#version 300 es
+precision highp float;
+uniform highp sampler2D srcDepth, cells;
+uniform float side;
+uniform int marks;
+${DEPTH_GLSL}
+out vec2 vSrc;
+float edge(int i, int n) {  // a vertex's position along an axis of n pixels (grid index i)
+  int p = min(i * ${CELL}, n - 1);
+  return i == 0 ? 0.0 : p == n - 1 ? float(n) : float(p) + 0.5;
+}
+void main() {
+  int id = gl_VertexID / 6, k = gl_VertexID % 6;
+  ivec2 size = textureSize(srcDepth, 0), n = textureSize(cells, 0);
+  ivec2 c = ivec2(id % n.x, id / n.x);
+  ivec2 q = ivec2(k == 1 || k == 2 || k == 4 ? 1 : 0, k == 2 || k == 4 || k == 5 ? 1 : 0);
+  vec4 f = texelFetch(cells, c, 0);
+  if ((f.r > 0.5) == (marks == 1)) { gl_Position = vec4(2.0, 2.0, 2.0, 1.0); return; }
+  ivec2 g = c + q;
+  vec2 v = vec2(edge(g.x, size.x), edge(g.y, size.y));
+  if (marks == 1) {
+    float lo = f.g * 255.0, hi = f.b * 255.0;
+    float x = q.x == 0 ? edge(c.x, size.x) - 1.0 - (side > 0.0 ? hi : -lo)
+                       : edge(c.x + 1, size.x) + 1.0 - (side > 0.0 ? lo : -hi);
+    float y = q.y == 0 ? v.y - 0.5 : v.y + 0.5;
+    gl_Position = vec4(2.0 * x / float(size.x) - 1.0, 2.0 * y / float(size.y) - 1.0, 0.0, 1.0);
+    vSrc = v;
+    return;
+  }
+  ivec2 p = min(g * ${CELL}, size - 1);
+  float z = texelFetch(srcDepth, p, 0).r;
+  float x = v.x - side * D / viewDepth(srcDepth, p);
+  gl_Position = vec4(2.0 * x / float(size.x) - 1.0, 2.0 * v.y / float(size.y) - 1.0, 2.0 * z - 1.0, 1.0);
+  vSrc = v;
+}`;
+const MESH_FS = `#version 300 es
+precision highp float;
+uniform highp sampler2D srcColour;
+in vec2 vSrc;
+out vec4 o;
+void main() {
+  ivec2 size = textureSize(srcColour, 0);
+  o = vec4(texelFetch(srcColour, min(ivec2(floor(vSrc)), size - 1), 0).rgb, 1.0);
+}`;
+// The least a full-screen pass over the target can cost: each pixel one fetch of the source.
+const COPY_FS = `#version 300 es
+precision highp float;
+uniform highp sampler2D img;
+out vec4 o;
+void main() { o = texelFetch(img, ivec2(gl_FragCoord.xy), 0); }`;
 const FILL_FS = `#version 300 es
 precision highp float;
 uniform vec3 colour;
@@ -178,11 +278,7 @@ float viewDepth(ivec2 p) {
   return 2.0 * near * far / (far + near - n * (far - near));
 }
 bool filled(ivec2 p) { return texelFetch(img, p, 0).a > 0.5; }
-void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  ivec2 size = textureSize(img, 0);
-  vec4 c = texelFetch(img, p, 0);
-  if (c.a > 0.5 || patchMode == 0) { o = vec4(c.rgb, 1.0); return; }
+vec4 patchHole(ivec2 p, ivec2 size) {
   int a = p.x, b = p.x;
   while (a > 0 && p.x - a < ${MAX_RUN} && !filled(ivec2(a - 1, p.y))) a--;
   while (b + 1 < size.x && b - p.x < ${MAX_RUN} && !filled(ivec2(b + 1, p.y))) b++;
@@ -216,15 +312,27 @@ void main() {
       acc += sum / float(kept) * wk;
       rem -= wk;
       any = true;
+      // The columns left weigh at most rem: below 2^-10 they move no channel by a quarter step.
+      if (rem < ${1 / 1024}) break;
     }
-    if (any) { o = vec4(acc / (1.0 - rem), 1.0); return; }
+    if (any) return vec4(acc / (1.0 - rem), 1.0);
   }
   // Left to the nearest filled pixel of the row.
   for (int k = 1; k < ${4 * MAX_RUN}; ++k) {
-    if (p.x - k >= 0 && filled(ivec2(p.x - k, p.y))) { o = vec4(texelFetch(img, ivec2(p.x - k, p.y), 0).rgb, 1.0); return; }
-    if (p.x + k < size.x && filled(ivec2(p.x + k, p.y))) { o = vec4(texelFetch(img, ivec2(p.x + k, p.y), 0).rgb, 1.0); return; }
+    if (p.x - k >= 0 && filled(ivec2(p.x - k, p.y))) return vec4(texelFetch(img, ivec2(p.x - k, p.y), 0).rgb, 1.0);
+    if (p.x + k < size.x && filled(ivec2(p.x + k, p.y))) return vec4(texelFetch(img, ivec2(p.x + k, p.y), 0).rgb, 1.0);
   }
-  o = vec4(0.0, 0.0, 0.0, 1.0);
+  return vec4(0.0, 0.0, 0.0, 1.0);
+}
+void main() {
+  ivec2 p = ivec2(gl_FragCoord.xy);
+  ivec2 size = textureSize(img, 0);
+  vec4 c = texelFetch(img, p, 0);
+  o = vec4(c.rgb, 1.0);
+  // A hole's work inside a loop: SwiftShader runs a branch's code for the whole group of lanes
+  // (a 2 x 2 quad) with the others masked, but leaves a loop as soon as no lane is in it, so the
+  // filled pixels (99%) pay one test.
+  for (int k = c.a > 0.5 || patchMode == 0 ? 1 : 0; k < 1; ++k) o = patchHole(p, size);
 }`;
 
 function compile(gl, vs, fs, defines = "") {
@@ -319,8 +427,8 @@ export class StereoViewer {
     this.patch = params.get("patch") || "yoro";
     if (!["yoro", "render", "none"].includes(this.patch)) throw new Error(`patch=${this.patch}: yoro, render or none`);
     this.reps = Number(params.get("reps") || 0);
-    this.reproject = params.get("reproject") || "gather";
-    if (!["gather", "points"].includes(this.reproject)) throw new Error(`reproject=${this.reproject}: gather or points`);
+    this.reproject = params.get("reproject") || "mesh";
+    if (!["mesh", "gather", "points"].includes(this.reproject)) throw new Error(`reproject=${this.reproject}: mesh, gather or points`);
     Object.assign(this, await loadScene(params));
     this.setup();
     this.path = params.get("path") ? parsePath(params.get("path")) : null;
@@ -350,8 +458,20 @@ export class StereoViewer {
     gl.bindFramebuffer(gl.FRAMEBUFFER, this.blocks.fb);
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.blocks.tex, 0);
     gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    this.cellProg = compile(gl, QUAD_VS, CELL_FS);
+    this.meshProg = compile(gl, MESH_VS, MESH_FS);
+    this.markGatherProg = compile(gl, MESH_VS, GATHER_FS);
+    this.markPatchProg = compile(gl, MESH_VS, PATCH_FS);
+    this.cells = {fb: gl.createFramebuffer(), tex: gl.createTexture(),
+                  n: [Math.max(1, Math.ceil((w - 1) / CELL)), Math.max(1, Math.ceil((h - 1) / CELL))]};
+    gl.bindTexture(gl.TEXTURE_2D, this.cells.tex);
+    gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA8, ...this.cells.n);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, this.cells.fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, this.cells.tex, 0);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
     this.patchProg = compile(gl, QUAD_VS, PATCH_FS);
     this.fillProg = compile(gl, QUAD_VS, FILL_FS);
+    this.copyProg = compile(gl, QUAD_VS, COPY_FS);
     this.empty = gl.createVertexArray();
     this.targets = {left: this.target(), right: this.target(), splat: this.target(), patched: this.target()};
     if (this.multiview) this.initMultiview();
@@ -434,7 +554,7 @@ export class StereoViewer {
   }
 
   // Draws the set from camera c into target t (cleared first unless `holesOnly`: then only where
-  // the stencil is 0, the splat's holes).
+  // the stencil is not 1, the splat's holes).
   renderEye(t, c, holesOnly = false) {
     const gl = this.gl, P = this.prog;
     if (!holesOnly) this.clear(t);
@@ -443,7 +563,7 @@ export class StereoViewer {
     gl.depthFunc(gl.LEQUAL);
     if (holesOnly) {
       gl.enable(gl.STENCIL_TEST);
-      gl.stencilFunc(gl.EQUAL, 0, 0xff);
+      gl.stencilFunc(gl.NOTEQUAL, 1, 0xff);
       gl.stencilOp(gl.KEEP, gl.KEEP, gl.KEEP);
     }
     gl.useProgram(P.p);
@@ -474,8 +594,14 @@ export class StereoViewer {
 
   // Single-render stereo: the dominant eye rendered, reprojected to the other, patched.
   single(src, dst, cs, cd) {
-    const gl = this.gl;
     this.renderEye(src, cs);
+    this.reprojectEye(src, cs, cd);
+    return this.patchSplat(dst, cd);
+  }
+
+  // The source eye (rendered into src from cs) reprojected to cd: into this.targets.splat.
+  reprojectEye(src, cs, cd) {
+    const gl = this.gl;
     // The splat: colour, alpha 1 where written, the splat's depth, stencil 1 where written.
     this.clear(this.targets.splat, [0, 0, 0, 0]);
     gl.enable(gl.DEPTH_TEST);
@@ -507,32 +633,79 @@ export class StereoViewer {
         gl.uniform1f(P.u.far, this.far);
         gl.uniform1f(P.u.D, D);
       };
+      const side = dot3(sub3(cd.eye, cs.eye), cs.r) > 0 ? 1 : -1;
+      this.side = side;
+      this.D = D;
+      const mesh = this.reproject === "mesh";
       gl.disable(gl.STENCIL_TEST);
       gl.disable(gl.DEPTH_TEST);
       gl.bindFramebuffer(gl.FRAMEBUFFER, this.blocks.fb);
       gl.viewport(0, 0, Math.ceil(this.W / BLOCK), this.H);
       set(this.blockProg);
       gl.drawArrays(gl.TRIANGLES, 0, 3);
+      if (mesh) {
+        gl.bindFramebuffer(gl.FRAMEBUFFER, this.cells.fb);
+        gl.viewport(0, 0, ...this.cells.n);
+        set(this.cellProg);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+      }
       gl.bindFramebuffer(gl.FRAMEBUFFER, this.targets.splat.fb);
       gl.viewport(0, 0, this.W, this.H);
       gl.enable(gl.STENCIL_TEST);
+      if (mesh) {
+        const M = this.meshProg, n = 6 * this.cells.n[0] * this.cells.n[1];
+        set(M);
+        gl.activeTexture(gl.TEXTURE3);
+        gl.bindTexture(gl.TEXTURE_2D, this.cells.tex);
+        gl.uniform1i(M.u.srcColour, 0);
+        gl.uniform1i(M.u.cells, 3);
+        gl.uniform1f(M.u.side, side);
+        // The marks (stencil 2, nothing else written), then the warped cells outside them.
+        gl.colorMask(false, false, false, false);
+        gl.stencilFunc(gl.ALWAYS, 2, 0xff);
+        gl.uniform1i(M.u.marks, 1);
+        gl.drawArrays(gl.TRIANGLES, 0, n);
+        gl.colorMask(true, true, true, true);
+        gl.enable(gl.DEPTH_TEST);
+        gl.depthFunc(gl.LEQUAL);
+        gl.stencilFunc(gl.EQUAL, 1, 0x02);  // passes where unmarked, writes 1
+        gl.uniform1i(M.u.marks, 0);
+        gl.drawArrays(gl.TRIANGLES, 0, n);
+        gl.stencilFunc(gl.NOTEQUAL, 1, 0x02);  // the gather where marked, writes 1
+      }
+      // The gather: full-screen, or over the marks only (a fragment shader writing its depth is
+      // not stencil-tested before it runs).
+      const G = mesh ? this.markGatherProg : this.gatherProg;
       gl.enable(gl.DEPTH_TEST);
       gl.depthFunc(gl.ALWAYS);
-      set(this.gatherProg);
+      set(G);
       gl.activeTexture(gl.TEXTURE2);
       gl.bindTexture(gl.TEXTURE_2D, this.blocks.tex);
-      gl.uniform1i(this.gatherProg.u.srcColour, 0);
-      gl.uniform1i(this.gatherProg.u.blocks, 2);
-      gl.uniform1f(this.gatherProg.u.side, dot3(sub3(cd.eye, cs.eye), cs.r) > 0 ? 1 : -1);
-      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      gl.uniform1i(G.u.srcColour, 0);
+      gl.uniform1i(G.u.blocks, 2);
+      gl.uniform1f(G.u.side, side);
+      if (mesh) {
+        gl.uniform1i(G.u.cells, 3);
+        gl.uniform1i(G.u.marks, 1);
+        gl.drawArrays(gl.TRIANGLES, 0, 6 * this.cells.n[0] * this.cells.n[1]);
+      } else {
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+      }
       gl.depthFunc(gl.LEQUAL);
     }
     gl.disable(gl.STENCIL_TEST);
+  }
+
+  // The splat's holes patched (this.patch): returns the target holding the produced eye.
+  patchSplat(dst, cd) {
+    const gl = this.gl;
     if (this.patch === "render") {
       // The holes: the background colour, then the set drawn from the target eye, where the
-      // stencil is 0 only.
+      // stencil is not 1 only.
+      gl.bindFramebuffer(gl.FRAMEBUFFER, this.targets.splat.fb);
+      gl.viewport(0, 0, this.W, this.H);
       gl.enable(gl.STENCIL_TEST);
-      gl.stencilFunc(gl.EQUAL, 0, 0xff);
+      gl.stencilFunc(gl.NOTEQUAL, 1, 0xff);
       gl.stencilOp(gl.KEEP, gl.KEEP, gl.KEEP);
       gl.disable(gl.DEPTH_TEST);
       gl.useProgram(this.fillProg.p);
@@ -541,9 +714,16 @@ export class StereoViewer {
       this.renderEye(this.targets.splat, cd, true);
       return this.targets.splat;
     }
-    this.clear(dst);
+    // With the mesh, holes lie only in the marks (the warped cells and the marks tile the target
+    // between the row's outermost landings) and in the strip of the image's side the content
+    // moves away from: the splat is copied and the patcher runs there only.
+    const marks = this.reproject === "mesh" && this.patch === "yoro";
+    gl.bindFramebuffer(gl.FRAMEBUFFER, dst.fb);
+    gl.viewport(0, 0, this.W, this.H);
     gl.disable(gl.DEPTH_TEST);
-    const Q = this.patchProg;
+    gl.disable(gl.STENCIL_TEST);
+    if (marks) this.copyPass(this.targets.splat, dst);
+    const Q = marks ? this.markPatchProg : this.patchProg;
     gl.useProgram(Q.p);
     gl.activeTexture(gl.TEXTURE0);
     gl.bindTexture(gl.TEXTURE_2D, this.targets.splat.colour);
@@ -554,8 +734,43 @@ export class StereoViewer {
     gl.uniform1f(Q.u.near, NEAR);
     gl.uniform1f(Q.u.far, this.far);
     gl.uniform1i(Q.u.patchMode, this.patch === "none" ? 0 : 1);
+    gl.bindVertexArray(this.empty);
+    if (!marks) {
+      gl.drawArrays(gl.TRIANGLES, 0, 3);
+      return dst;
+    }
+    gl.activeTexture(gl.TEXTURE3);
+    gl.bindTexture(gl.TEXTURE_2D, this.cells.tex);
+    gl.uniform1i(Q.u.srcDepth, 1);
+    gl.uniform1i(Q.u.cells, 3);
+    gl.uniform1f(Q.u.side, this.side);
+    gl.uniform1i(Q.u.marks, 1);
+    gl.uniform1f(Q.u.D, this.D);
+    gl.drawArrays(gl.TRIANGLES, 0, 6 * this.cells.n[0] * this.cells.n[1]);
+    const strip = Math.min(this.W, MAX_DISPARITY + 2);
+    gl.useProgram(this.patchProg.p);
+    for (const [k, v] of [["img", 0], ["depth", 1], ["patchMode", 1]]) gl.uniform1i(this.patchProg.u[k], v);
+    gl.uniform1f(this.patchProg.u.near, NEAR);
+    gl.uniform1f(this.patchProg.u.far, this.far);
+    gl.enable(gl.SCISSOR_TEST);
+    gl.scissor(this.side > 0 ? this.W - strip : 0, 0, strip, this.H);
     gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.disable(gl.SCISSOR_TEST);
     return dst;
+  }
+
+  copyPass(src, dst) {
+    const gl = this.gl, P = this.copyProg;
+    gl.bindFramebuffer(gl.FRAMEBUFFER, dst.fb);
+    gl.viewport(0, 0, this.W, this.H);
+    gl.disable(gl.DEPTH_TEST);
+    gl.disable(gl.STENCIL_TEST);
+    gl.useProgram(P.p);
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, src.colour);
+    gl.uniform1i(P.u.img, 0);
+    gl.bindVertexArray(this.empty);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
   }
 
   // Waits for the GPU (a one-pixel read) and returns the ms since t0.
@@ -614,6 +829,12 @@ export class StereoViewer {
     this.patch = "none";
     const msNoPatch = timed(() => this.single(src, T.patched, cams[d], cams[o]));
     this.patch = patchMode;
+    // The passes alone, on the source eye just rendered: reprojection, patching, and a full-screen
+    // copy of the source (the least any pass writing every target pixel costs).
+    this.renderEye(src, cams[d]);
+    const msReproject = timed(() => this.reprojectEye(src, cams[d], cams[o]));
+    const msPatch = timed(() => this.patchSplat(T.patched, cams[o]));
+    const msCopy = timed(() => this.copyPass(src, T.patched));
     let produced;
     const msSingle = timed(() => { produced = this.single(src, T.patched, cams[d], cams[o]); });
     const other = this.read(produced);
@@ -632,7 +853,8 @@ export class StereoViewer {
                  size: [this.W, this.H], ipd: this.ipd, dominant: this.dominant, patch: this.patch,
                  hole_pixels: holes, hole_share: holes / (this.W * this.H),
                  psnr: q.psnr, off_by_8_share: q.offShare,
-                 ms_single: msSingle, ms_one_render: msOne, ms_unpatched: msNoPatch, ms_two_renders: msTwo, ms_multiview: msMultiview,
+                 ms_single: msSingle, ms_one_render: msOne, ms_unpatched: msNoPatch,
+                 ms_reproject: msReproject, ms_patch: msPatch, ms_copy_pass: msCopy, ms_two_renders: msTwo, ms_multiview: msMultiview,
                  ratio_single_to_two: msSingle / msTwo,
                  ratio_single_to_multiview: msMultiview ? msSingle / msMultiview : null,
                  reps: Math.max(1, this.reps), multiview: !!this.multiview};
