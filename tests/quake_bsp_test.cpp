@@ -885,6 +885,23 @@ std::string bake_file(const Scene& scene, const ViewCells& cells, const BakeSett
   return read_file(path);
 }
 
+// The tiny map's two leaves baked on 1 and 2 threads (the same bytes, checked) and once more for
+// the report; each cell's set is checked against bake_cell, which bakes it alone.
+struct TwoLeafBake {
+  std::string bytes;
+  BakeReport report;
+};
+TwoLeafBake bake_two_leaves(const Scene& scene, const ViewCells& cells, const BakeSettings& s,
+                            const std::string& dir) {
+  TwoLeafBake out;
+  out.bytes = bake_file(scene, cells, s, dir + "/one.pvs", 1);
+  EXPECT_EQ(out.bytes, bake_file(scene, cells, s, dir + "/two.pvs", 2));
+  out.report = bake(scene, cells, s, {}, {dir + "/r.pvs", dir + "/r.ckpt", false});
+  pvs::Reader r = pvs::Reader::from_memory(out.bytes);
+  for (uint32_t c = 0; c < 2; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, cells, c, s));
+  return out;
+}
+
 // The view region of each cell of `cells` (Quake coordinates), by cell.
 std::vector<ConvexPolytope> cell_regions(const QuakeBsp& m, const ViewCells& cells) {
   std::vector<ConvexPolytope> out(cells.layout.cell_count());
@@ -1153,13 +1170,9 @@ TEST(QuakeBake, PortalSweepRunsEachPortalOnceForBothLeavesAndHoldsEveryRayFromTh
     EXPECT_EQ(nlohmann::json::parse(cells.description)["sweep"], "portals");
     BakeSettings s;
     s.region.segment.resolution = 32;
-    const std::string one = bake_file(scene, cells, s, dir + "/one.pvs", 1);
-    const std::string two = bake_file(scene, cells, s, dir + "/two.pvs", 2);
-    EXPECT_EQ(one, two);
-    const BakeReport report = bake(scene, cells, s, {}, {dir + "/r.pvs", dir + "/r.ckpt", false});
-    EXPECT_EQ(report.segment_runs_shared, cells.segments[0].size());
-    pvs::Reader r = pvs::Reader::from_memory(one);
-    for (uint32_t c = 0; c < 2; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, cells, c, s));
+    const TwoLeafBake baked = bake_two_leaves(scene, cells, s, dir);
+    EXPECT_EQ(baked.report.segment_runs_shared, cells.segments[0].size());
+    pvs::Reader r = pvs::Reader::from_memory(baked.bytes);
     expect_every_ray_in_the_sets(scene, m, cells, r, 3605, liquids);
     // Witnesses: a portal run's eye lies on the portal and is moved back along its ray into the
     // cell's region, or gives none when the ray does not pass through it (here every run's
@@ -1202,15 +1215,11 @@ TEST(QuakeBake, AdaptivePortalSweepInsertsTheSameChordsForBothLeavesAndRunsEachO
   EXPECT_EQ(sweep_family_key(cells.sweeps[0][0]), sweep_family_key(cells.sweeps[1][0]));
   BakeSettings s;
   s.region.segment.resolution = 32;
-  const std::string one = bake_file(scene, cells, s, dir + "/one.pvs", 1);
-  const std::string two = bake_file(scene, cells, s, dir + "/two.pvs", 2);
-  EXPECT_EQ(one, two);
-  const BakeReport report = bake(scene, cells, s, {}, {dir + "/r.pvs", dir + "/r.ckpt", false});
+  const TwoLeafBake baked = bake_two_leaves(scene, cells, s, dir);
   // More than the polygon's edges: the sweep ran chords, and each was computed once.
-  EXPECT_GT(report.segment_runs_shared, cells.segments[0].size());
-  EXPECT_EQ(report.segment_runs_computed, report.segment_runs_shared);
-  pvs::Reader r = pvs::Reader::from_memory(one);
-  for (uint32_t c = 0; c < 2; ++c) EXPECT_EQ(r.read_cell(c), bake_cell(scene, cells, c, s));
+  EXPECT_GT(baked.report.segment_runs_shared, cells.segments[0].size());
+  EXPECT_EQ(baked.report.segment_runs_computed, baked.report.segment_runs_shared);
+  pvs::Reader r = pvs::Reader::from_memory(baked.bytes);
   expect_every_ray_in_the_sets(scene, m, cells, r, 3607, BspLiquids::see_through);
   // The witness re-run finds a witness for each of the own triangles at least (a re-run that
   // chose other chords would see other ids: every id it returns is in the set).
