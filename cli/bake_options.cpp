@@ -89,6 +89,8 @@ vislib::CellPlacement placement_of(const BakeArgs& a) {
   p.agent_radius = given(a.agent_radius);
   p.agent_step = given(a.agent_step);
   p.band_levels = a.band_levels;
+  if (!a.wall_traces.empty()) p.wall_traces = a.wall_traces == "on";
+  p.near = a.near;
   return p;
 }
 
@@ -199,7 +201,7 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
     return;
   }
   for (const char* o :
-       {"--walkable", "--box", "--grid", "--cell-size", "--eye-height", "--band-levels",
+       {"--walkable", "--box", "--grid", "--cell-size", "--eye-height", "--band-levels", "--wall-traces",
         "--walkable-from", "--agent-height", "--agent-radius", "--agent-step"})
     if (cmd.count(o))
       throw CLI::ValidationError(o,
@@ -231,10 +233,10 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     return vislib::bsp_leaf_cells(bsp, o, &scene);
   }
   vislib::CellPlacement p = placement_of(a);
+  // A Quake map: its faces are wound clockwise seen from the front (floors, walls' fronts).
+  if (ends_with_bsp(a.scene)) p.clockwise_front = true;
   if (a.walkable && ends_with_bsp(a.scene)) {
-    // A Quake map: its faces are wound clockwise seen from the front; Quake's player walks, from
-    // the map's player starts unless given.
-    p.clockwise_front = true;
+    // Quake's player walks, from the map's player starts unless given.
     if (!p.agent_height) p.agent_height = vislib::kQuakePlayerHeight;
     if (!p.agent_radius) p.agent_radius = vislib::kQuakePlayerRadius;
     if (!p.agent_step) p.agent_step = vislib::kQuakeStepHeight;
@@ -357,6 +359,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "about levels / 2 times the cost; default 3 for walkable cells, 2 for a grid; "
                   "docs/bake.md \"Eye band\")")
       ->check(CLI::Range(vislib::kPaperBandLevels, vislib::kMaxBandLevels));
+  cmd->add_option("--wall-traces", a.wall_traces,
+                  "Grid and walkable cells: also run along the walls that cross the middle of a "
+                  "cell's eye band, a little off each wall's front (an eye next to a wall inside "
+                  "the cell sees past its edges what the perimeter samples coarsely); default on "
+                  "for walkable cells, off for a grid (docs/bake.md \"Wall traces\")")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--max-slope", a.max_slope, "Walkable: steepest floor, degrees from horizontal")
       ->check(in_range(0.0, 90.0))
       ->capture_default_str();

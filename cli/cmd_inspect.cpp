@@ -129,8 +129,10 @@ void run_inspect(const InspectArgs& a) {
       // A BSP leaf cell: its segments sweep the leaf's region (the file's metadata says how).
       j["leaf"] = info.layout.cell_leaf[c];
     } else {
-      for (const auto& s : vislib::cell_boundary_segments(
-               vislib::to_box3(info.layout.view_region(c)), vislib::band_levels_of(info.metadata)))
+      if (a.scene.empty() && vislib::wall_traces_of(info.metadata))
+        j["wall_traces"] = "recorded: give --scene to list them among the boundary segments";
+      for (const auto& s :
+           vislib::recorded_cell_segments(info, c, a.scene.empty() ? nullptr : &scene))
         segs.push_back(
             {{"from", {s.from.x, s.from.y, s.from.z}}, {"to", {s.to.x, s.to.y, s.to.z}}});
     }

@@ -25,6 +25,7 @@
 #include "vislib/bake/checkpoint.h"
 #include "vislib/bake/long_segments.h"
 #include "vislib/bake/scene_subset.h"
+#include "vislib/bake/wall_traces.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
 #include "vislib/eval/ray_reference.h"
@@ -942,4 +943,110 @@ TEST(BandLevels, AnEdgeAtMidBandSeesThroughSlitsThatTheBottomAndTopPerimetersCan
   const ViewCells placed = place_view_cells(scene, p);
   EXPECT_EQ(placed.band_levels, 3);
   EXPECT_EQ(nlohmann::json::parse(placed.description).at("band_levels"), 3);
+}
+
+// A building (x 4..6, z 4..14, walls y 0..10, wound to face out) stands in a cell over
+// [0, 10]^2 whose eye band is y 1.5..1.8; a roof at y 20 covers everything but a hole above the
+// strip just west of the building, and a target at y 50 lies above the hole. An eye next to the
+// building's west wall sees the target straight up through the hole; from the perimeter of the
+// band's rectangles (x or z 0 or 10), a line through the hole lands at y 50 at least 1.6 times
+// its distance to the hole beyond it, far off the target (x 1.96..5.96, z 3..7).
+Scene building_under_a_holed_roof(uint32_t* target) {
+  Scene scene;
+  vislib_test::add_quad(scene, {4, 0, 4}, {4, 0, 14}, {4, 10, 14}, {4, 10, 4});  // west, -x
+  vislib_test::add_quad(scene, {6, 0, 14}, {6, 0, 4}, {6, 10, 4}, {6, 10, 14});  // east, +x
+  vislib_test::add_quad(scene, {6, 0, 4}, {4, 0, 4}, {4, 10, 4}, {6, 10, 4});    // south, -z
+  vislib_test::add_quad(scene, {4, 0, 14}, {6, 0, 14}, {6, 10, 14}, {4, 10, 14});  // north, +z
+  const double hx0 = 3.86, hx1 = 4.06, hz0 = 4.5, hz1 = 5.5, y = 20;
+  vislib_test::add_quad(scene, {-50, y, -50}, {hx0, y, -50}, {hx0, y, 50}, {-50, y, 50});
+  vislib_test::add_quad(scene, {hx1, y, -50}, {50, y, -50}, {50, y, 50}, {hx1, y, 50});
+  vislib_test::add_quad(scene, {hx0, y, -50}, {hx1, y, -50}, {hx1, y, hz0}, {hx0, y, hz0});
+  vislib_test::add_quad(scene, {hx0, y, hz1}, {hx1, y, hz1}, {hx1, y, 50}, {hx0, y, 50});
+  *target = uint32_t(scene.triangle_count());
+  vislib_test::add_quad(scene, {1.96, 50, 3}, {5.96, 50, 3}, {5.96, 50, 7}, {1.96, 50, 7});
+  return scene;
+}
+
+TEST(WallTraces, AreTheWallsAtMidBandOffTheirFrontClippedToTheCellAndJoined) {
+  uint32_t target = 0;
+  const Scene scene = building_under_a_holed_roof(&target);
+  Box3 region;
+  region.extend({0, 1.5, 0});
+  region.extend({10, 1.8, 10});
+  WallTraceOptions o;
+  o.clearance = 0.04;
+  const std::vector<Segment> t = wall_traces(scene, region, o);
+  // West, east and south walls, each quad's two triangles joined into one segment; the north wall
+  // lies outside the cell, the roof and the target are not walls.
+  ASSERT_EQ(t.size(), 3u);
+  auto near = [](Vec3 a, Vec3 b) { return length(a - b) < 1e-12; };
+  auto is = [&](const Segment& s, Vec3 a, Vec3 b) {
+    return (near(s.from, a) && near(s.to, b)) || (near(s.from, b) && near(s.to, a));
+  };
+  EXPECT_TRUE(is(t[0], {3.96, 1.65, 4}, {3.96, 1.65, 10})) << t[0].from.x << " " << t[0].to.z;
+  EXPECT_TRUE(is(t[1], {6.04, 1.65, 4}, {6.04, 1.65, 10}));
+  EXPECT_TRUE(is(t[2], {4, 1.65, 3.96}, {6, 1.65, 3.96}));
+  // Wound the other way, the fronts face into the building.
+  o.clockwise_front = true;
+  const std::vector<Segment> inside = wall_traces(scene, region, o);
+  ASSERT_EQ(inside.size(), 3u);
+  EXPECT_TRUE(is(inside[0], {4.04, 1.65, 4}, {4.04, 1.65, 10}));
+  // A layout's cells get what their regions get.
+  o.clockwise_front = false;
+  const ViewCells cells = grid_cells(Box3{{0, 0, 0}, {10, 3, 10}}, 1, 1, 1, EyeBand{1.5, 1.8});
+  const std::vector<std::vector<Segment>> per_cell = wall_traces(scene, cells.layout, o);
+  ASSERT_EQ(per_cell.size(), 1u);
+  ASSERT_EQ(per_cell[0].size(), 3u);
+  for (size_t k = 0; k < 3; ++k)
+    EXPECT_TRUE(near(per_cell[0][k].from, t[k].from) && near(per_cell[0][k].to, t[k].to));
+}
+
+TEST(WallTraces, AnEyeNextToAWallInsideTheCellSeesWhatThePerimetersCannot) {
+  uint32_t target = 0;
+  const Scene scene = building_under_a_holed_roof(&target);
+  // The oracle: an eye of the band next to the west wall sees the target.
+  const OracleSample hit = brute_force_first_hit(scene, 0, {3.95, 1.6, 5}, {0, 1, 0}, 1e-3);
+  ASSERT_FALSE(hit.ambiguous);
+  ASSERT_TRUE(hit.tri == target || hit.tri == target + 1);
+
+  CellPlacement p;
+  p.box = Box3{{0, 0, 0}, {10, 3, 10}};
+  p.grid = std::array<uint32_t, 3>{1, 1, 1};
+  p.eye = EyeBand{1.5, 1.8};
+  p.band_levels = 3;
+  RegionOptions o;
+  o.segment.resolution = 128;
+  o.runs = 1;
+  o.seed = 3;
+  auto sees_target = [&](const CellVisibility& v) {
+    return std::binary_search(v.triangles.begin(), v.triangles.end(), target) ||
+           std::binary_search(v.triangles.begin(), v.triangles.end(), target + 1);
+  };
+  const ViewCells perimeters = place_view_cells(scene, p);  // a grid: no traces by default
+  EXPECT_TRUE(perimeters.wall_traces.empty());
+  EXPECT_EQ(nlohmann::json::parse(perimeters.description).count("wall_traces"), 0u);
+  const CellVisibility without = cell_visibility(scene, perimeters, 0, o);
+  EXPECT_FALSE(sees_target(without)) << "the band's perimeters see through the hole";
+  EXPECT_EQ(without.segments.size(), 12u);
+
+  p.wall_traces = true;
+  const ViewCells traced = place_view_cells(scene, p);
+  ASSERT_EQ(traced.wall_traces.size(), 1u);
+  EXPECT_EQ(traced.wall_traces[0].size(), 3u);
+  const nlohmann::json recorded = nlohmann::json::parse(traced.description).at("wall_traces");
+  EXPECT_DOUBLE_EQ(recorded.at("clearance").get<double>(), kWallTraceClearanceFactor * kDefaultNear);
+  EXPECT_EQ(recorded.at("front_faces"), "counter-clockwise");
+  const CellVisibility with = cell_visibility(scene, traced, 0, o);
+  EXPECT_TRUE(sees_target(with));
+  EXPECT_EQ(with.segments.size(), 15u);  // the traces run after the rectangles
+  EXPECT_TRUE(std::includes(with.triangles.begin(), with.triangles.end(),
+                            without.triangles.begin(), without.triangles.end()));
+  // The file's metadata gives the options back (pvs inspect draws the traces from them).
+  const std::optional<WallTraceOptions> back =
+      wall_traces_of(nlohmann::json{{"cells", nlohmann::json::parse(traced.description)}}.dump());
+  ASSERT_TRUE(back.has_value());
+  EXPECT_DOUBLE_EQ(back->clearance, kWallTraceClearanceFactor * kDefaultNear);
+  EXPECT_FALSE(back->clockwise_front);
+  EXPECT_FALSE(wall_traces_of(nlohmann::json{{"cells", nlohmann::json::parse(
+                                                           perimeters.description)}}.dump()));
 }

@@ -194,8 +194,21 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
   EXPECT_NE(out.find("enclosed by the scene"), std::string::npos) << out;
   ASSERT_NE(out.find('{'), std::string::npos) << out;
   json c = json::parse(out.substr(out.find('{')));
-  // Walkable cells: the perimeters of the band's bottom, middle and top (kWalkableBandLevels).
-  EXPECT_EQ(c["boundary_segments"].size(), 12u);
+  // Walkable cells: the perimeters of the band's bottom, middle and top (kWalkableBandLevels),
+  // then the traces of the building's walls at the band's middle (wall_traces.h).
+  const json& segs = c["boundary_segments"];
+  ASSERT_GT(segs.size(), 12u);
+  const double mid = 0.5 * (c["view_region"]["min"][1].get<double>() +
+                            c["view_region"]["max"][1].get<double>());
+  for (size_t k = 12; k < segs.size(); ++k) {
+    EXPECT_DOUBLE_EQ(segs[k]["from"][1].get<double>(), mid);
+    EXPECT_DOUBLE_EQ(segs[k]["to"][1].get<double>(), mid);
+  }
+  // Without the scene the traces cannot be drawn, and inspect says so.
+  ASSERT_EQ(run_pvs("inspect " + pvs + " --at 0,1.6,0 --json", &out), 0) << out;
+  json bare = json::parse(out);
+  EXPECT_EQ(bare["boundary_segments"].size(), 12u);
+  EXPECT_NE(bare["wall_traces"].get<std::string>().find("--scene"), std::string::npos);
   EXPECT_GT(c["visible_count"].get<int>(), 0);
   EXPECT_EQ(c["visible"].size(), c["visible_count"].get<size_t>());
   vislib::Scene exported = vislib::load_scene(glb);

@@ -265,7 +265,23 @@ std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout
 
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell) {
   if (!cells.segments.empty()) return {cells.segments.at(cell)};
-  return rectangle_groups(cells.layout, cell, cells.band_levels);
+  std::vector<std::vector<Segment>> groups = rectangle_groups(cells.layout, cell, cells.band_levels);
+  if (!cells.wall_traces.empty() && !cells.wall_traces.at(cell).empty())
+    groups.push_back(cells.wall_traces[cell]);
+  return groups;
+}
+
+std::vector<Segment> recorded_cell_segments(const pvs::FileInfo& info, uint32_t cell,
+                                            const Scene* scene) {
+  assert(info.layout.kind != pvs::LayoutKind::BspTree);
+  const Box3 region = to_box3(info.layout.view_region(cell));
+  std::vector<Segment> out = cell_boundary_segments(region, band_levels_of(info.metadata));
+  const std::optional<WallTraceOptions> traces = wall_traces_of(info.metadata);
+  if (traces && scene) {
+    const std::vector<Segment> t = wall_traces(*scene, region, *traces);
+    out.insert(out.end(), t.begin(), t.end());
+  }
+  return out;
 }
 
 CellVisibility cell_visibility(const Scene& scene, const pvs::CellLayout& layout, uint32_t cell,

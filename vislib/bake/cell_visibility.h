@@ -48,10 +48,17 @@ struct CellVisibility {
 std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell,
                                   int levels = kPaperBandLevels);
 
+// The segments box cell `cell` of a baked file ran on (pvs inspect): the perimeters of its band's
+// rectangles at the levels the metadata records (band_levels_of), then, when it records wall
+// traces (wall_traces_of) and `scene` (the scene baked) is given, the cell's wall traces.
+std::vector<Segment> recorded_cell_segments(const pvs::FileInfo& info, uint32_t cell,
+                                            const Scene* scene);
+
 // The segments cell `cell`'s visibility is computed on, in groups: group g's runs are seeded
 // Rng::derive(cell_seed(seed, cell), g) (segments_visibility). Cells with their own segments
 // (cells.segments not empty): cells.segments[cell], one group. Otherwise the perimeter segments
-// of each of cell_rectangles(cells.layout, cell, cells.band_levels), one group per rectangle.
+// of each of cell_rectangles(cells.layout, cell, cells.band_levels), one group per rectangle,
+// then the cell's wall traces (ViewCells::wall_traces), when it has any, as one group.
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell);
 
 // Visible triangles of cell `cell` of `layout` (a grid or box list: BSP leaf cells carry their

@@ -392,9 +392,36 @@ ViewCells placed_cells(const Scene& scene, const CellPlacement& p) {
 }  // namespace
 
 ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
-  return with_band_levels(
-      placed_cells(scene, p),
-      p.band_levels.value_or(p.walkable ? kWalkableBandLevels : kPaperBandLevels));
+  ViewCells cells =
+      with_band_levels(placed_cells(scene, p),
+                       p.band_levels.value_or(p.walkable ? kWalkableBandLevels : kPaperBandLevels));
+  if (p.wall_traces.value_or(p.walkable)) {
+    assert(p.near > 0);
+    WallTraceOptions o;
+    o.clearance = kWallTraceClearanceFactor * p.near;
+    o.clockwise_front = p.clockwise_front;
+    cells.wall_traces = wall_traces(scene, cells.layout, o);
+    nlohmann::json d = nlohmann::json::parse(cells.description);
+    d["wall_traces"] = {{"clearance", o.clearance},
+                        {"front_faces", o.clockwise_front ? "clockwise" : "counter-clockwise"}};
+    cells.description = d.dump();
+  }
+  return cells;
+}
+
+std::optional<WallTraceOptions> wall_traces_of(const std::string& metadata) {
+  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
+  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return std::nullopt;
+  const nlohmann::json& cells = md["cells"];
+  const auto w = cells.find("wall_traces");
+  if (w == cells.end() || !w->is_object() || !w->contains("clearance") ||
+      !(*w)["clearance"].is_number())
+    return std::nullopt;
+  WallTraceOptions o;
+  o.clearance = (*w)["clearance"].get<double>();
+  if (!(o.clearance > 0) || !std::isfinite(o.clearance)) return std::nullopt;
+  o.clockwise_front = w->value("front_faces", "") == "clockwise";
+  return o;
 }
 
 int band_levels_of(const std::string& metadata) {

@@ -26,6 +26,7 @@
 #include "pvs_format/pvs_format.h"
 #include "vislib/bake/face_sweep.h"
 #include "vislib/bake/walkable_reach.h"
+#include "vislib/bake/wall_traces.h"
 #include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/quake_bsp_volumes.h"
 #include "vislib/scene/scene.h"
@@ -58,6 +59,11 @@ struct ViewCells {
   // side at its own height: the perimeters at the bottom and the top pass above and below that
   // point, and an edge between them catches most of what they miss (docs/bake.md "Eye band").
   int band_levels = kPaperBandLevels;
+  // Empty, or one list per cell (cells without their own segments): the traces of the walls that
+  // cross the middle of the cell's band (wall_traces.h), run as one more group after the
+  // rectangles' perimeters. An eye next to a wall inside the cell sees past its edges what the
+  // perimeter samples coarsely.
+  std::vector<std::vector<Segment>> wall_traces;
   // Empty, or one value per cell: the largest near distance (scene units) at which the cell's
   // eyes see no surface cut by the near plane (a BSP leaf thinner than twice the clearance,
   // quake_bsp_volumes.h); the cell's runs use the smaller of it and the bake's near.
@@ -152,7 +158,7 @@ struct CellPlacement {
   bool walkable = false;  // (b) instead of (a)
   std::optional<EyeBand> eye;     // band above a cell's bottom / a floor; (b) default EyeBand{}
   double max_slope_degrees = 45;  // (b) WalkableOptions::max_slope_degrees
-  bool clockwise_front = false;   // (b) WalkableOptions::clockwise_front
+  bool clockwise_front = false;   // (b) WalkableOptions::clockwise_front; the wall traces' front
   bool require_headroom = true;   // (b) WalkableOptions::require_headroom
   // (b) WalkableOptions::starts and required_starts; the agent's height (default: the eye band's
   // top), radius and step (default: a quarter of the band's top each), each finite, height > 0.
@@ -162,6 +168,13 @@ struct CellPlacement {
   // (a) and (b): ViewCells::band_levels (>= 2; not 2: recorded in the description); unset:
   // kWalkableBandLevels for (b), kPaperBandLevels for (a).
   std::optional<int> band_levels;
+  // (a) and (b): run the wall traces of each cell too (ViewCells::wall_traces), offset from their
+  // walls by kWallTraceClearanceFactor times `near` (the bake's near distance, > 0), to the side
+  // the winding faces (clockwise_front); recorded in the description ("wall_traces":
+  // {"clearance": C, "front_faces": "clockwise" or "counter-clockwise"}). Unset: on for (b), off
+  // for (a).
+  std::optional<bool> wall_traces;
+  double near = kDefaultNear;
 };
 
 // At most this many grid cells, or walkable columns, are placed (their index would not fit the
@@ -196,6 +209,10 @@ class PlacementError : public std::invalid_argument {
 // the start, its source and the agent). May return no cell (walkable: no floor in box).
 // Deterministic; `scene` is read only for walkable cells.
 ViewCells place_view_cells(const Scene& scene, const CellPlacement& placement);
+
+// The wall-trace options a bake's metadata records for its cells ("cells": {"wall_traces": {...}},
+// CellPlacement::wall_traces); none when it records none (or an invalid clearance).
+std::optional<WallTraceOptions> wall_traces_of(const std::string& metadata);
 
 // The band levels a bake's metadata (JSON, pvs::FileInfo::metadata) records for its cells
 // ("cells": {"band_levels": K}); kPaperBandLevels when it records none or an invalid one.
