@@ -90,6 +90,7 @@ vislib::CellPlacement placement_of(const BakeArgs& a) {
   p.agent_step = given(a.agent_step);
   p.band_levels = a.band_levels;
   if (!a.wall_traces.empty()) p.wall_traces = a.wall_traces == "on";
+  if (!a.vertical_edges.empty()) p.vertical_edges = a.vertical_edges == "on";
   p.near = a.near;
   return p;
 }
@@ -201,8 +202,9 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
     return;
   }
   for (const char* o :
-       {"--walkable", "--box", "--grid", "--cell-size", "--eye-height", "--band-levels", "--wall-traces",
-        "--walkable-from", "--agent-height", "--agent-radius", "--agent-step"})
+       {"--walkable", "--box", "--grid", "--cell-size", "--eye-height", "--band-levels",
+        "--vertical-edges", "--wall-traces", "--walkable-from", "--agent-height", "--agent-radius",
+        "--agent-step"})
     if (cmd.count(o))
       throw CLI::ValidationError(o,
                                  "cannot be combined with --cells bsp-leaves (the cells are "
@@ -355,10 +357,15 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--band-levels", a.band_levels,
                   "Grid and walkable cells: the runs are the perimeters of the eye band's "
                   "rectangles at this many heights, bottom to top evenly spaced (2: the bottom and "
-                  "the top, the paper's rule; more miss less of what eyes inside the band see, at "
-                  "about levels / 2 times the cost; default 3 for walkable cells, 2 for a grid; "
-                  "docs/bake.md \"Eye band\")")
+                  "the top, the paper's rule, and the default; more miss less of what eyes inside "
+                  "the band see, at about levels / 2 times the cost; docs/bake.md \"Eye band\")")
       ->check(CLI::Range(vislib::kPaperBandLevels, vislib::kMaxBandLevels));
+  cmd->add_option("--vertical-edges", a.vertical_edges,
+                  "Grid and walkable cells: also run the four vertical edges of a cell's view "
+                  "region, which pass through every height of the band (an eye between two band "
+                  "levels sees past the region's sides what no level's perimeter does); default "
+                  "on for walkable cells, off for a grid (docs/bake.md \"Eye band\")")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--wall-traces", a.wall_traces,
                   "Grid and walkable cells: also run along the walls that cross the middle of a "
                   "cell's eye band, a little off each wall's front (an eye next to a wall inside "

@@ -45,6 +45,7 @@ struct BakeArgs {
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)
+  std::string vertical_edges;              // --vertical-edges on|off ("": the placement's default)
   double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default
 };
 

@@ -933,6 +933,20 @@ TEST(BandLevels, AnEdgeAtMidBandSeesThroughSlitsThatTheBottomAndTopPerimetersCan
   // Everything the paper's rule sees is still seen (its segments are among these).
   EXPECT_TRUE(std::includes(three.triangles.begin(), three.triangles.end(), two.triangles.begin(),
                             two.triangles.end()));
+  // The region's vertical edges pass through the slits' height at the corners: with them the
+  // bottom and top levels alone see the target.
+  cells.band_levels = 2;
+  cells.vertical_edges = true;
+  const CellVisibility edges = cell_visibility(scene, cells, 0, o);
+  EXPECT_TRUE(sees_target(edges));
+  ASSERT_EQ(edges.segments.size(), 12u);
+  for (size_t k = 8; k < 12; ++k) {  // after the rectangles, bottom to top
+    EXPECT_EQ(edges.segments[k].from.y, 1);
+    EXPECT_EQ(edges.segments[k].to.y, 2);
+    EXPECT_EQ(edges.segments[k].from.x, edges.segments[k].to.x);
+    EXPECT_EQ(edges.segments[k].from.z, edges.segments[k].to.z);
+  }
+  cells.vertical_edges = false;
   // Placed cells record a choice other than the paper's.
   CellPlacement p;
   p.box = box;
@@ -943,6 +957,15 @@ TEST(BandLevels, AnEdgeAtMidBandSeesThroughSlitsThatTheBottomAndTopPerimetersCan
   const ViewCells placed = place_view_cells(scene, p);
   EXPECT_EQ(placed.band_levels, 3);
   EXPECT_EQ(nlohmann::json::parse(placed.description).at("band_levels"), 3);
+  EXPECT_FALSE(placed.vertical_edges);  // a grid's default
+  p.vertical_edges = true;
+  const ViewCells with_edges = place_view_cells(scene, p);
+  EXPECT_TRUE(with_edges.vertical_edges);
+  const std::string md =
+      nlohmann::json{{"cells", nlohmann::json::parse(with_edges.description)}}.dump();
+  EXPECT_TRUE(vertical_edges_of(md));
+  EXPECT_FALSE(vertical_edges_of(nlohmann::json{{"cells", nlohmann::json::parse(
+                                                              placed.description)}}.dump()));
 }
 
 // A building (x 4..6, z 4..14, walls y 0..10, wound to face out) stands in a cell over
@@ -1038,7 +1061,7 @@ TEST(WallTraces, AnEyeNextToAWallInsideTheCellSeesWhatThePerimetersCannot) {
   EXPECT_EQ(recorded.at("front_faces"), "counter-clockwise");
   const CellVisibility with = cell_visibility(scene, traced, 0, o);
   EXPECT_TRUE(sees_target(with));
-  EXPECT_EQ(with.segments.size(), 15u);  // the traces run after the rectangles
+  EXPECT_EQ(with.segments.size(), 15u);  // the traces run after the rectangles (a grid: no edges)
   EXPECT_TRUE(std::includes(with.triangles.begin(), with.triangles.end(),
                             without.triangles.begin(), without.triangles.end()));
   // The file's metadata gives the options back (pvs inspect draws the traces from them).

@@ -194,12 +194,17 @@ TEST(CliBake, InspectSummarisesAndExportsACellOfAGeneratedCity) {
   EXPECT_NE(out.find("enclosed by the scene"), std::string::npos) << out;
   ASSERT_NE(out.find('{'), std::string::npos) << out;
   json c = json::parse(out.substr(out.find('{')));
-  // Walkable cells: the perimeters of the band's bottom, middle and top (kWalkableBandLevels),
-  // then the traces of the building's walls at the band's middle (wall_traces.h).
+  // Walkable cells: the perimeters of the band's bottom and top (kPaperBandLevels), the region's
+  // four vertical edges, then the traces of the building's walls at the band's middle
+  // (wall_traces.h).
   const json& segs = c["boundary_segments"];
   ASSERT_GT(segs.size(), 12u);
-  const double mid = 0.5 * (c["view_region"]["min"][1].get<double>() +
-                            c["view_region"]["max"][1].get<double>());
+  const double bottom = c["view_region"]["min"][1].get<double>(),
+               top = c["view_region"]["max"][1].get<double>(), mid = 0.5 * (bottom + top);
+  for (size_t k = 8; k < 12; ++k) {
+    EXPECT_DOUBLE_EQ(segs[k]["from"][1].get<double>(), bottom);
+    EXPECT_DOUBLE_EQ(segs[k]["to"][1].get<double>(), top);
+  }
   for (size_t k = 12; k < segs.size(); ++k) {
     EXPECT_DOUBLE_EQ(segs[k]["from"][1].get<double>(), mid);
     EXPECT_DOUBLE_EQ(segs[k]["to"][1].get<double>(), mid);

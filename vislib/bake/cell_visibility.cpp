@@ -55,6 +55,15 @@ std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels)
   return out;
 }
 
+std::vector<Segment> vertical_edge_segments(const Box3& view_region) {
+  if (!(view_region.max.y > view_region.min.y)) return {};
+  std::vector<Segment> out;
+  for (double z : {view_region.min.z, view_region.max.z})
+    for (double x : {view_region.min.x, view_region.max.x})
+      out.push_back(Segment{{x, view_region.min.y, z}, {x, view_region.max.y, z}});
+  return out;
+}
+
 uint64_t cell_seed(uint64_t seed, uint32_t cell) {
   return Rng::derive(seed, cell);
 }
@@ -266,6 +275,10 @@ std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell) {
   if (!cells.segments.empty()) return {cells.segments.at(cell)};
   std::vector<std::vector<Segment>> groups = rectangle_groups(cells.layout, cell, cells.band_levels);
+  if (cells.vertical_edges) {
+    std::vector<Segment> v = vertical_edge_segments(to_box3(cells.layout.view_region(cell)));
+    if (!v.empty()) groups.push_back(std::move(v));
+  }
   if (!cells.wall_traces.empty() && !cells.wall_traces.at(cell).empty())
     groups.push_back(cells.wall_traces[cell]);
   return groups;
@@ -276,6 +289,10 @@ std::vector<Segment> recorded_cell_segments(const pvs::FileInfo& info, uint32_t 
   assert(info.layout.kind != pvs::LayoutKind::BspTree);
   const Box3 region = to_box3(info.layout.view_region(cell));
   std::vector<Segment> out = cell_boundary_segments(region, band_levels_of(info.metadata));
+  if (vertical_edges_of(info.metadata)) {
+    const std::vector<Segment> v = vertical_edge_segments(region);
+    out.insert(out.end(), v.begin(), v.end());
+  }
   const std::optional<WallTraceOptions> traces = wall_traces_of(info.metadata);
   if (traces && scene) {
     const std::vector<Segment> t = wall_traces(*scene, region, *traces);

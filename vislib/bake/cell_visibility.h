@@ -26,6 +26,10 @@ namespace vislib {
 // when the region is flat in y. The paper's rule is the bottom and the top (kPaperBandLevels).
 std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels = kPaperBandLevels);
 
+// The four vertical edges of a box cell's view region (ViewCells::vertical_edges), bottom to top,
+// at (min.x, min.z), (max.x, min.z), (min.x, max.z), (max.x, max.z); none when it is flat in y.
+std::vector<Segment> vertical_edge_segments(const Box3& view_region);
+
 // The family of runs of a portal's adaptive sweep (SegmentRunCache::expect_family): its chords
 // are the same for both of its leaves (run_cell_groups judges them by both sides), so a bake
 // registers one user per leaf it computes. The key of the sweep's first polygon edge and its
@@ -49,8 +53,9 @@ std::vector<Box3> cell_rectangles(const pvs::CellLayout& layout, uint32_t cell,
                                   int levels = kPaperBandLevels);
 
 // The segments box cell `cell` of a baked file ran on (pvs inspect): the perimeters of its band's
-// rectangles at the levels the metadata records (band_levels_of), then, when it records wall
-// traces (wall_traces_of) and `scene` (the scene baked) is given, the cell's wall traces.
+// rectangles at the levels the metadata records (band_levels_of), its vertical edges when it
+// records them (vertical_edges_of), then, when it records wall traces (wall_traces_of) and
+// `scene` (the scene baked) is given, the cell's wall traces.
 std::vector<Segment> recorded_cell_segments(const pvs::FileInfo& info, uint32_t cell,
                                             const Scene* scene);
 
@@ -58,7 +63,8 @@ std::vector<Segment> recorded_cell_segments(const pvs::FileInfo& info, uint32_t 
 // Rng::derive(cell_seed(seed, cell), g) (segments_visibility). Cells with their own segments
 // (cells.segments not empty): cells.segments[cell], one group. Otherwise the perimeter segments
 // of each of cell_rectangles(cells.layout, cell, cells.band_levels), one group per rectangle,
-// then the cell's wall traces (ViewCells::wall_traces), when it has any, as one group.
+// then the view region's vertical edges (ViewCells::vertical_edges) as one group, then the
+// cell's wall traces (ViewCells::wall_traces), when it has any, as one group.
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell);
 
 // Visible triangles of cell `cell` of `layout` (a grid or box list: BSP leaf cells carry their

@@ -393,8 +393,13 @@ ViewCells placed_cells(const Scene& scene, const CellPlacement& p) {
 
 ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
   ViewCells cells =
-      with_band_levels(placed_cells(scene, p),
-                       p.band_levels.value_or(p.walkable ? kWalkableBandLevels : kPaperBandLevels));
+      with_band_levels(placed_cells(scene, p), p.band_levels.value_or(kPaperBandLevels));
+  if (p.vertical_edges.value_or(p.walkable)) {
+    cells.vertical_edges = true;
+    nlohmann::json d = nlohmann::json::parse(cells.description);
+    d["vertical_edges"] = true;
+    cells.description = d.dump();
+  }
   if (p.wall_traces.value_or(p.walkable)) {
     assert(p.near > 0);
     WallTraceOptions o;
@@ -407,6 +412,13 @@ ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
     cells.description = d.dump();
   }
   return cells;
+}
+
+bool vertical_edges_of(const std::string& metadata) {
+  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
+  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return false;
+  const auto v = md["cells"].find("vertical_edges");
+  return v != md["cells"].end() && v->is_boolean() && v->get<bool>();
 }
 
 std::optional<WallTraceOptions> wall_traces_of(const std::string& metadata) {

@@ -35,14 +35,11 @@ namespace vislib {
 
 // The cells of a bake and a JSON object (text) saying how they were placed, for the metadata of
 // the PVS file.
-// The eye band's rectangles of the paper's perimeter rule: the bottom and the top.
+// The eye band's rectangles of the paper's perimeter rule: the bottom and the top. The default of
+// placed cells; walkable cells add their regions' vertical edges and wall traces instead of more
+// levels (ViewCells::vertical_edges, wall_traces): on the quick start's city a middle level takes
+// 12 sampled miss rays to 10 for 1.28 times the runs (docs/bake.md "Eye band").
 constexpr int kPaperBandLevels = 2;
-// Placed walkable cells' default (place_view_cells): the bottom, the middle and the top. Eyes in
-// a walkable cell stand anywhere in its band, and the middle rectangle's perimeter catches most
-// of what they see past the band's sides that the bottom and top miss: on the quick start's city
-// 432 sampled miss rays fall to 71 for 1.6 times the CPU, on sauer_fdm6 104,793 to 28,779 for
-// 1.5 times (docs/bake.md "Eye band").
-constexpr int kWalkableBandLevels = 3;
 // The most band levels a bake takes (pvs bake --band-levels): a cell's runs grow with them.
 constexpr int kMaxBandLevels = 16;
 
@@ -59,6 +56,12 @@ struct ViewCells {
   // side at its own height: the perimeters at the bottom and the top pass above and below that
   // point, and an edge between them catches most of what they miss (docs/bake.md "Eye band").
   int band_levels = kPaperBandLevels;
+  // Cells without their own segments: also run the four vertical edges of the view region (the
+  // box's corners from its bottom to its top), when it is not flat. An eye between two band
+  // levels sees, along rays that leave through a side face between them, what no level's
+  // perimeter passes through; the vertical edges pass through every height (on sauer_fdm6's
+  // walkable cells they see 90% of the (cell, triangle) pairs that three levels miss).
+  bool vertical_edges = false;
   // Empty, or one list per cell (cells without their own segments): the traces of the walls that
   // cross the middle of the cell's band (wall_traces.h), run as one more group after the
   // rectangles' perimeters. An eye next to a wall inside the cell sees past its edges what the
@@ -166,7 +169,7 @@ struct CellPlacement {
   bool required_starts = true;
   std::optional<double> agent_height, agent_radius, agent_step;
   // (a) and (b): ViewCells::band_levels (>= 2; not 2: recorded in the description); unset:
-  // kWalkableBandLevels for (b), kPaperBandLevels for (a).
+  // kPaperBandLevels.
   std::optional<int> band_levels;
   // (a) and (b): run the wall traces of each cell too (ViewCells::wall_traces), offset from their
   // walls by kWallTraceClearanceFactor times `near` (the bake's near distance, > 0), to the side
@@ -175,6 +178,9 @@ struct CellPlacement {
   // for (a).
   std::optional<bool> wall_traces;
   double near = kDefaultNear;
+  // (a) and (b): ViewCells::vertical_edges; recorded in the description ("vertical_edges": true).
+  // Unset: on for (b), off for (a).
+  std::optional<bool> vertical_edges;
 };
 
 // At most this many grid cells, or walkable columns, are placed (their index would not fit the
@@ -217,5 +223,9 @@ std::optional<WallTraceOptions> wall_traces_of(const std::string& metadata);
 // The band levels a bake's metadata (JSON, pvs::FileInfo::metadata) records for its cells
 // ("cells": {"band_levels": K}); kPaperBandLevels when it records none or an invalid one.
 int band_levels_of(const std::string& metadata);
+
+// Whether a bake's metadata records that its cells ran their view regions' vertical edges
+// ("cells": {"vertical_edges": true}, ViewCells::vertical_edges).
+bool vertical_edges_of(const std::string& metadata);
 
 }  // namespace vislib
