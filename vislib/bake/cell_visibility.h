@@ -1,8 +1,10 @@
 // cell_visibility.h: a view cell's visible set.
 //
-// A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeter of
-// the view region's bottom and top rectangles (the paper's perimeter heuristic, §4.1, applied at
-// the two ends of the eye band), each with K cube orientations (§4.5) seeded per cell; or, for
+// A cell's visible set (cell_visibility) is the union of from-segment runs on the perimeters of
+// the view region's rectangles at the band's levels (the bottom and the top by default), with the
+// region's vertical edges (together the box's twelve edges: the paper's perimeter heuristic,
+// §4.1) and the traces of walls inside the cell where the cells carry them (ViewCells), each with
+// K cube orientations (§4.5) seeded per cell; or, for
 // cells that carry their own segments (ViewCells::segments: a BSP leaf's faces or portals swept,
 // bsp_cells.h), the union of runs on those and of the cell's own triangles (ViewCells::own).
 #pragma once
@@ -23,7 +25,7 @@ namespace vislib {
 // The segments a box cell's visibility is computed on: the four sides of each rectangle of the
 // view region at `levels` (>= 2) heights evenly spaced from its bottom (y = min.y) to its top
 // (y = max.y), bottom first, each in the order of perimeter_segments; only the four of the bottom
-// when the region is flat in y. The paper's rule is the bottom and the top (kPaperBandLevels).
+// when the region is flat in y. The default is the bottom and the top (kPaperBandLevels).
 std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels = kPaperBandLevels);
 
 // The four vertical edges of a box cell's view region (ViewCells::vertical_edges), bottom to top,
