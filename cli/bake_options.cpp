@@ -201,10 +201,9 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
     parse_starts(a);
     return;
   }
-  for (const char* o :
-       {"--walkable", "--box", "--grid", "--cell-size", "--eye-height", "--band-levels",
-        "--vertical-edges", "--wall-traces", "--walkable-from", "--agent-height", "--agent-radius",
-        "--agent-step"})
+  for (const char* o : {"--walkable", "--box", "--grid", "--cell-size", "--eye-height",
+                        "--band-levels", "--vertical-edges", "--wall-traces", "--walkable-from",
+                        "--agent-height", "--agent-radius", "--agent-step"})
     if (cmd.count(o))
       throw CLI::ValidationError(o,
                                  "cannot be combined with --cells bsp-leaves (the cells are "

@@ -972,8 +972,8 @@ TEST(BandLevels, AnEdgeAtMidBandSeesThroughSlitsThatTheBottomAndTopPerimetersCan
   const std::string md =
       nlohmann::json{{"cells", nlohmann::json::parse(with_edges.description)}}.dump();
   EXPECT_TRUE(vertical_edges_of(md));
-  EXPECT_FALSE(vertical_edges_of(nlohmann::json{{"cells", nlohmann::json::parse(
-                                                              placed.description)}}.dump()));
+  EXPECT_FALSE(vertical_edges_of(
+      nlohmann::json{{"cells", nlohmann::json::parse(placed.description)}}.dump()));
 }
 
 // A building (x 4..6, z 4..14, walls y 0..10, wound to face out) stands in a cell over
@@ -984,9 +984,9 @@ TEST(BandLevels, AnEdgeAtMidBandSeesThroughSlitsThatTheBottomAndTopPerimetersCan
 // its distance to the hole beyond it, far off the target (x 1.96..5.96, z 3..7).
 Scene building_under_a_holed_roof(uint32_t* target) {
   Scene scene;
-  vislib_test::add_quad(scene, {4, 0, 4}, {4, 0, 14}, {4, 10, 14}, {4, 10, 4});  // west, -x
-  vislib_test::add_quad(scene, {6, 0, 14}, {6, 0, 4}, {6, 10, 4}, {6, 10, 14});  // east, +x
-  vislib_test::add_quad(scene, {6, 0, 4}, {4, 0, 4}, {4, 10, 4}, {6, 10, 4});    // south, -z
+  vislib_test::add_quad(scene, {4, 0, 4}, {4, 0, 14}, {4, 10, 14}, {4, 10, 4});    // west, -x
+  vislib_test::add_quad(scene, {6, 0, 14}, {6, 0, 4}, {6, 10, 4}, {6, 10, 14});    // east, +x
+  vislib_test::add_quad(scene, {6, 0, 4}, {4, 0, 4}, {4, 10, 4}, {6, 10, 4});      // south, -z
   vislib_test::add_quad(scene, {4, 0, 14}, {6, 0, 14}, {6, 10, 14}, {4, 10, 14});  // north, +z
   const double hx0 = 3.86, hx1 = 4.06, hz0 = 4.5, hz1 = 5.5, y = 20;
   vislib_test::add_quad(scene, {-50, y, -50}, {hx0, y, -50}, {hx0, y, 50}, {-50, y, 50});
@@ -1058,19 +1058,20 @@ TEST(WallTraces, AnEyeNextToAWallInsideTheCellSeesWhatThePerimetersCannot) {
   ASSERT_EQ(traced.wall_traces.size(), 1u);
   EXPECT_EQ(traced.wall_traces[0].size(), 3u);
   const nlohmann::json recorded = nlohmann::json::parse(traced.description).at("wall_traces");
-  EXPECT_DOUBLE_EQ(recorded.at("clearance").get<double>(), kWallTraceClearanceFactor * kDefaultNear);
+  EXPECT_DOUBLE_EQ(recorded.at("clearance").get<double>(),
+                   kWallTraceClearanceFactor * kDefaultNear);
   EXPECT_EQ(recorded.at("front_faces"), "counter-clockwise");
   const CellVisibility with = cell_visibility(scene, traced, 0, o);
   EXPECT_TRUE(sees_target(with));
   EXPECT_EQ(with.segments.size(), 11u);  // the traces run after the rectangles (a grid: no edges)
-  EXPECT_TRUE(std::includes(with.triangles.begin(), with.triangles.end(),
-                            without.triangles.begin(), without.triangles.end()));
+  EXPECT_TRUE(std::includes(with.triangles.begin(), with.triangles.end(), without.triangles.begin(),
+                            without.triangles.end()));
   // The file's metadata gives the options back (pvs inspect draws the traces from them).
   const std::optional<WallTraceOptions> back =
       wall_traces_of(nlohmann::json{{"cells", nlohmann::json::parse(traced.description)}}.dump());
   ASSERT_TRUE(back.has_value());
   EXPECT_DOUBLE_EQ(back->clearance, kWallTraceClearanceFactor * kDefaultNear);
   EXPECT_FALSE(back->clockwise_front);
-  EXPECT_FALSE(wall_traces_of(nlohmann::json{{"cells", nlohmann::json::parse(
-                                                           perimeters.description)}}.dump()));
+  EXPECT_FALSE(wall_traces_of(
+      nlohmann::json{{"cells", nlohmann::json::parse(perimeters.description)}}.dump()));
 }

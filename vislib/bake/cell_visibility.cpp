@@ -274,7 +274,8 @@ std::vector<std::vector<Segment>> rectangle_groups(const pvs::CellLayout& layout
 
 std::vector<std::vector<Segment>> cell_segment_groups(const ViewCells& cells, uint32_t cell) {
   if (!cells.segments.empty()) return {cells.segments.at(cell)};
-  std::vector<std::vector<Segment>> groups = rectangle_groups(cells.layout, cell, cells.band_levels);
+  std::vector<std::vector<Segment>> groups =
+      rectangle_groups(cells.layout, cell, cells.band_levels);
   if (cells.vertical_edges) {
     std::vector<Segment> v = vertical_edge_segments(to_box3(cells.layout.view_region(cell)));
     if (!v.empty()) groups.push_back(std::move(v));

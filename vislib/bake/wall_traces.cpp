@@ -18,7 +18,9 @@ namespace {
 // pieces are parallel.
 constexpr double kJoinTolerance = 1e-9;
 
-double cell_side(const Box3& r) { return std::max(r.max.x - r.min.x, r.max.z - r.min.z); }
+double cell_side(const Box3& r) {
+  return std::max(r.max.x - r.min.x, r.max.z - r.min.z);
+}
 
 // The front normal of a triangle and whether the triangle is a wall (kWallTraceMinTiltDegrees).
 Vec3 front_normal(const std::array<Vec3, 3>& c, const WallTraceOptions& o) {
@@ -103,15 +105,13 @@ bool join(Segment& a, const Segment& b, double tol) {
 
 // The traces of `candidates` (increasing triangle ids) in `region` (wall_traces.h).
 std::vector<Segment> traces_of(const Scene& scene, const Box3& region,
-                               const std::vector<uint32_t>& candidates,
-                               const WallTraceOptions& o) {
+                               const std::vector<uint32_t>& candidates, const WallTraceOptions& o) {
   const double h = 0.5 * (region.min.y + region.max.y), side = cell_side(region);
   const double tol = kJoinTolerance * side, min_length = kWallTraceMinLengthFraction * side;
   std::vector<Segment> out;
   for (uint32_t t : candidates) {
     const std::array<Vec3, 3> c = scene.corners(t, o.state);
-    if (std::min({c[0].y, c[1].y, c[2].y}) > h || std::max({c[0].y, c[1].y, c[2].y}) < h)
-      continue;
+    if (std::min({c[0].y, c[1].y, c[2].y}) > h || std::max({c[0].y, c[1].y, c[2].y}) < h) continue;
     const std::optional<Segment> raw = raw_trace(c, h, o);
     if (!raw) continue;
     std::optional<Segment> s = clip_to_rectangle(*raw, region);
@@ -135,9 +135,10 @@ std::vector<Segment> traces_of(const Scene& scene, const Box3& region,
           break;
         }
   }
-  out.erase(std::remove_if(out.begin(), out.end(),
-                           [&](const Segment& s) { return !(length(s.to - s.from) >= min_length); }),
-            out.end());
+  out.erase(
+      std::remove_if(out.begin(), out.end(),
+                     [&](const Segment& s) { return !(length(s.to - s.from) >= min_length); }),
+      out.end());
   return out;
 }
 
