@@ -369,7 +369,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "Grid and walkable cells: also run along the walls that cross the middle of a "
                   "cell's eye band, a little off each wall's front (an eye next to a wall inside "
                   "the cell sees past its edges what the perimeter samples coarsely); default on "
-                  "for walkable cells, off for a grid (docs/bake.md \"Wall traces\")")
+                  "for walkable cells, off for a grid (docs/bake.md \"Eye band\")")
       ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--max-slope", a.max_slope, "Walkable: steepest floor, degrees from horizontal")
       ->check(in_range(0.0, 90.0))

@@ -327,15 +327,25 @@ namespace {
 
 // Placed cells whose runs are the perimeters of their eye band at `levels` heights; a choice other
 // than the paper's is recorded in the description ("band_levels").
+// Records `key`: `value` in the cells' description (a JSON object).
+void describe(ViewCells& cells, const char* key, const nlohmann::json& value) {
+  nlohmann::json d = nlohmann::json::parse(cells.description);
+  d[key] = value;
+  cells.description = d.dump();
+}
+
 ViewCells with_band_levels(ViewCells cells, int levels) {
   assert(levels >= kPaperBandLevels);
   cells.band_levels = levels;
-  if (levels != kPaperBandLevels) {
-    nlohmann::json d = nlohmann::json::parse(cells.description);
-    d["band_levels"] = levels;
-    cells.description = d.dump();
-  }
+  if (levels != kPaperBandLevels) describe(cells, "band_levels", levels);
   return cells;
+}
+
+// The "cells" object of a bake's metadata (the cells' description); null when there is none.
+nlohmann::json cells_description(const std::string& metadata) {
+  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
+  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return nullptr;
+  return md["cells"];
 }
 
 ViewCells placed_cells(const Scene& scene, const CellPlacement& p) {
@@ -396,9 +406,7 @@ ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
       with_band_levels(placed_cells(scene, p), p.band_levels.value_or(kPaperBandLevels));
   if (p.vertical_edges.value_or(p.walkable)) {
     cells.vertical_edges = true;
-    nlohmann::json d = nlohmann::json::parse(cells.description);
-    d["vertical_edges"] = true;
-    cells.description = d.dump();
+    describe(cells, "vertical_edges", true);
   }
   if (p.wall_traces.value_or(p.walkable)) {
     assert(p.near > 0);
@@ -406,25 +414,23 @@ ViewCells place_view_cells(const Scene& scene, const CellPlacement& p) {
     o.clearance = kWallTraceClearanceFactor * p.near;
     o.clockwise_front = p.clockwise_front;
     cells.wall_traces = wall_traces(scene, cells.layout, o);
-    nlohmann::json d = nlohmann::json::parse(cells.description);
-    d["wall_traces"] = {{"clearance", o.clearance},
-                        {"front_faces", o.clockwise_front ? "clockwise" : "counter-clockwise"}};
-    cells.description = d.dump();
+    describe(cells, "wall_traces",
+             {{"clearance", o.clearance},
+              {"front_faces", o.clockwise_front ? "clockwise" : "counter-clockwise"}});
   }
   return cells;
 }
 
 bool vertical_edges_of(const std::string& metadata) {
-  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
-  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return false;
-  const auto v = md["cells"].find("vertical_edges");
-  return v != md["cells"].end() && v->is_boolean() && v->get<bool>();
+  const nlohmann::json cells = cells_description(metadata);
+  if (!cells.is_object()) return false;
+  const auto v = cells.find("vertical_edges");
+  return v != cells.end() && v->is_boolean() && v->get<bool>();
 }
 
 std::optional<WallTraceOptions> wall_traces_of(const std::string& metadata) {
-  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
-  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return std::nullopt;
-  const nlohmann::json& cells = md["cells"];
+  const nlohmann::json cells = cells_description(metadata);
+  if (!cells.is_object()) return std::nullopt;
   const auto w = cells.find("wall_traces");
   if (w == cells.end() || !w->is_object() || !w->contains("clearance") ||
       !(*w)["clearance"].is_number())
@@ -437,10 +443,10 @@ std::optional<WallTraceOptions> wall_traces_of(const std::string& metadata) {
 }
 
 int band_levels_of(const std::string& metadata) {
-  const nlohmann::json md = nlohmann::json::parse(metadata, nullptr, false);
-  if (!md.is_object() || !md.contains("cells") || !md["cells"].is_object()) return kPaperBandLevels;
-  const auto k = md["cells"].find("band_levels");
-  if (k == md["cells"].end() || !k->is_number_integer()) return kPaperBandLevels;
+  const nlohmann::json cells = cells_description(metadata);
+  if (!cells.is_object()) return kPaperBandLevels;
+  const auto k = cells.find("band_levels");
+  if (k == cells.end() || !k->is_number_integer()) return kPaperBandLevels;
   const int64_t levels = k->get<int64_t>();
   return levels >= kPaperBandLevels && levels <= kMaxBandLevels ? int(levels) : kPaperBandLevels;
 }

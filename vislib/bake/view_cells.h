@@ -213,7 +213,7 @@ class PlacementError : public std::invalid_argument {
 // (counts) or grid_cells_by_size (cell size). Throws PlacementError, checked in the order of
 // PlacementProblem, before placing anything (StartWithoutFloor: while placing; its message names
 // the start, its source and the agent). May return no cell (walkable: no floor in box).
-// Deterministic; `scene` is read only for walkable cells.
+// Deterministic; `scene` is read only for walkable cells and wall traces.
 ViewCells place_view_cells(const Scene& scene, const CellPlacement& placement);
 
 // The wall-trace options a bake's metadata records for its cells ("cells": {"wall_traces": {...}},
