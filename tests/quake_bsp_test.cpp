@@ -27,6 +27,7 @@
 #include "vislib/bake/cell_visibility.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
+#include "vislib/base/random.h"
 #include "vislib/eval/embree_scene.h"
 #include "vislib/scene/import.h"
 #include "vislib/scene/quake_bsp_volumes.h"
@@ -1383,4 +1384,40 @@ TEST(QuakeBakeLibreQuake, LongLqdm1WholeBakeHoldsItsRays) {
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "", 321, 4, 64);
+}
+
+// vis-compare and pvs check re-cast through RayCrossingIndex: on the maps (their T-junction fans
+// hold exactly degenerate triangles, their coordinates run to thousands of units) it must give
+// the brute force's crossings, line for line.
+TEST(QuakeBspLibreQuake, RayCrossingIndexGivesTheBruteForceCrossingsOnTheMaps) {
+  bool any = false;
+  for (const char* name : {"lqdm1.bsp", "e1m2.bsp"}) {
+    auto path = librequake(name);
+    if (!path) continue;
+    any = true;
+    const Scene scene = load(*path);
+    const RayCrossingIndex index(scene, 0);
+    const Box3 b = scene.bounds();
+    Rng rng(5);
+    size_t crossings = 0;
+    for (int i = 0; i < 1000; ++i) {
+      const Vec3 eye{rng.uniform(b.min.x, b.max.x), rng.uniform(b.min.y, b.max.y),
+                     rng.uniform(b.min.z, b.max.z)};
+      Vec3 dir{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)};
+      if (i % 5 == 0) dir.y = 0;  // level lines, along the maps' many horizontal floors' planes
+      if (!(length(dir) > 0)) continue;
+      dir = dir * (1.0 / length(dir));
+      const std::vector<RayCrossing> want = ray_crossings(scene, 0, eye, dir);
+      const std::vector<RayCrossing> got = index.crossings(eye, dir);
+      crossings += want.size();
+      ASSERT_EQ(got.size(), want.size()) << name << " line " << i;
+      for (size_t k = 0; k < want.size(); ++k) {
+        ASSERT_EQ(got[k].tri, want[k].tri) << name << " line " << i;
+        ASSERT_EQ(got[k].lambda, want[k].lambda);
+        ASSERT_EQ(got[k].min_bary, want[k].min_bary);
+      }
+    }
+    EXPECT_GT(crossings, 1000u) << name;
+  }
+  if (!any) GTEST_SKIP() << "../shared/scenes/librequake is absent";
 }

@@ -184,3 +184,66 @@ TEST(RayOracle, BruteForceUsesAnimationTime) {
   EXPECT_EQ(ref.tri, 0u);
   EXPECT_NEAR(ref.lambda, 2.0, 1e-12);
 }
+
+// The index must give ray_crossings' list exactly: the same triangles, depths and barycentrics,
+// in the same order, for lines that pass through, beside and along triangles of every shape:
+// large, tiny, far from the origin, thin, degenerate (collinear corners), and lines parallel to
+// the axes (a zero direction component) or running along a triangle's plane.
+TEST(RayCrossingIndex, GivesTheBruteForceCrossingsOnEveryLine) {
+  Scene s;
+  Rng rng(77);
+  for (int i = 0; i < 400; ++i) {
+    const Vec3 c{rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(-50, 50)};
+    const double size = i % 4 == 0 ? 1e-4 : i % 4 == 1 ? 40.0 : 2.0;
+    const Vec3 a = c + Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)} * size;
+    const Vec3 b = c + Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)} * size;
+    Vec3 d = c + Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)} * size;
+    if (i % 10 == 3) d = a + (b - a) * 0.37;                    // degenerate
+    if (i % 10 == 5) d = a + (b - a) * 0.5 + Vec3{0, 1e-7, 0};  // thin
+    add_triangle(s, a, b, d);
+  }
+  add_triangle(s, {1e5, 0, 0}, {1e5 + 1, 0, 0}, {1e5, 1, 0});  // far away
+  add_triangle(s, {-3, -3, 7}, {3, -3, 7}, {0, 3, 7});         // axis-aligned plane z = 7
+  const RayCrossingIndex index(s, 0);
+  size_t lines = 0, crossings = 0;
+  auto same = [&](Vec3 eye, Vec3 dir) {
+    const std::vector<RayCrossing> want = ray_crossings(s, 0, eye, dir);
+    const std::vector<RayCrossing> got = index.crossings(eye, dir);
+    ++lines;
+    crossings += want.size();
+    ASSERT_EQ(got.size(), want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+      EXPECT_EQ(got[k].tri, want[k].tri);
+      EXPECT_EQ(got[k].lambda, want[k].lambda);
+      EXPECT_EQ(got[k].min_bary, want[k].min_bary);
+    }
+  };
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3 eye{rng.uniform(-60, 60), rng.uniform(-60, 60), rng.uniform(-60, 60)};
+    // Aim at a corner, an edge point or an inner point of a random triangle, or anywhere.
+    const auto& t = s.triangles[size_t(rng.uniform(0, double(s.triangle_count()) - 1e-9))];
+    const Vec3 p0 = s.positions[0][t[0]], p1 = s.positions[0][t[1]], p2 = s.positions[0][t[2]];
+    Vec3 target;
+    switch (i % 4) {
+      case 0:
+        target = p0;
+        break;
+      case 1:
+        target = p0 + (p1 - p0) * rng.uniform();
+        break;
+      case 2:
+        target = (p0 + p1 + p2) * (1.0 / 3.0);
+        break;
+      default:
+        target = {rng.uniform(-60, 60), rng.uniform(-60, 60), rng.uniform(-60, 60)};
+    }
+    Vec3 dir = target - eye;
+    if (i % 7 == 0) dir.x = 0;
+    if (i % 11 == 0) dir.y = 0, dir.z = 0, dir.x = 1;
+    if (!(length(dir) > 0)) continue;
+    same(eye, dir * (1.0 / length(dir)));
+  }
+  same({-10, 0, 7}, {1, 0, 0});  // along the plane z = 7
+  same({0, 0, -20}, {0, 0, 1});  // through the z = 7 triangle, axis-parallel
+  EXPECT_GT(crossings, lines / 2) << "the lines must cross triangles for the test to say much";
+}

@@ -62,7 +62,8 @@ void check_hit(const Scene& scene, const EmbreeScene& embree, const SampleSettin
     }
     if (!any) return;
   }
-  const std::vector<RayCrossing> cr = ray_crossings(scene, 0, eye, dir);
+  const std::vector<RayCrossing> cr =
+      st.crossings ? st.crossings->crossings(eye, dir) : ray_crossings(scene, 0, eye, dir);
   const SeeingRule rule{scene, st.z_near, st.eps_z};
   const double lambda = rule.seen_depth(cr, x);
   if (lambda < 0) {
@@ -205,8 +206,10 @@ PvsCheckResult pvs_check(const Scene& scene, const std::vector<EyeRegion>& regio
   const size_t tris = scene.triangle_count();
   const Box3 bounds = scene.bounds();
   const EmbreeScene embree(scene, 0, tris ? (bounds.min + bounds.max) * 0.5 : Vec3{0, 0, 0});
+  const RayCrossingIndex crossings(scene, 0);
   SampleSettings settings = options.sample;
   settings.tri_plane = nullptr;
+  settings.crossings = &crossings;
   PvsCheckResult result;
   result.cells.resize(regions.size());
   auto one_cell = [&](size_t c) {

@@ -39,6 +39,8 @@
 
 namespace vislib {
 
+class RayCrossingIndex;  // ray_reference.h
+
 // A uniform eye of a leaf region is drawn in its bounding box up to this many times until it
 // falls inside (then a random convex combination of its corners).
 constexpr int kEyeRejectionTries = 64;
@@ -89,6 +91,9 @@ struct SampleSettings {
   // hit x missing from a set is no miss of it, without a re-cast, when the next surface behind x
   // along the ray (Embree) lies on x's plane and is in the set (a coincident face of a map).
   const std::vector<uint32_t>* tri_plane = nullptr;
+  // Optional: the scene's RayCrossingIndex at time 0, which makes each re-cast O(log triangles)
+  // with the same answer; null: every re-cast visits every triangle (ray_crossings).
+  const RayCrossingIndex* crossings = nullptr;
 };
 constexpr uint32_t kNoTrianglePlane = 0xFFFFFFFFu;
 

@@ -39,6 +39,39 @@ struct RayCrossing {
 // deterministic.
 std::vector<RayCrossing> ray_crossings(const Scene& scene, double tau, Vec3 eye, Vec3 dir);
 
+// ray_crossings' answer without visiting every triangle: a bounding-volume hierarchy over the
+// triangles' boxes at one animation time, each box widened by kCrossingIndexRelativePad of its
+// diagonal plus kCrossingIndexScenePad of the scene's size (so that every crossing or near miss
+// that the double arithmetic can report lies inside it), and the triangles too thin for that
+// bound (height over longest edge at most kCrossingIndexThinness, degenerate ones included:
+// their double barycentrics can land anywhere) tested on every line. The candidates then go
+// through ray_crossings' own arithmetic, so the answer is the same list, in the same order.
+// O(log triangles + candidates + thin triangles) per line. Immutable once built; thread-safe.
+constexpr double kCrossingIndexRelativePad = 1e-3;  // of a triangle's box diagonal (unitless)
+constexpr double kCrossingIndexScenePad = 1e-7;     // of 1 + the largest |coordinate| (scene units)
+constexpr double kCrossingIndexThinness = 1e-3;     // height / longest edge (unitless)
+class RayCrossingIndex {
+ public:
+  RayCrossingIndex(const Scene& scene, double tau);
+  // ray_crossings(scene, tau, eye, dir), equal element for element.
+  std::vector<RayCrossing> crossings(Vec3 eye, Vec3 dir) const;
+
+ private:
+  struct Node {
+    Box3 box;
+    uint32_t first = 0, count = 0;  // a leaf: order_[first, first + count); else count == 0
+    uint32_t left = 0, right = 0;   // an inner node's children
+  };
+  // Lays out the subtree of order_[first, first + count) (median split on the widest axis of
+  // the box centres) and returns its node.
+  uint32_t build(const std::vector<Box3>& boxes, const std::vector<Vec3>& centres, uint32_t first,
+                 uint32_t count);
+  std::vector<Vec3> corners_;    // 3 per triangle, as ray_crossings reads them
+  std::vector<uint32_t> order_;  // triangle ids, grouped by leaf
+  std::vector<uint32_t> thin_;   // tested on every line
+  std::vector<Node> nodes_;
+};
+
 // The exact-as-double first hit of the ray eye + lambda*dir (lambda > z_near) over every triangle
 // of `scene` at animation time `tau` (Moller-Trumbore, vertices re-centred at `eye` in double).
 // Ties in lambda go to the lower id. `ambiguous` is set when the winner's smallest barycentric is

@@ -31,6 +31,7 @@ struct Context {
   const std::vector<uint32_t>& tri_plane;   // map plane of each triangle's face (or none)
   const std::vector<uint8_t>& degenerate;   // per triangle
   const std::vector<uint8_t>& never_drawn;  // per triangle: its face is in no marksurfaces
+  const RayCrossingIndex& crossings;        // the scene's, for every re-cast
 };
 
 Vec3 centroid(const std::vector<Vec3>& c) {
@@ -77,7 +78,7 @@ Search find_witness(const Context& ctx, uint32_t tri, const std::vector<Vec3>& e
         candidate = h.tri != kNoHit && (h.tri == tri || ctx.tri_plane[h.tri] == ctx.tri_plane[tri]);
       }
       if (!candidate) continue;
-      const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, eye, dir);
+      const std::vector<RayCrossing> cr = ctx.crossings.crossings(eye, dir);
       const double lambda = ctx.rule.seen_depth(cr, tri);
       if (lambda < 0) continue;
       // Seen, but where a triangle of theirs lies at the same depth (a coincident face they
@@ -110,7 +111,7 @@ void settle_with_kernel(const Context& ctx, VisCompareLeaf& row, std::vector<Vis
     }
     VisWitness w = kw[k];
     w.from_kernel = true;
-    const std::vector<RayCrossing> cr = ray_crossings(ctx.scene, 0, w.eye, w.dir);
+    const std::vector<RayCrossing> cr = ctx.crossings.crossings(w.eye, w.dir);
     const double lambda = ctx.rule.seen_depth(cr, t);
     if (lambda < 0 && ctx.rule.seen_at_tie(cr, t))
       row.tie_witnesses.push_back(w);
@@ -136,6 +137,7 @@ void sample_leaf(const Context& ctx, VisCompareLeaf& row, const EyeRegion& regio
   st.z_near = ctx.opt.z_near;
   st.eps_z = ctx.opt.eps_z;
   st.tri_plane = &ctx.tri_plane;
+  st.crossings = &ctx.crossings;
   std::vector<SampledSet> sets(2);
   sets[0].in_set = &in_ours;
   sets[1].in_set = &in_theirs;
@@ -180,6 +182,7 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
       marked[bsp.marksurfaces[l.first_marksurface + i]] = 1;
   const Box3 bounds = scene.bounds();
   const EmbreeScene embree(scene, 0, tris ? (bounds.min + bounds.max) * 0.5 : Vec3{0, 0, 0});
+  const RayCrossingIndex crossings(scene, 0);
   std::vector<uint32_t> tri_plane(tris, kNoTrianglePlane);
   std::vector<uint8_t> degenerate(tris, 0), never_drawn(tris, 0);
   for (uint32_t f = 0; f < faces.size(); ++f) {
@@ -244,7 +247,8 @@ VisCompareResult vis_compare(const QuakeBsp& bsp, const Scene& scene,
                       SeeingRule{scene, cell_options.z_near, options.eps_z},
                       tri_plane,
                       degenerate,
-                      never_drawn};
+                      never_drawn,
+                      crossings};
     std::vector<Vec3> eyes;  // scene coordinates
     if (!region_corners.empty()) {
       const Vec3 mid = centroid(region_corners);
