@@ -19,11 +19,13 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include "tests/scene_builders.h"
 #include "tests/support/bsp_writer.h"
 #include "tests/support/ray_oracle.h"
 #include "tests/test_support.h"
 #include "vislib/bake/bake.h"
 #include "vislib/bake/bsp_cells.h"
+#include "vislib/bake/bsp_portals.h"
 #include "vislib/bake/cell_visibility.h"
 #include "vislib/base/error.h"
 #include "vislib/base/file_util.h"
@@ -980,6 +982,65 @@ TEST(QuakeBake, RegionSegmentsAreEdgesOnceThenChordsAtMostTheSpacingApart) {
   EXPECT_EQ(bsp_region_segments(box, 8).size(), 12u + 2 * 3 + 2 * 1 + 2 * 1);
   // Spacing 10 over a width of 32: 4 equal steps of 8 (at most 10 apart), 3 chords.
   EXPECT_EQ(bsp_region_segments(box, 10).size(), 12u + 2 * 3 + 2 * 1 + 2 * 1);
+}
+
+// A face laid over a portal closes it, though the portal's corners (from float planes) miss the
+// face's by 1e-4 units: before the edge band, such a portal of e1m2 (under a floor face) counted
+// as open, its runs' eyes lay on the floor, the near plane cut it away and they saw the sky
+// through it (417 false witnesses on the whole map). A face over half of a portal cuts the
+// portal's segments to the open half, clear of the face by the clearance; a face meeting the
+// portal only along an edge (within the band) covers nothing.
+TEST(QuakeBake, PortalCoverClosesAPortalUnderAFaceAndCutsSegmentsToTheOpenPart) {
+  BspPortal p;  // 16 x 8 on z = 324, normal -z: counter-clockwise seen from below
+  const double e = 1e-4;
+  p.polygon = {
+      {0 - e, 8 + e, 324}, {16 + e, 8 + e, 324}, {16 + e, 0 - e, 324}, {0 - e, 0 - e, 324}};
+  p.normal = {0, 0, -1};
+  p.area = (16 + 2 * e) * (8 + 2 * e);
+  auto scene_with = [](const std::vector<std::array<Vec3, 4>>& quads) {
+    Scene s;
+    for (const auto& q : quads)
+      vislib_test::add_quad(s, quake_to_scene(q[0]), quake_to_scene(q[1]), quake_to_scene(q[2]),
+                            quake_to_scene(q[3]));
+    return s;
+  };
+  const Scene floor = scene_with({{{{0, 0, 324}, {16, 0, 324}, {16, 8, 324}, {0, 8, 324}}}});
+  const BspPortalCover closed = bsp_portal_cover(p, floor);
+  EXPECT_TRUE(closed.closed);
+  EXPECT_EQ(closed.parts.size(), 2u);
+  // Half of it: open, one part, and a chord along x loses [8 - clearance, 16].
+  const Scene half = scene_with({{{{8, 0, 324}, {16, 0, 324}, {16, 8, 324}, {8, 8, 324}}}});
+  const BspPortalCover open = bsp_portal_cover(p, half);
+  EXPECT_FALSE(open.closed);
+  ASSERT_EQ(open.parts.size(), 2u);
+  const double clearance = 0.02;
+  const std::vector<Segment> pieces =
+      bsp_portal_open_pieces({{0.5, 4, 324}, {15.5, 4, 324}}, p, open, clearance, 1e-6);
+  ASSERT_EQ(pieces.size(), 1u);
+  EXPECT_EQ(pieces[0].from, (Vec3{0.5, 4, 324}));
+  EXPECT_NEAR(pieces[0].to.x, 8 - clearance, 1e-9);
+  // A chord across the cover's edge at an angle keeps the part before it only.
+  const std::vector<Segment> slant =
+      bsp_portal_open_pieces({{12, 1, 324}, {4, 7, 324}}, p, open, clearance, 1e-6);
+  ASSERT_EQ(slant.size(), 1u);
+  EXPECT_NEAR(slant[0].from.x, 8 - clearance, 1e-9);
+  EXPECT_EQ(slant[0].to, (Vec3{4, 7, 324}));
+  // A cover in the middle splits a chord in two.
+  const Scene middle = scene_with({{{{6, 0, 324}, {10, 0, 324}, {10, 8, 324}, {6, 8, 324}}}});
+  const std::vector<Segment> two = bsp_portal_open_pieces(
+      {{0.5, 4, 324}, {15.5, 4, 324}}, p, bsp_portal_cover(p, middle), clearance, 1e-6);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_NEAR(two[0].to.x, 6 - clearance, 1e-9);
+  EXPECT_NEAR(two[1].from.x, 10 + clearance, 1e-9);
+  // The next leaf's floor, meeting the portal along its edge y = 8 (within the band): no part.
+  const Scene next = scene_with({{{{0, 8, 324}, {16, 8, 324}, {16, 16, 324}, {0, 16, 324}}}});
+  const BspPortalCover beside = bsp_portal_cover(p, next);
+  EXPECT_FALSE(beside.closed);
+  EXPECT_TRUE(beside.parts.empty());
+  // A face off the plane (a ceiling 4 units above) covers nothing.
+  EXPECT_TRUE(
+      bsp_portal_cover(p, scene_with({{{{0, 0, 328}, {16, 0, 328}, {16, 8, 328}, {0, 8, 328}}}}))
+          .parts.empty());
 }
 
 // A leaf thinner than twice the near clearance (a slab 0.015 units thick over the tiny map's

@@ -195,7 +195,8 @@ void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<
   const ConvexPolytope none;
   const double clearance = kNearClearanceFactor * options.near;
   for (const BspPortal& p : bsp_leaf_portals(pieces, all)) {
-    if (bsp_portal_covered(p, scene)) continue;  // closed: each side sees the surface only
+    const BspPortalCover cover = bsp_portal_cover(p, scene);
+    if (cover.closed) continue;  // each side sees the surface only
     auto side_volume = [&](int s) -> const ConvexPolytope& {
       const uint32_t l = p.leaves[s];
       return pieces_of[l] == 1 ? *volume[l] : none;
@@ -203,16 +204,26 @@ void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<
     const std::vector<Vec3> clear =
         bsp_portal_clear_part(p, side_volume(0), side_volume(1), clearance);
     if (clear.empty()) continue;  // nothing of it is clear of the walls: only they are seen
-    std::vector<Segment> segs;    // Quake coordinates
+    std::vector<Segment> whole;   // Quake coordinates
     for (size_t i = 0; i < clear.size(); ++i) {
       const Vec3 a = clear[i], b = clear[(i + 1) % clear.size()];
-      if (length(b - a) > kBspSameEndpoint) segs.push_back({a, b});
+      if (length(b - a) > kBspSameEndpoint) whole.push_back({a, b});
     }
-    const std::optional<FaceSweep> sweep = face_sweep_of(clear, p.normal, kBspSameEndpoint);
-    if (sweep && !options.adaptive && options.face_spacing > 0) {
-      const std::vector<Segment> c = even_chords(*sweep, options.face_spacing, kBspSameEndpoint);
-      segs.insert(segs.end(), c.begin(), c.end());
+    std::optional<FaceSweep> sweep = face_sweep_of(clear, p.normal, kBspSameEndpoint);
+    // A partly covered portal is swept evenly (at the adaptive sweep's floor spacing when the
+    // bake's sweep is adaptive, whose chords are whole), its segments cut to the open part.
+    const double spacing = !options.adaptive     ? options.face_spacing
+                           : cover.parts.empty() ? 0.0
+                                                 : options.adaptive->floor;
+    if (sweep && spacing > 0) {
+      const std::vector<Segment> c = even_chords(*sweep, spacing, kBspSameEndpoint);
+      whole.insert(whole.end(), c.begin(), c.end());
     }
+    if (!cover.parts.empty()) sweep.reset();
+    std::vector<Segment> segs;
+    for (const Segment& s : whole)
+      for (const Segment& piece : bsp_portal_open_pieces(s, p, cover, clearance, kBspSameEndpoint))
+        segs.push_back(piece);
     const Vec3 normal = quake_to_scene(p.normal);
     for (int side = 0; side < 2; ++side) {
       const uint32_t c = cells.layout.leaf_cell[p.leaves[side]];

@@ -203,10 +203,29 @@ std::vector<Vec3> bsp_portal_clear_part(const BspPortal& portal, const ConvexPol
   return polygon_area(part) > 0 ? part : std::vector<Vec3>{};
 }
 
-bool bsp_portal_covered(const BspPortal& portal, const Scene& scene) {
+BspPortalCover bsp_portal_cover(const BspPortal& portal, const Scene& scene) {
   const double offset = dot(portal.normal, portal.polygon[0]);
   Box3 box;
   for (const Vec3& v : portal.polygon) box.extend(v);
+  // The portal's outward edge normals (unit, in its plane): it is counter-clockwise seen from its
+  // normal's side.
+  const size_t n = portal.polygon.size();
+  std::vector<Vec3> outward(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3 o = cross(portal.polygon[(i + 1) % n] - portal.polygon[i], portal.normal);
+    outward[i] = length(o) > 0 ? o * (1.0 / length(o)) : Vec3{0, 0, 0};
+  }
+  // The polygon clipped by the portal's edges moved inward by `band` (>= 0); a repeated corner
+  // (an edge of no length) bounds nothing.
+  auto inside = [&](std::vector<Vec3> poly, double band) {
+    for (size_t i = 0; i < n && !poly.empty(); ++i)
+      if (outward[i] != Vec3{0, 0, 0})
+        poly = clip_polygon(poly, outward[i], dot(outward[i], portal.polygon[i]) - band);
+    return poly;
+  };
+  // The portal with its edges moved inward by the band: the parts are the triangles clipped to it.
+  const std::vector<Vec3> inner = inside(portal.polygon, kBspOwnMinWidth);
+  BspPortalCover cover;
   double covered = 0;
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (scene.triangle_see_through(t)) continue;
@@ -229,15 +248,64 @@ bool bsp_portal_covered(const BspPortal& portal, const Scene& scene) {
       tri.push_back(q);
     }
     if (!on) continue;
-    // The triangle's overlap with the portal: clipped by the portal's edges' inward half-planes.
-    for (size_t i = 0; i < portal.polygon.size() && !tri.empty(); ++i) {
-      const Vec3 p = portal.polygon[i], e = portal.polygon[(i + 1) % portal.polygon.size()] - p;
-      const Vec3 outward = cross(e, portal.normal);
-      tri = clip_polygon(tri, outward, dot(outward, p));
-    }
+    if (inner.empty()) break;
+    tri = inside(std::move(tri), kBspOwnMinWidth);
+    if (tri.empty() || !(polygon_area(tri) > 0)) continue;
     covered += polygon_area(tri);
+    cover.parts.push_back(std::move(tri));
   }
-  return covered >= portal.area * (1 - 1e-9);
+  // The triangles of a map's face share its corners exactly and do not overlap, so their areas
+  // add up to the inner part's to within rounding; a portal narrower than twice the band is
+  // closed (all of it lies in the band).
+  cover.closed = inner.empty() || covered >= polygon_area(inner) * (1 - 1e-9);
+  return cover;
+}
+
+std::vector<Segment> bsp_portal_open_pieces(const Segment& s, const BspPortal& portal,
+                                            const BspPortalCover& cover, double clearance,
+                                            double min_length) {
+  if (cover.parts.empty()) return {s};
+  // Each part's interval of s, the part grown by `clearance` (each edge moved outward by it: a
+  // superset of the points within clearance of it).
+  std::vector<std::pair<double, double>> shut;
+  const Vec3 d = s.to - s.from;
+  for (const std::vector<Vec3>& part : cover.parts) {
+    Vec3 centre{0, 0, 0};
+    for (const Vec3& v : part) centre = centre + v;
+    centre = centre * (1.0 / double(part.size()));
+    double lo = 0, hi = 1;
+    for (size_t i = 0; i < part.size() && lo <= hi; ++i) {
+      Vec3 o = cross(part[(i + 1) % part.size()] - part[i], portal.normal);
+      const double len = length(o);
+      if (!(len > 0)) continue;
+      o = o * (1.0 / len);
+      if (dot(o, centre - part[i]) > 0) o = o * -1.0;  // the part's winding is either way
+      // dot(o, from + t d - part[i]) <= clearance
+      const double a = dot(o, d), b = clearance - dot(o, s.from - part[i]);
+      if (a > 0)
+        hi = std::min(hi, b / a);
+      else if (a < 0)
+        lo = std::max(lo, b / a);
+      else if (b < 0)
+        hi = -1;  // parallel and outside
+    }
+    if (lo <= hi) shut.push_back({lo, hi});
+  }
+  std::sort(shut.begin(), shut.end());
+  std::vector<Segment> out;
+  double open = 0;
+  auto piece = [&](double t0, double t1) {
+    Segment p = s;
+    p.from = s.from + d * t0;
+    p.to = s.from + d * t1;
+    if (length(p.to - p.from) > min_length) out.push_back(p);
+  };
+  for (const auto& [lo, hi] : shut) {
+    if (lo > open) piece(open, lo);
+    open = std::max(open, hi);
+  }
+  if (open < 1) piece(open, 1);
+  return out;
 }
 
 ConvexPolytope polytope_to_scene(const ConvexPolytope& p) {

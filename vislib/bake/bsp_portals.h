@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "vislib/base/vec.h"
+#include "vislib/kernel/region_visibility.h"
 #include "vislib/scene/quake_bsp_volumes.h"
 #include "vislib/scene/scene.h"
 
@@ -90,10 +91,28 @@ ConvexPolytope polytope_to_scene(const ConvexPolytope& p);
 std::vector<Vec3> bsp_portal_clear_part(const BspPortal& portal, const ConvexPolytope& a,
                                         const ConvexPolytope& b, double clearance);
 
-// Whether the opaque triangles of `scene` that lie on the portal's plane (corners within
-// kBspOnFaceDistance; Quake coordinates in, the scene's are quake_to_scene) cover it: their
-// overlaps with it add up to its area (to within a relative 1e-9). Such a portal is closed (a
-// liquid's opaque surface): both leaves see the surface (on their faces) and nothing through it.
-bool bsp_portal_covered(const BspPortal& portal, const Scene& scene);
+// The opaque triangles of `scene` that lie on a portal's plane (corners within
+// kBspOnFaceDistance; the scene's coordinates are quake_to_scene of the map's): a floor or a
+// liquid's opaque surface laid over the portal. An eye of the portal inside such a part would see
+// through the surface (it lies at depth 0, cut by any near plane), so the part is not swept.
+struct BspPortalCover {
+  // Each such triangle's overlap with the portal but for a band kBspOwnMinWidth wide along the
+  // portal's edges, Quake coordinates, in increasing triangle id (those with no overlap of
+  // positive area left out). The band is under a pixel at any eye the bake samples, and holds the
+  // slivers of the faces next to the portal (its corners come from float planes and miss the
+  // faces' corners by up to about 1e-4 units).
+  std::vector<std::vector<Vec3>> parts;
+  // The parts cover the portal but for the band (or the portal is narrower than twice the band):
+  // it is closed, both leaves see the surface (on their faces) and nothing through it.
+  bool closed = false;
+};
+BspPortalCover bsp_portal_cover(const BspPortal& portal, const Scene& scene);
+
+// The pieces of segment `s` (on the plane of `portal`, Quake coordinates) that keep at least
+// `clearance` (Quake units, >= 0) from every part of `cover`, in the plane: in order from s.from,
+// each a sub-segment of s longer than `min_length`; s itself when the cover has no parts.
+std::vector<Segment> bsp_portal_open_pieces(const Segment& s, const BspPortal& portal,
+                                            const BspPortalCover& cover, double clearance,
+                                            double min_length);
 
 }  // namespace vislib
