@@ -10,7 +10,6 @@
 
 #include "tests/scene_builders.h"
 #include "tests/support/ray_oracle.h"
-#include "vislib/base/random.h"
 #include "vislib/kernel/region_visibility.h"
 
 using namespace vislib;
@@ -422,116 +421,5 @@ TEST(SegmentVisibility, DirectionSidesHoldWhatThePixelsOfEachSideOfThePlaneSee) 
   EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
   bad = o;
   bad.splits = {0.5};
-  EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
-}
-
-namespace {
-
-Vec3 unit(Vec3 v) {
-  return v * (1.0 / length(v));
-}
-
-// The box [lo, hi] as a convex polytope with its faces built.
-ConvexPolytope box_polytope(Vec3 lo, Vec3 hi) {
-  ConvexPolytope p;
-  p.halfspaces = {{{-1, 0, 0}, -lo.x}, {{1, 0, 0}, hi.x},   {{0, -1, 0}, -lo.y},
-                  {{0, 1, 0}, hi.y},   {{0, 0, -1}, -lo.z}, {{0, 0, 1}, hi.z}};
-  return inset_polytope(p, 0);
-}
-
-// Whether some point v0 + t e - s d (s > 0, sampled) lies in `p`.
-bool back_ray_meets(const ConvexPolytope& p, Vec3 q, Vec3 d, double reach) {
-  for (double s = 1e-3; s < reach; s += 1e-3) {
-    const Vec3 x = q - d * s;
-    bool in = true;
-    for (const HalfSpace& h : p.halfspaces) in = in && dot(h.normal, x) <= h.offset;
-    if (in) return true;
-  }
-  return false;
-}
-
-}  // namespace
-
-// back_window: the eyes of a segment whose ray back along -d passes through a box below it.
-// Straight up, the box's x range; at 45 degrees, that range shifted by the depth; straight down
-// (away from the box), none. Held against a sampled walk back from eyes along the segment.
-TEST(SegmentVisibility, BackWindowIsTheEyesWhoseRayBackMeetsTheRegion) {
-  const ConvexPolytope box = box_polytope({2, -1, -3}, {4, 1, -1});
-  const Vec3 v0{0, 0, 0}, e{10, 0, 0};
-  auto w = back_window(box.halfspaces, v0, e, {0, 0, 1}, 100);
-  EXPECT_NEAR(w.first, 0.2, 1e-12);
-  EXPECT_NEAR(w.second, 0.4, 1e-12);
-  w = back_window(box.halfspaces, v0, e, Vec3{1, 0, 1} * (1 / std::sqrt(2.0)), 100);
-  EXPECT_NEAR(w.first, 0.3, 1e-12);
-  EXPECT_NEAR(w.second, 0.7, 1e-12);
-  w = back_window(box.halfspaces, v0, e, {0, 0, -1}, 100);
-  EXPECT_GT(w.first, w.second);
-  Rng rng(7);
-  for (int i = 0; i < 20; ++i) {
-    const Vec3 d = unit(Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(0.05, 1)});
-    w = back_window(box.halfspaces, v0, e, d, 100);
-    for (double t = 0.0025; t < 1; t += 0.005) {
-      const bool meets = back_ray_meets(box, v0 + e * t, d, 12);
-      const bool inside = t >= w.first && t <= w.second;
-      // Sampled at 1e-3 along the ray: an eye within a step of the window's ends may disagree.
-      if (std::min(std::fabs(t - w.first), std::fabs(t - w.second)) > 0.003)
-        EXPECT_EQ(meets, inside) << "direction " << i << " t " << t;
-    }
-  }
-}
-
-// Side regions (SegmentOptions::side_regions): a side with a region marks an id only over the
-// eyes whose pixel ray comes from the region (its pieces' overlap with the pixel's back_window);
-// the set is the pieces' ids so restricted, within the side's unrestricted set and smaller than
-// it when the region sees through part of the segment only, and every witness's ray comes from
-// the region.
-TEST(SegmentVisibility, SideRegionsCountOnlyTheRaysTheirRegionCasts) {
-  const Scene s = random_soup(300, 31);
-  SegmentOptions o;
-  o.resolution = 32;
-  o.coplanar = CoplanarRule::First;
-  o.orientation = random_orientation(5);
-  o.want_pieces = true;
-  const Vec3 v0{-2, 0, 0}, v1{2, 0, 0}, n{0, 1, 0};
-  o.side_normal = n;
-  const SegmentResult plain = segment_visibility(s, v0, v1, o);
-  // Side 0 (directions with d.y >= 0) serves a small box below the segment's left half.
-  const ConvexPolytope region = box_polytope({-2, -0.6, -0.1}, {-1, -0.5, 0.1});
-  o.side_regions[0] = &region;
-  const SegmentResult r = segment_visibility(s, v0, v1, o);
-  EXPECT_TRUE(same_lists(r.pieces, plain.pieces));
-  EXPECT_EQ(r.visible_sides[1], plain.visible_sides[1]);
-  std::set<uint32_t> expect;
-  const int N = o.resolution;
-  double reach = 0;
-  for (const auto& f : region.faces)
-    for (const Vec3& p : f) reach = std::max(reach, length(p - v0));
-  reach = 2 * (reach + length(v1 - v0)) + 1;
-  for (int f = 0; f < kCubeFaces; ++f)
-    for (int y = 0; y < N; ++y)
-      for (int x = 0; x < N; ++x) {
-        const Vec3 d = pixel_direction(face_axes(f, o.orientation), x, y, N);
-        if (dot(d, n) < -kSideTolerance * length(d)) continue;
-        const auto w = back_window(region.halfspaces, v0, v1 - v0, d, reach);
-        for (const auto& p : r.pieces[(size_t(f) * N + y) * N + x])
-          if (std::min(p.t1, w.second) - std::max(p.t0, w.first) > o.eps_len) expect.insert(p.id);
-      }
-  EXPECT_EQ(r.visible_sides[0], std::vector<uint32_t>(expect.begin(), expect.end()));
-  EXPECT_TRUE(std::includes(plain.visible_sides[0].begin(), plain.visible_sides[0].end(),
-                            r.visible_sides[0].begin(), r.visible_sides[0].end()));
-  EXPECT_LT(r.visible_sides[0].size(), plain.visible_sides[0].size());
-  ASSERT_FALSE(r.visible_sides[0].empty());
-  SegmentOptions one = o;
-  one.want_pieces = false;
-  one.side_only = 0;
-  one.want_witnesses = true;
-  const SegmentResult wr = segment_visibility(s, v0, v1, one);
-  EXPECT_EQ(wr.visible, r.visible_sides[0]);
-  for (const Witness& w : wr.witnesses) {
-    const Vec3 d = unit(pixel_direction(face_axes(w.face, o.orientation), w.x, w.y, N));
-    EXPECT_TRUE(back_ray_meets(region, lerp(v0, v1, w.t), d, 10)) << "witness of " << w.tri;
-  }
-  SegmentOptions bad = o;
-  bad.side_normal = {0, 0, 0};
   EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
 }

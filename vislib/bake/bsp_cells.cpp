@@ -225,24 +225,15 @@ void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<
       for (const Segment& piece : bsp_portal_open_pieces(s, p, cover, clearance, kBspSameEndpoint))
         segs.push_back(piece);
     const Vec3 normal = quake_to_scene(p.normal);
-    // Each side's rays are those its leaf's view region casts (ViewCells::regions, indexed by
-    // cell): a baked leaf of one piece names its region; others count every ray.
-    std::array<uint32_t, 2> region{kNoSideRegion, kNoSideRegion};
-    for (int side = 0; side < 2; ++side) {
-      const uint32_t c = cells.layout.leaf_cell[p.leaves[side]];
-      if (c != pvs::kNoCell && pieces_of[p.leaves[side]] == 1) region[size_t(side)] = c;
-    }
     for (int side = 0; side < 2; ++side) {
       const uint32_t c = cells.layout.leaf_cell[p.leaves[side]];
       if (c == pvs::kNoCell) continue;  // a leaf not baked
       for (const Segment& s : segs)
-        cells.segments[c].push_back(
-            {quake_to_scene(s.from), quake_to_scene(s.to), normal, side, region});
+        cells.segments[c].push_back({quake_to_scene(s.from), quake_to_scene(s.to), normal, side});
       if (sweep && options.adaptive) {
         FaceSweep f = scene_sweep(*sweep);
         f.side_normal = normal;
         f.side = side;
-        f.side_region = region;
         cells.sweeps[c].push_back(std::move(f));
       }
     }

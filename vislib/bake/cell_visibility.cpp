@@ -86,7 +86,6 @@ RegionOptions group_options(const RegionOptions& options, uint64_t cell_seed, si
 // the runs are shared between cells (ViewCells::shared_runs: not eyes of this cell).
 RegionOptions cell_options(const ViewCells& cells, uint32_t cell, const RegionOptions& options) {
   RegionOptions o = options;
-  if (!cells.regions.empty()) o.side_regions = &cells.regions;
   if (!cells.near_limit.empty() && !cells.shared_runs)
     o.segment.near = std::min(o.segment.near, cells.near_limit.at(cell));
   return o;

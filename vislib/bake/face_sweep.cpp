@@ -55,7 +55,7 @@ std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_l
     any = true;
   }
   if (!any || !(length(b - a) > min_length)) return std::nullopt;
-  return Segment{a, b, sweep.side_normal, sweep.side, sweep.side_region};
+  return Segment{a, b, sweep.side_normal, sweep.side};
 }
 
 namespace {

@@ -29,7 +29,6 @@ struct FaceSweep {
   // The directions its chords count (Segment::side_normal and side; zero: all): a portal's.
   Vec3 side_normal{0, 0, 0};
   int side = 0;
-  std::array<uint32_t, 2> side_region{kNoSideRegion, kNoSideRegion};  // Segment::side_region
 };
 
 // Chords shorter than this (scene units) are points and are not run (a chord at a face's vertex);

@@ -6,7 +6,6 @@
 #include <cassert>
 #include <functional>
 #include <iterator>
-#include <stdexcept>
 
 #include "vislib/base/phase_times.h"
 #include "vislib/base/random.h"
@@ -73,12 +72,6 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       const bool sided = !(seg.side_normal == Vec3{0, 0, 0});
       so.side_normal = seg.side_normal;
       so.side_only = witnesses && sided ? seg.side : -1;
-      for (size_t i = 0; i < 2; ++i)
-        if (seg.side_region[i] != kNoSideRegion) {
-          if (!options.side_regions || seg.side_region[i] >= options.side_regions->size())
-            throw std::invalid_argument("a segment names a side region the options do not hold");
-          so.side_regions[i] = &(*options.side_regions)[seg.side_region[i]];
-        }
       SegmentResult sr;
       bool computed = true;
       // Phases for a caller that times them (phase_times.h): a run computed here, or one another

@@ -7,7 +7,6 @@
 // random rotations drawn from the seed (paper §4.5). The visible set is the union.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <functional>
 #include <utility>
@@ -24,15 +23,10 @@ enum class Granularity { Triangle, Object };
 // side 1 is dot(d, n) <= 0): a portal's chord, whose run serves the leaves on both sides
 // (docs/quake.md "Portals"). Its runs are computed with both sides split, so that the shared run
 // cache hands one run to both; with witnesses, with the one side.
-// With side_normal, each side may name the region of eyes it serves, an index into
-// RegionOptions::side_regions (SegmentOptions::side_regions: only the rays an eye of the region
-// casts through the segment count), or kNoSideRegion.
-constexpr uint32_t kNoSideRegion = UINT32_MAX;
 struct Segment {
   Vec3 from, to;
   Vec3 side_normal{0, 0, 0};
   int side = 0;
-  std::array<uint32_t, 2> side_region{kNoSideRegion, kNoSideRegion};
 };
 
 // Perimeter segments of `box` (min <= max on every axis), in a fixed documented order: edges
@@ -59,9 +53,6 @@ struct RegionOptions {
   // for this many users in all when > 1 (SegmentRunCache::get's `users`: the two leaves of a
   // portal, whose adaptive chords are the same for both).
   std::vector<uint32_t> segment_users;
-  // The regions Segment::side_region indexes (scene coordinates, faces built); null when no
-  // segment names one.
-  const std::vector<ConvexPolytope>* side_regions = nullptr;
 };
 
 struct RunRecord {

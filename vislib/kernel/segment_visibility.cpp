@@ -325,16 +325,6 @@ class StaticKind {
       sides_ = true;
       all_sides_ = opt.side_only < 0 ? 3 : 1;
       for (int f = 0; f < kCubeFaces; ++f) side_axes_[size_t(f)] = face_axes(f, opt.orientation);
-      for (size_t i = 0; i < 2; ++i) {
-        const ConvexPolytope* r = opt.side_regions[i];
-        if (!r) continue;
-        windowed_ = true;
-        // Farther than any point of the region from any eye of the segment, with a margin.
-        double far = 0;
-        for (const std::vector<Vec3>& f : r->faces)
-          for (const Vec3& p : f) far = std::max(far, length(p - v0_));
-        reach_[i] = 2 * (far + length(v1_ - v0_)) + 1;
-      }
     }
   }
 
@@ -445,7 +435,6 @@ class StaticKind {
         for (int x = x0; x <= x1; ++x) {
           const uint8_t sides = side_mask(face, x, y);
           if (sides == 0) continue;
-          PixelWindows windows;
           const size_t k = rect.index(x, y);
           const Vec3 d = axes.F + axes.S * pixel_centers_[size_t(x)] + axes.T * tc;
           const double far = sc.far[k];
@@ -459,15 +448,27 @@ class StaticKind {
           LinearDepth depth;
           if (!static_coverage(st, d, axes.S, axes.T, opt_.near, lo, hi, depth)) continue;
           ++stats.covered_pairs;
-          for_each_see_through_stretch(
-              sc.lists[k], Piece{lo, hi, b.id, depth}, keep_ties_, opt_.eps_z,
-              [&](double t0, double t1) {
-                if (!part_bounds_.empty()) {
-                  mark_parts(found, part_bounds_, opt_.eps_len, b.id, t0, t1);
-                  return;
-                }
-                mark_stretch(found, witnesses, b.id, t0, t1, sides, windows, face, x, y);
-              });
+          for_each_see_through_stretch(sc.lists[k], Piece{lo, hi, b.id, depth}, keep_ties_,
+                                       opt_.eps_z, [&](double t0, double t1) {
+                                         if (!part_bounds_.empty()) {
+                                           mark_parts(found, part_bounds_, opt_.eps_len, b.id, t0,
+                                                      t1);
+                                           return;
+                                         }
+                                         const double len = t1 - t0;
+                                         if (!(len > opt_.eps_len)) return;
+                                         if (!witnesses) {
+                                           found.add(b.id, sides);
+                                           return;
+                                         }
+                                         Witness w;
+                                         w.tri = b.id;
+                                         w.face = face;
+                                         w.x = x;
+                                         w.y = y;
+                                         w.t = 0.5 * (t0 + t1);
+                                         found.mark(b.id, len, w);
+                                       });
         }
       }
     }
@@ -571,11 +572,22 @@ class StaticKind {
     }
     const bool witnesses = !found.witness_len.empty();
     auto settled = [&](uint32_t id) { return !witnesses && (found.seen(id) & sides) == sides; };
-    PixelWindows windows;
     for_each_visible(
         l, sc.ties[k],
         [&](uint32_t id, double t0, double t1) {
-          mark_stretch(found, witnesses, id, t0, t1, sides, windows, face, x, y);
+          double len = t1 - t0;
+          if (!(len > opt_.eps_len)) return;
+          if (!witnesses) {  // the mark alone (no witness to build and compare)
+            found.add(id, sides);
+            return;
+          }
+          Witness w;
+          w.tri = id;
+          w.face = face;
+          w.x = x;
+          w.y = y;
+          w.t = 0.5 * (t0 + t1);
+          found.mark(id, len, w);
         },
         settled);
     if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
@@ -597,59 +609,6 @@ class StaticKind {
     return uint8_t(mask >> opt_.side_only & 1);
   }
 
-  // The windows of a pixel's sides (SegmentOptions::side_regions), made when the first stretch
-  // needs them: bit i of the pixel's sides (with side_only, bit 0 is that side) counts over
-  // window[i]; [0, 1] for a side without a region.
-  struct PixelWindows {
-    bool made = false;
-    std::array<std::pair<double, double>, 2> window{{{0.0, 1.0}, {0.0, 1.0}}};
-  };
-  // Marks `id`, visible over [t0, t1] of the segment at pixel (x, y) of `face` on `sides`
-  // (side_mask), for each side over its window (the overlap longer than eps_len), with a
-  // witness at the middle of the overlap (of the last side counted) when `witnesses`.
-  void mark_stretch(FoundMarks& found, bool witnesses, uint32_t id, double t0, double t1,
-                    uint8_t sides, PixelWindows& windows, int face, int x, int y) const {
-    double len = t1 - t0;
-    if (!(len > opt_.eps_len)) return;
-    uint8_t bits = sides;
-    double mid = 0.5 * (t0 + t1);
-    if (windowed_) {
-      if (!windows.made) {
-        windows.made = true;
-        const FaceAxes& a = side_axes_[size_t(face)];
-        const Vec3 d = a.F + a.S * pixel_centers_[size_t(x)] + a.T * pixel_centers_[size_t(y)];
-        for (size_t bit = 0; bit < 2; ++bit) {
-          const size_t side = opt_.side_only < 0 ? bit : size_t(opt_.side_only);
-          if (!(sides >> bit & 1) || !opt_.side_regions[side]) continue;
-          windows.window[bit] =
-              back_window(opt_.side_regions[side]->halfspaces, v0_, v1_ - v0_, d, reach_[side]);
-        }
-      }
-      bits = 0;
-      for (size_t bit = 0; bit < 2; ++bit) {
-        if (!(sides >> bit & 1)) continue;
-        const double lo = std::max(t0, windows.window[bit].first),
-                     hi = std::min(t1, windows.window[bit].second);
-        if (!(hi - lo > opt_.eps_len)) continue;
-        bits = uint8_t(bits | 1 << bit);
-        len = hi - lo;
-        mid = 0.5 * (lo + hi);
-      }
-      if (bits == 0) return;
-    }
-    if (!witnesses) {  // the mark alone (no witness to build and compare)
-      found.add(id, bits);
-      return;
-    }
-    Witness w;
-    w.tri = id;
-    w.face = face;
-    w.x = x;
-    w.y = y;
-    w.t = mid;
-    found.mark(id, len, w);
-  }
-
   void relative_corners(size_t t, Vec3* rel) const {
     auto c = scene_.corners(uint32_t(t), opt_.state);
     const Vec3 r[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
@@ -666,8 +625,6 @@ class StaticKind {
   bool sides_ = false;               // side_normal given
   uint8_t all_sides_ = 1;            // the mark of an id seen on every side that counts
   std::array<FaceAxes, kCubeFaces> side_axes_{};  // world axes of each face (sides_ only)
-  bool windowed_ = false;                         // a side has a region (side_regions)
-  std::array<double, 2> reach_{0, 0};             // back_window's bound, per side
   bool keep_ties_ = false;
   bool has_see_through_ = false;
   double far_scale_ = 1.0;
@@ -677,37 +634,6 @@ class StaticKind {
 };
 
 }  // namespace
-
-std::pair<double, double> back_window(const std::vector<HalfSpace>& region, Vec3 v0, Vec3 e, Vec3 d,
-                                      double reach) {
-  // The (t, s) rectangle [0, 1] x [0, reach] clipped by each half-space: dot(n, v0 + t e - s d)
-  // <= offset, i.e. a t + b s <= c.
-  struct P {
-    double t, s;
-  };
-  std::vector<P> poly{{0, 0}, {1, 0}, {1, reach}, {0, reach}}, out;
-  for (const HalfSpace& h : region) {
-    const double a = dot(h.normal, e), b = -dot(h.normal, d), c = h.offset - dot(h.normal, v0);
-    out.clear();
-    for (size_t k = 0; k < poly.size(); ++k) {
-      const P u = poly[k], v = poly[(k + 1) % poly.size()];
-      const double su = a * u.t + b * u.s - c, sv = a * v.t + b * v.s - c;
-      if (su <= 0) out.push_back(u);
-      if ((su < 0 && sv > 0) || (su > 0 && sv < 0)) {
-        const double f = su / (su - sv);
-        out.push_back({u.t + (v.t - u.t) * f, u.s + (v.s - u.s) * f});
-      }
-    }
-    poly.swap(out);
-    if (poly.empty()) return {1.0, 0.0};
-  }
-  double lo = 1, hi = 0;
-  for (const P& p : poly) {
-    lo = std::min(lo, p.t);
-    hi = std::max(hi, p.t);
-  }
-  return {std::max(lo, 0.0), std::min(hi, 1.0)};
-}
 
 SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt) {
   assert(opt.resolution >= 1 && opt.near > 0 && opt.tile_size >= 0);
@@ -730,8 +656,6 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
       throw std::invalid_argument("side_only must be -1 (both sides), 0 or 1");
     if (opt.side_only < 0 && opt.want_witnesses)
       throw std::invalid_argument("witnesses need one side (side_only 0 or 1), not both");
-  } else if (opt.side_regions[0] || opt.side_regions[1]) {
-    throw std::invalid_argument("side regions need a side plane (side_normal)");
   }
   if (scene.sphere_count() > 0 || scene.is_dynamic()) {
     if (scene.has_see_through()) throw std::invalid_argument(kSeeThroughStaticOnly);

@@ -15,9 +15,7 @@
 // pieces at triple depth crossings: interval_list.h.)
 #pragma once
 
-#include <array>
 #include <cstdint>
-#include <utility>
 #include <vector>
 
 #include "vislib/base/cubemap.h"
@@ -27,7 +25,6 @@
 #include "vislib/kernel/interval_list.h"
 #include "vislib/kernel/triangle_bvh.h"
 #include "vislib/kernel/witness.h"
-#include "vislib/scene/quake_bsp_volumes.h"
 #include "vislib/scene/scene.h"
 
 namespace vislib {
@@ -101,23 +98,7 @@ struct SegmentOptions {
   // on both sides, each with the directions that leave it (docs/quake.md "Portals").
   Vec3 side_normal{0, 0, 0};
   int side_only = -1;
-  // With side_normal: for side i, null or a convex polytope of positive volume (scene
-  // coordinates, its faces built) behind the segment, the eyes that side serves (a portal's leaf's
-  // view region). A pixel of side i, direction d, then counts an id only over the eyes q(t) of
-  // the segment whose ray back, q(t) - s d for some s > 0, passes through the region
-  // (back_window): the rays through the portal that an eye of the region casts, and no others.
-  // An id counts when its final piece's overlap with that window is longer than eps_len; its
-  // witness lies at the overlap's middle.
-  std::array<const ConvexPolytope*, 2> side_regions{nullptr, nullptr};
 };
-
-// The eyes of segment [v0, v0 + e] (t in [0, 1]) whose ray back along -d passes through the
-// convex region `region` (half-spaces, bounded, positive volume): {t : v0 + t e - s d in region
-// for some s > 0}, an interval [lo, hi], empty (lo > hi) when there is none. `reach` bounds the
-// s that can matter: at least the largest distance from v0 to a point of the region plus |e|.
-// Exact up to rounding (a clip of the (t, s) rectangle by each half-space).
-std::pair<double, double> back_window(const std::vector<HalfSpace>& region, Vec3 v0, Vec3 e, Vec3 d,
-                                      double reach);
 
 constexpr size_t kMaxSplitParts = 8;
 // Pixels whose direction lies within this of a side plane (a cosine: |dot(d, n)| / (|d| |n|)) are
