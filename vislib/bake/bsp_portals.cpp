@@ -226,6 +226,10 @@ BspPortalCover bsp_portal_cover(const BspPortal& portal, const Scene& scene) {
   // The portal with its edges moved inward by the band: the parts are the triangles clipped to it.
   const std::vector<Vec3> inner = inside(portal.polygon, kBspOwnMinWidth);
   BspPortalCover cover;
+  if (inner.empty()) {  // narrower than twice the band: all of it lies in the band
+    cover.closed = true;
+    return cover;
+  }
   double covered = 0;
   for (uint32_t t = 0; t < scene.triangle_count(); ++t) {
     if (scene.triangle_see_through(t)) continue;
@@ -248,16 +252,14 @@ BspPortalCover bsp_portal_cover(const BspPortal& portal, const Scene& scene) {
       tri.push_back(q);
     }
     if (!on) continue;
-    if (inner.empty()) break;
     tri = inside(std::move(tri), kBspOwnMinWidth);
     if (tri.empty() || !(polygon_area(tri) > 0)) continue;
     covered += polygon_area(tri);
     cover.parts.push_back(std::move(tri));
   }
   // The triangles of a map's face share its corners exactly and do not overlap, so their areas
-  // add up to the inner part's to within rounding; a portal narrower than twice the band is
-  // closed (all of it lies in the band).
-  cover.closed = inner.empty() || covered >= polygon_area(inner) * (1 - 1e-9);
+  // add up to the inner part's to within rounding.
+  cover.closed = covered >= polygon_area(inner) * (1 - 1e-9);
   return cover;
 }
 
