@@ -118,14 +118,21 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
 // Per-face, compute-once rectangles and depths (of BVH nodes, or of triangles by their position in
 // the tree's leaf order): the first thread to need entry i computes it and publishes it; a thread
 // that finds it being written computes its own copy (the same values: the computation is
-// deterministic). An entry is ready when its stamp equals the face's.
-// Memory: the arrays are mapped untouched (mmap), so a run's resident memory grows
-// with the entries its walk touches (nodes and leaves lie in tree order, so those are few pages),
-// not with the scene: several runs of a bake hold these at once. A new face hands the pages
-// back to the kernel (madvise MADV_DONTNEED: they read as zeros, stale stamps, when touched
-// again), so a run holds one face's entries, not the union of its six faces' (on the 1M-triangle
-// city at N = 512, an 8 m segment's six faces touch 6.6 MB of entries, one face at most 2.1 MB).
+// deterministic). An entry is ready when its stamp is the current face's: each face has its own
+// generation number, so a new face makes every entry stale without touching it.
+// Memory: the arrays are mapped untouched (mmap), so a run's resident memory grows with the
+// entries its walk touches (nodes and leaves lie in tree order, so those are few pages), not with
+// the scene. Arrays of at most kFaceBoundsKeepBytes stay resident from face to face and from run
+// to run (FaceBoundsCaches::take): on lqdm1 (4,208 triangles, N = 128) handing the pages back at
+// every face and faulting them in again was 13% of a short run, most of it the other cores'
+// TLB flushes. Larger arrays hand their pages back at every new face (madvise MADV_DONTNEED: they
+// read as zeros, stale stamps, when touched again), so a run holds one face's entries, not the
+// union of its six faces' (on the 1M-triangle city at N = 512, an 8 m segment's six faces touch
+// 6.6 MB of entries, one face at most 2.1 MB), and are unmapped at the run's end: several runs of
+// a bake hold these at once.
 // Callers call next_face only while no tile of the run reads the cache.
+constexpr size_t kFaceBoundsKeepBytes = size_t(4) << 20;
+
 class FaceBoundsCache {
   static_assert(std::is_trivially_default_constructible_v<std::atomic<uint32_t>>);
 
@@ -134,10 +141,11 @@ class FaceBoundsCache {
   FaceBoundsCache(const FaceBoundsCache&) = delete;
   FaceBoundsCache& operator=(const FaceBoundsCache&) = delete;
   ~FaceBoundsCache() { release(); }
+  // Makes every entry stale, for a face of a run over `n` entries.
   void next_face(size_t n) {
     if (n > size_) {
       release();
-      // std::atomic<uint32_t> is trivially constructible: zeroed memory holds zero stamps.
+      // std::atomic<uint32_t> is trivially constructible: zeroed memory holds stale stamps.
       size_ = n;
       stamp_ = static_cast<std::atomic<uint32_t>*>(map_untouched(stamp_bytes()));
       box_ = static_cast<int*>(map_untouched(box_bytes()));  // read only under a stamp
@@ -146,19 +154,25 @@ class FaceBoundsCache {
         release();
         throw std::bad_alloc();
       }
-    } else if (size_) {
+    } else if (!kept()) {
       // box_ and zmin_ are read only under a ready stamp: discarding them only frees memory.
-      if (!discard(stamp_, stamp_bytes()))
-        for (size_t i = 0; i < size_; ++i) stamp_[i].store(kStale, std::memory_order_relaxed);
+      if (!discard(stamp_, stamp_bytes())) clear_stamps();
       discard(box_, box_bytes());
       discard(zmin_, zmin_bytes());
     }
+    if (++generation_ > kLastGeneration) {  // stamps of the first generations come back
+      clear_stamps();
+      generation_ = 1;
+    }
   }
+  // True when the arrays stay resident between faces and runs (kFaceBoundsKeepBytes).
+  bool kept() const { return stamp_bytes() + box_bytes() + zmin_bytes() <= kFaceBoundsKeepBytes; }
   // Rectangle (x0, x1, y0, y1) in box and nearest depth (rounded down) in z; false when empty.
   template <class Compute>
   bool get(size_t i, int* box, float& z, Compute compute) {
+    const uint32_t ready = 2 * generation_ + 1, writing = 2 * generation_;
     uint32_t seen = stamp_[i].load(std::memory_order_acquire);
-    if (seen != kReady) {
+    if (seen != ready) {
       double zd = 0;
       bool ok = compute(box, zd);
       if (!ok) {
@@ -166,11 +180,11 @@ class FaceBoundsCache {
         box[1] = 0;
       }
       z = ok ? round_down_to_float(zd) : 0.0f;
-      if (seen == kStale &&
-          stamp_[i].compare_exchange_strong(seen, kBeingWritten, std::memory_order_acq_rel)) {
+      if (seen != writing &&
+          stamp_[i].compare_exchange_strong(seen, writing, std::memory_order_acq_rel)) {
         std::copy(box, box + 4, &box_[i * 4]);
         zmin_[i] = z;
-        stamp_[i].store(kReady, std::memory_order_release);
+        stamp_[i].store(ready, std::memory_order_release);
       }
       return ok;
     }
@@ -180,11 +194,15 @@ class FaceBoundsCache {
   }
 
  private:
-  // An entry's stamp: zero (fresh or discarded pages), claimed by a writer, or ready this face.
-  static constexpr uint32_t kStale = 0, kBeingWritten = 1, kReady = 2;
+  // An entry's stamp: 2g + 1 ready in generation g, 2g claimed by a writer in generation g
+  // (g >= 1); anything else, zero included, is stale.
+  static constexpr uint32_t kLastGeneration = (uint32_t(1) << 31) - 1;
   size_t stamp_bytes() const { return size_ * sizeof(std::atomic<uint32_t>); }
   size_t box_bytes() const { return size_ * 4 * sizeof(int); }
   size_t zmin_bytes() const { return size_ * sizeof(float); }
+  void clear_stamps() {
+    for (size_t i = 0; i < size_; ++i) stamp_[i].store(0, std::memory_order_relaxed);
+  }
   // Zeroed pages straight from the kernel, resident only once written, and returned to it by
   // release(). (malloc would hand back memory freed by earlier runs, resident already: every run
   // in flight would then hold its whole arrays.)
@@ -205,11 +223,36 @@ class FaceBoundsCache {
     box_ = nullptr;
     zmin_ = nullptr;
     size_ = 0;
+    generation_ = 0;
   }
   std::atomic<uint32_t>* stamp_ = nullptr;
   int* box_ = nullptr;
   float* zmin_ = nullptr;
   size_t size_ = 0;
+  uint32_t generation_ = 0;  // the current face's; 0 before the first
+};
+
+// The node and triangle caches of one run. take() hands out the calling thread's pair (a new
+// one when it has none, or when its pair is in use further up the stack: a thread waiting on its
+// run's tiles may take up another run);
+// give_back() keeps the pair for the thread's next run when both stay within
+// kFaceBoundsKeepBytes, and frees it otherwise.
+struct FaceBoundsCaches {
+  FaceBoundsCache nodes, triangles;
+  static std::unique_ptr<FaceBoundsCaches> take() {
+    std::unique_ptr<FaceBoundsCaches> c = std::move(slot());
+    if (!c) c.reset(new FaceBoundsCaches);
+    return c;
+  }
+  static void give_back(std::unique_ptr<FaceBoundsCaches> c) {
+    if (!slot() && c->nodes.kept() && c->triangles.kept()) slot() = std::move(c);
+  }
+
+ private:
+  static std::unique_ptr<FaceBoundsCaches>& slot() {
+    thread_local std::unique_ptr<FaceBoundsCaches> c;
+    return c;
+  }
 };
 
 // The culling bounds of one tile: the farthest `far` over its pixels (inf while some pixel does
@@ -453,7 +496,8 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   std::vector<float> zmin(bvh ? 0 : count);
   std::vector<uint32_t> bin_start;
   std::vector<TileItem> bins;
-  FaceBoundsCache node_cache, tri_cache;
+  std::unique_ptr<FaceBoundsCaches> caches = FaceBoundsCaches::take();
+  FaceBoundsCache &node_cache = caches->nodes, &tri_cache = caches->triangles;
 
   for (int face = 0; face < kCubeFaces; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
@@ -562,6 +606,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                         Work::give_back(std::move(work), held, run);
                       });
   }
+  FaceBoundsCaches::give_back(std::move(caches));
 }
 
 }  // namespace vislib
