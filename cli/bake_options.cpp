@@ -193,7 +193,7 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
     for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
-                          "--chord-floor", "--sweep"})
+                          "--chord-floor", "--chord-piece", "--sweep"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -223,10 +223,16 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     o.face_spacing = a.face_spacing.value_or(a.sweep == "portals" ? vislib::kBspPortalSpacing
                                                                   : vislib::kBspFaceSpacing);
     o.near = a.near;
-    if (a.face_sweep == "adaptive") {
-      if (!(a.chords.floor <= a.chords.coarse))
+    const bool portals = a.sweep == "portals";
+    if (a.face_sweep.value_or(portals ? "adaptive" : "even") == "adaptive") {
+      const vislib::AdaptiveSpacing d =
+          portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
+      const vislib::AdaptiveSpacing chords{a.chord_coarse.value_or(d.coarse),
+                                           a.chord_floor.value_or(d.floor),
+                                           a.chord_piece.value_or(d.piece)};
+      if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
-      o.adaptive = a.chords;
+      o.adaptive = chords;
     }
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
     o.scene = load_options_of(a.import);
@@ -329,18 +335,22 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--face-sweep", a.face_sweep,
                   "bsp-leaves: 'even' (chords --face-spacing apart) or 'adaptive' (coarse chords, "
                   "one inserted between two neighbours while it sees ids neither sees, down to "
-                  "--chord-floor; docs/quake.md)")
-      ->check(CLI::IsMember({"even", "adaptive"}))
-      ->capture_default_str();
-  cmd->add_option("--chord-coarse", a.chords.coarse,
-                  "bsp-leaves, adaptive: the first chords at most this far apart (Quake units)")
-      ->check(in_range(1e-3, 1e6))
-      ->capture_default_str();
-  cmd->add_option("--chord-floor", a.chords.floor,
+                  "--chord-floor; docs/quake.md); default adaptive with --sweep portals, even "
+                  "with faces")
+      ->check(CLI::IsMember({"even", "adaptive"}));
+  cmd->add_option("--chord-coarse", a.chord_coarse,
+                  "bsp-leaves, adaptive: the first chords at most this far apart (Quake units; "
+                  "default 128 with --sweep portals, 64 with faces)")
+      ->check(in_range(1e-3, 1e6));
+  cmd->add_option("--chord-floor", a.chord_floor,
                   "bsp-leaves, adaptive: no chord is inserted closer than this to a neighbour "
-                  "(Quake units, at most --chord-coarse)")
-      ->check(in_range(1e-3, 1e6))
-      ->capture_default_str();
+                  "(Quake units, at most --chord-coarse; default 4)")
+      ->check(in_range(1e-3, 1e6));
+  cmd->add_option("--chord-piece", a.chord_piece,
+                  "bsp-leaves, adaptive: cut each swept polygon into strips at most this long "
+                  "along its chords, each refined on its own (Quake units; 0 = whole chords; "
+                  "default 128 with --sweep portals, 0 with faces)")
+      ->check(in_range(0.0, 1e6));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

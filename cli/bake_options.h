@@ -38,10 +38,13 @@ struct BakeArgs {
   std::string cells;                // --cells: "" (grid or walkable) or bsp-leaves
   // --face-spacing (bsp-leaves), Quake units; unset: kBspPortalSpacing or kBspFaceSpacing.
   std::optional<double> face_spacing;
-  std::string leaves;                      // --leaves A-B (bsp-leaves)
-  std::string face_sweep = "even";         // --face-sweep even|adaptive (bsp-leaves)
-  std::string sweep = "portals";           // --sweep portals|faces (bsp-leaves)
-  vislib::AdaptiveSpacing chords;          // --chord-coarse, --chord-floor (adaptive)
+  std::string leaves;  // --leaves A-B (bsp-leaves)
+  // --face-sweep even|adaptive (bsp-leaves); unset: adaptive with --sweep portals, even with faces.
+  std::optional<std::string> face_sweep;
+  std::string sweep = "portals";  // --sweep portals|faces (bsp-leaves)
+  // --chord-coarse, --chord-floor, --chord-piece (adaptive); unset: kBspPortalChords with --sweep
+  // portals, else AdaptiveSpacing's defaults.
+  std::optional<double> chord_coarse, chord_floor, chord_piece;
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)

@@ -34,7 +34,11 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     if (!coarse.is_number() || !floor.is_number() || !(floor.get<double>() > 0) ||
         !(floor.get<double>() <= coarse.get<double>()))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_coarse or chord_floor");
-    co.adaptive = vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>()};
+    const nlohmann::json piece = find_key(md, "chord_piece");  // absent: whole chords
+    if (!piece.is_null() && !(piece.is_number() && piece.get<double>() >= 0))
+      throw vislib::InputError(pvs, "metadata holds an invalid chord_piece");
+    co.adaptive = vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>(),
+                                          piece.is_null() ? 0.0 : piece.get<double>()};
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

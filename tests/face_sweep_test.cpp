@@ -40,6 +40,52 @@ TEST(FaceSweep, EvenChordsLieAcrossTheFaceAtMostTheSpacingApart) {
   EXPECT_TRUE(even_chords(s, 10, kSweepMinChord).empty());  // not wider than the spacing
 }
 
+// A strip's chords are the pieces of the face's chords over its stretch: the strips of a
+// triangle cover each chord whole, piece after piece, and a chord that does not reach a strip
+// gives it none.
+TEST(FaceSweep, StripsCutEveryChordIntoPiecesThatMeetEndToEnd) {
+  const std::vector<Vec3> face = {{0, 0, 0}, {100, 0, 0}, {100, 50, 0}};
+  auto s = face_sweep_of(face, {0, 0, 1}, kSweepMinChord);  // chords along the hypotenuse
+  ASSERT_TRUE(s.has_value());
+  auto t_of = [&](Vec3 p) { return dot(s->along, p); };
+  const std::vector<FaceSweep> strips = sweep_strips(*s, 30);
+  ASSERT_EQ(strips.size(), 4u);  // about 111.8 units along the chords: 4 strips
+  EXPECT_EQ(strips.front().t_lo, -INFINITY);
+  EXPECT_EQ(strips.back().t_hi, INFINITY);
+  for (size_t k = 0; k + 1 < strips.size(); ++k) EXPECT_EQ(strips[k].t_hi, strips[k + 1].t_lo);
+  for (double f : {0.01, 0.2, 0.5, 0.75, 0.98}) {
+    const double h = s->lo + f * (s->hi - s->lo);
+    const auto whole = face_chord(*s, h, kSweepMinChord);
+    ASSERT_TRUE(whole.has_value());
+    const double t0 = std::min(t_of(whole->from), t_of(whole->to));
+    const double t1 = std::max(t_of(whole->from), t_of(whole->to));
+    double reached = t0;
+    size_t pieces = 0;
+    for (const FaceSweep& strip : strips) {
+      const auto piece = face_chord(strip, h, kSweepMinChord);
+      if (!piece) {  // the chord does not reach this strip
+        EXPECT_TRUE(t1 <= strip.t_lo + 1e-9 || t0 >= strip.t_hi - 1e-9) << h;
+        continue;
+      }
+      ++pieces;
+      const double p0 = std::min(t_of(piece->from), t_of(piece->to));
+      const double p1 = std::max(t_of(piece->from), t_of(piece->to));
+      EXPECT_NEAR(p0, reached, 1e-9) << h;
+      EXPECT_LE(p1 - p0, 30) << h;
+      EXPECT_NEAR(dot(s->across, piece->from), h, 1e-9);
+      EXPECT_NEAR(dot(s->across, piece->to), h, 1e-9);
+      reached = p1;
+    }
+    EXPECT_NEAR(reached, t1, 1e-9) << h;
+    EXPECT_GE(pieces, 1u);
+  }
+  // Not longer than the length: the sweep itself, and its chords bit for bit.
+  const std::vector<FaceSweep> one = sweep_strips(*s, 120);
+  ASSERT_EQ(one.size(), 1u);
+  const double h = s->lo + 0.5 * (s->hi - s->lo);
+  EXPECT_EQ(face_chord(one[0], h, kSweepMinChord)->to.x, face_chord(*s, h, kSweepMinChord)->to.x);
+}
+
 // The chord position of a segment of wide(): its x.
 double position(const Segment& s) {
   return s.from.x;

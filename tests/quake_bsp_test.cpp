@@ -18,6 +18,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <random>
+#include <set>
 
 #include "tests/scene_builders.h"
 #include "tests/support/bsp_writer.h"
@@ -1259,36 +1260,50 @@ TEST(QuakeBake, PortalSweepRunsEachPortalOnceForBothLeavesAndHoldsEveryRayFromTh
 
 // The adaptive sweep of a portal inserts the same chords for both of its leaves (judged by both
 // sides' runs, from what the portal's edges see), so the second leaf takes every one of the
-// first's runs from the cache: shared runs = computed runs. Bytes as each cell baked alone, at 1
+// first's runs from the cache: shared runs = computed runs; so does each strip of a portal cut
+// into strips (AdaptiveSpacing::piece), each its own family. Bytes as each cell baked alone, at 1
 // and 2 threads; the witness re-run, which keeps one side a run, judges the same chords.
 TEST(QuakeBake, AdaptivePortalSweepInsertsTheSameChordsForBothLeavesAndRunsEachOnce) {
   const std::string dir = temp_dir("quake_bake_adaptive_portals");
   const std::string path = write_map(dir, "tiny.bsp", encode_bsp(tiny_map()));
   const Scene scene = load(path, BspModels::world, BspLiquids::see_through);
   const QuakeBsp m = read_quake_bsp(path);
-  BspCellOptions o;
-  o.scene.bsp_liquids = BspLiquids::see_through;
-  o.sweep = BspSweep::Portals;
-  o.adaptive = AdaptiveSpacing{32, 2};
-  const ViewCells cells = bsp_leaf_cells(m, o, &scene);
-  ASSERT_EQ(cells.sweeps.size(), 2u);
-  ASSERT_EQ(cells.sweeps[0].size(), 1u);
-  ASSERT_EQ(cells.sweeps[1].size(), 1u);
-  EXPECT_EQ(sweep_family_key(cells.sweeps[0][0]), sweep_family_key(cells.sweeps[1][0]));
-  BakeSettings s;
-  s.region.segment.resolution = 32;
-  const TwoLeafBake baked = bake_two_leaves(scene, cells, s, dir);
-  // More than the polygon's edges: the sweep ran chords, and each was computed once.
-  EXPECT_GT(baked.report.segment_runs_shared, cells.segments[0].size());
-  EXPECT_EQ(baked.report.segment_runs_computed, baked.report.segment_runs_shared);
-  pvs::Reader r = pvs::Reader::from_memory(baked.bytes);
-  expect_every_ray_in_the_sets(scene, m, cells, r, 3607, BspLiquids::see_through);
-  // The witness re-run finds a witness for each of the own triangles at least (a re-run that
-  // chose other chords would see other ids: every id it returns is in the set).
-  for (uint32_t c = 0; c < 2; ++c) {
-    const std::vector<uint32_t> set = r.read_cell(c);
-    for (const CellWitnessRay& w : cell_witness_rays(scene, cells, c, s.region, set))
-      EXPECT_TRUE(std::binary_search(set.begin(), set.end(), w.tri));
+  for (double piece : {0.0, 16.0}) {
+    SCOPED_TRACE(piece);
+    BspCellOptions o;
+    o.scene.bsp_liquids = BspLiquids::see_through;
+    o.sweep = BspSweep::Portals;
+    o.adaptive = AdaptiveSpacing{32, 2, piece};
+    const ViewCells cells = bsp_leaf_cells(m, o, &scene);
+    ASSERT_EQ(cells.sweeps.size(), 2u);
+    ASSERT_EQ(cells.sweeps[0].size(), cells.sweeps[1].size());
+    if (piece == 0) {
+      ASSERT_EQ(cells.sweeps[0].size(), 1u);
+    } else {
+      ASSERT_GT(cells.sweeps[0].size(), 1u);
+    }
+    std::set<SegmentRunCache::Key> families;
+    for (size_t k = 0; k < cells.sweeps[0].size(); ++k) {
+      EXPECT_EQ(sweep_family_key(cells.sweeps[0][k]), sweep_family_key(cells.sweeps[1][k]));
+      families.insert(sweep_family_key(cells.sweeps[0][k]));
+    }
+    EXPECT_EQ(families.size(), cells.sweeps[0].size());
+    BakeSettings s;
+    s.region.segment.resolution = 32;
+    const TwoLeafBake baked = bake_two_leaves(
+        scene, cells, s, temp_dir("quake_bake_adaptive_portals_p" + std::to_string(int(piece))));
+    // More than the polygon's edges: the sweep ran chords, and each was computed once.
+    EXPECT_GT(baked.report.segment_runs_shared, cells.segments[0].size());
+    EXPECT_EQ(baked.report.segment_runs_computed, baked.report.segment_runs_shared);
+    pvs::Reader r = pvs::Reader::from_memory(baked.bytes);
+    expect_every_ray_in_the_sets(scene, m, cells, r, 3607, BspLiquids::see_through);
+    // The witness re-run finds a witness for each of the own triangles at least (a re-run that
+    // chose other chords would see other ids: every id it returns is in the set).
+    for (uint32_t c = 0; c < 2; ++c) {
+      const std::vector<uint32_t> set = r.read_cell(c);
+      for (const CellWitnessRay& w : cell_witness_rays(scene, cells, c, s.region, set))
+        EXPECT_TRUE(std::binary_search(set.begin(), set.end(), w.tri));
+    }
   }
 }
 
@@ -1329,9 +1344,22 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   nlohmann::json c = cells_of("");
   EXPECT_EQ(c["sweep"], "portals");
   EXPECT_EQ(c["face_spacing"], kBspPortalSpacing);
+  EXPECT_EQ(c["face_sweep"], "adaptive");
+  EXPECT_EQ(c["chord_coarse"], kBspPortalChords.coarse);
+  EXPECT_EQ(c["chord_floor"], kBspPortalChords.floor);
+  EXPECT_EQ(c["chord_piece"], kBspPortalChords.piece);
+  c = cells_of("--face-sweep even");
+  EXPECT_EQ(c["face_sweep"], "even");
+  EXPECT_FALSE(c.contains("chord_coarse"));
+  EXPECT_EQ(cells_of("--chord-floor 16")["chord_floor"], 16.0);
   c = cells_of("--sweep faces");
   EXPECT_EQ(c["sweep"], "faces");
   EXPECT_EQ(c["face_spacing"], kBspFaceSpacing);
+  EXPECT_EQ(c["face_sweep"], "even");
+  c = cells_of("--sweep faces --face-sweep adaptive");
+  EXPECT_EQ(c["chord_coarse"], AdaptiveSpacing{}.coarse);
+  EXPECT_EQ(c["chord_floor"], AdaptiveSpacing{}.floor);
+  EXPECT_EQ(c["chord_piece"], 0.0);
   EXPECT_EQ(cells_of("--sweep faces --face-spacing 4")["face_spacing"], 4.0);
   EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --sweep edges -o " + dir + "/x.pvs", &out),
             2);

@@ -46,6 +46,15 @@ FaceSweep scene_sweep(FaceSweep s) {
   return s;
 }
 
+// Appends `sweep` to `out`, cut into strips at most `piece` long when piece > 0 (AdaptiveSpacing).
+void add_sweep(std::vector<FaceSweep>& out, const FaceSweep& sweep, double piece) {
+  if (!(piece > 0)) {
+    out.push_back(sweep);
+    return;
+  }
+  for (FaceSweep& s : sweep_strips(sweep, piece)) out.push_back(std::move(s));
+}
+
 }  // namespace
 
 std::vector<uint32_t> bsp_cell_leaves(const QuakeBsp& bsp) {
@@ -234,7 +243,7 @@ void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<
         FaceSweep f = scene_sweep(*sweep);
         f.side_normal = normal;
         f.side = side;
-        cells.sweeps[c].push_back(std::move(f));
+        add_sweep(cells.sweeps[c], f, options.adaptive->piece);
       }
     }
   }
@@ -290,7 +299,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
     cells.segments[c].insert(cells.segments[c].end(), s.begin(), s.end());
     if (options.adaptive)
       for (const FaceSweep& f : region_sweeps(region.volume))
-        cells.sweeps[c].push_back(scene_sweep(f));
+        add_sweep(cells.sweeps[c], scene_sweep(f), options.adaptive->piece);
   }
   for (std::vector<ViewCells::OwnTriangle>& own : cells.own) {  // a leaf of several pieces
     std::stable_sort(own.begin(), own.end(),
@@ -331,6 +340,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
   if (options.adaptive) {
     d["chord_coarse"] = options.adaptive->coarse;
     d["chord_floor"] = options.adaptive->floor;
+    d["chord_piece"] = options.adaptive->piece;
   }
   cells.description = d.dump();
   return cells;

@@ -48,6 +48,12 @@ constexpr double kBspFaceSpacing = 16.0;
 // chords, so its chords lie twice as close; on lqdm1 the sampled misses then match the face
 // sweep's at 16 for half its CPU (docs/quake.md "Portals").
 constexpr double kBspPortalSpacing = 8.0;
+// The default chords of a portal sweep (BspSweep::Portals, Quake units; `pvs bake` sweeps portals
+// adaptively unless told --face-sweep even): the first chords at most 128 apart, inserted down to
+// 4, each portal cut into strips at most 128 long along its chords. On lqdm1 whole (N = 128) it
+// costs 0.6 of the even sweep at 8 for fewer sampled misses; a floor of 8 costs 0.37 for 1.4 times
+// its misses (docs/quake.md "Portals").
+constexpr AdaptiveSpacing kBspPortalChords{128.0, 4.0, 128.0};
 
 // The segments a convex region's visibility is computed on (Quake coordinates in, scene
 // coordinates out, quake_to_scene): first every edge of every face of `region`, in face order and

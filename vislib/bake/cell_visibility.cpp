@@ -43,7 +43,10 @@ std::vector<Box3> band_rectangles(const Box3& region, int levels) {
 
 SegmentRunCache::Key sweep_family_key(const FaceSweep& sweep) {
   assert(sweep.face.size() >= 2);
-  return SegmentRunCache::key_of(sweep.face[0], sweep.face[1], sweep.side_normal);
+  // A strip's window tells it from the face's other strips.
+  const auto end = [](double t) { return std::isfinite(t) ? t : 0.0; };
+  return SegmentRunCache::key_of(sweep.face[0] + sweep.along * end(sweep.t_lo),
+                                 sweep.face[1] + sweep.along * end(sweep.t_hi), sweep.side_normal);
 }
 
 std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels) {

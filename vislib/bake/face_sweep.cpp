@@ -54,8 +54,33 @@ std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_l
     }
     any = true;
   }
-  if (!any || !(length(b - a) > min_length)) return std::nullopt;
+  if (!any) return std::nullopt;
+  if (ta < sweep.t_lo || tb > sweep.t_hi) {  // a strip's piece (the whole chord bit for bit else)
+    if (tb < sweep.t_lo || ta > sweep.t_hi || !(ta < tb)) return std::nullopt;
+    const Vec3 d = b - a;
+    const double s0 = std::max(ta, sweep.t_lo), s1 = std::min(tb, sweep.t_hi);
+    b = s1 < tb ? a + d * ((s1 - ta) / (tb - ta)) : b;
+    a = s0 > ta ? a + d * ((s0 - ta) / (tb - ta)) : a;
+  }
+  if (!(length(b - a) > min_length)) return std::nullopt;
   return Segment{a, b, sweep.side_normal, sweep.side};
+}
+
+std::vector<FaceSweep> sweep_strips(const FaceSweep& sweep, double length) {
+  assert(length > 0);
+  double t0 = INFINITY, t1 = -INFINITY;
+  for (const Vec3& p : sweep.face) {
+    t0 = std::min(t0, dot(sweep.along, p));
+    t1 = std::max(t1, dot(sweep.along, p));
+  }
+  const int n = t1 - t0 > length ? int(std::ceil((t1 - t0) / length)) : 1;
+  std::vector<FaceSweep> out(size_t(n), sweep);
+  for (int k = 1; k < n; ++k) {
+    const double cut = t0 + (t1 - t0) * double(k) / double(n);
+    out[size_t(k) - 1].t_hi = cut;
+    out[size_t(k)].t_lo = cut;
+  }
+  return out;
 }
 
 namespace {

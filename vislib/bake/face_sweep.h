@@ -9,6 +9,7 @@
 // costs a few chords, a doorway as many as it needs.
 #pragma once
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <vector>
@@ -29,6 +30,9 @@ struct FaceSweep {
   // The directions its chords count (Segment::side_normal and side; zero: all): a portal's.
   Vec3 side_normal{0, 0, 0};
   int side = 0;
+  // The chords are cut to t_lo <= dot(along, x) <= t_hi: a strip of the face (sweep_strips). The
+  // face's edges stay its base's (the adaptive sweep's extreme positions).
+  double t_lo = -INFINITY, t_hi = INFINITY;
 };
 
 // Chords shorter than this (scene units) are points and are not run (a chord at a face's vertex);
@@ -46,6 +50,12 @@ std::optional<FaceSweep> face_sweep_of(const std::vector<Vec3>& face, Vec3 norma
 // Nothing when it is shorter than `min_length` (at a vertex of the face, say).
 std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_length);
 
+// `sweep` cut across its chords into strips of equal length along them, at most `length` long
+// (length > 0): each strip's chords are the pieces of the face's chords over its stretch, the
+// first and the last strips open-ended (so that together they cover every chord whole, each piece
+// ending where the next begins). One strip, `sweep` itself, when the face is not longer.
+std::vector<FaceSweep> sweep_strips(const FaceSweep& sweep, double length);
+
 // The even sweep: chords at h = lo + k (hi - lo) / n, k = 1 .. n - 1, with n = ceil((hi - lo) /
 // spacing) (at most `spacing` apart), in increasing k; none when the width is not larger than
 // spacing. `spacing` > 0.
@@ -55,10 +65,13 @@ std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double 
 // apart (the even sweep's positions); a chord is inserted midway between two neighbours (a face's
 // own extreme positions count as neighbours that see its base, below) whose distance is larger
 // than `floor`, and kept on the grid of halvings, while the last one inserted there saw an id
-// that neither neighbour saw. 0 < floor <= coarse.
+// that neither neighbour saw. 0 < floor <= coarse. With `piece` > 0 each swept face is first cut
+// into strips at most `piece` long along its chords (sweep_strips), each refined on its own, so a
+// long chord's probes go on only over the stretches where new ids are seen (0: whole chords).
 struct AdaptiveSpacing {
   double coarse = 64;
   double floor = 4;
+  double piece = 0;
 };
 
 // Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
