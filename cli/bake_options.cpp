@@ -344,7 +344,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->check(in_range(1e-3, 1e6));
   cmd->add_option("--chord-floor", a.chord_floor,
                   "bsp-leaves, adaptive: no chord is inserted closer than this to a neighbour "
-                  "(Quake units, at most --chord-coarse; default 4)")
+                  "(Quake units, at most --chord-coarse; default 8 with --sweep portals, 4 with "
+                  "faces)")
       ->check(in_range(1e-3, 1e6));
   cmd->add_option("--chord-piece", a.chord_piece,
                   "bsp-leaves, adaptive: cut each swept polygon into strips at most this long "

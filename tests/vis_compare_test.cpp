@@ -694,12 +694,12 @@ TEST(VisCompareLibreQuake, E1m2LeavesUnderFacesOnTheirPortalsSeeNothingThroughTh
 // where the set changes, kBspPortalChords; -j 2) and held against the map's vis. Every extra is
 // settled: none is left unconfirmed and no kernel witness is false (the map's T-junctions leaked
 // through cracks before edges took their runs' lines: edge_lines.h). Our sampled misses
-// (measured: 21 rays of 31.6 million; the even sweep at 8 units left 23, the face sweep at 16
-// units 15) are triangles seen only between two chords (docs/quake.md, "Portals"): bounded, not
-// zero, at this spacing (the opt-in test below sweeps the faces at 4, where they are zero). Release
-// builds only: the sanitizers multiply the bake's cost, and the 4-leaf bake of quake_bsp_test.cpp
-// covers the same code under them. Time budget: printed; about 150 CPU s for the bake (the same
-// bake with a floor of 8: 92 CPU s, 46 s wall on two idle cores) and 2 CPU s for the comparison.
+// (measured: 27 rays of 31.6 million; the even sweep at 8 units left 23, a floor of 4 21, the face
+// sweep at 16 units 15) are triangles seen only between two chords (docs/quake.md, "Portals"):
+// bounded, not zero, at this spacing (the opt-in test below sweeps the faces at 4, where they are
+// zero). Release builds only: the sanitizers multiply the bake's cost, and the 4-leaf bake of
+// quake_bsp_test.cpp covers the same code under them. Time budget: printed; about 95 CPU s for the
+// bake (46-50 s wall on two idle cores) and 2 CPU s for the comparison.
 constexpr int kLqdm1N64MissBound = 32;  // sampled rays, of 31,555,584
 TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMisses) {
 #if defined(__SANITIZE_ADDRESS__)
@@ -709,7 +709,7 @@ TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMiss
 #ifndef NDEBUG
   GTEST_SKIP() << "the whole-map bake is a release-suite test";
 #endif
-  auto j = bake_and_compare("lqdm1.bsp", "--res 64", "1.5 minutes on two idle cores");
+  auto j = bake_and_compare("lqdm1.bsp", "--res 64", "1 minute on two idle cores");
   if (!j) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   const auto& t = (*j)["totals"];
   ASSERT_FALSE(t.empty());

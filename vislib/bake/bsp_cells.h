@@ -50,10 +50,10 @@ constexpr double kBspFaceSpacing = 16.0;
 constexpr double kBspPortalSpacing = 8.0;
 // The default chords of a portal sweep (BspSweep::Portals, Quake units; `pvs bake` sweeps portals
 // adaptively unless told --face-sweep even): the first chords at most 128 apart, inserted down to
-// 4, each portal cut into strips at most 128 long along its chords. On lqdm1 whole (N = 128) it
-// costs 0.6 of the even sweep at 8 for fewer sampled misses; a floor of 8 costs 0.37 for 1.4 times
-// its misses (docs/quake.md "Portals").
-constexpr AdaptiveSpacing kBspPortalChords{128.0, 4.0, 128.0};
+// 8, each portal cut into strips at most 128 long along its chords. It costs less CPU than the
+// even sweep at 8 on lqdm1, e1m2 and e2m3 for about its sampled misses; a floor of 4 buys fewer
+// misses for more CPU on the bigger maps (docs/quake.md "Portals" has the figures).
+constexpr AdaptiveSpacing kBspPortalChords{128.0, 8.0, 128.0};
 
 // The segments a convex region's visibility is computed on (Quake coordinates in, scene
 // coordinates out, quake_to_scene): first every edge of every face of `region`, in face order and
