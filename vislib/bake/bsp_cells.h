@@ -50,9 +50,10 @@ constexpr double kBspFaceSpacing = 16.0;
 constexpr double kBspPortalSpacing = 8.0;
 // The default chords of a portal sweep (BspSweep::Portals, Quake units; `pvs bake` sweeps portals
 // adaptively unless told --face-sweep even): the first chords at most 128 apart, inserted down to
-// 8, each portal cut into strips at most 128 long along its chords. It costs less CPU than the
-// even sweep at 8 on lqdm1, e1m2 and e2m3 for about its sampled misses; a floor of 4 buys fewer
-// misses for more CPU on the bigger maps (docs/quake.md "Portals" has the figures).
+// 8, each portal cut into strips at most 128 long along its chords. For about the even sweep at
+// 8's sampled misses it costs less CPU on lqdm1 whole and on leaf samples of e1m2 and e2m3, but
+// more on e2m3 whole; a floor of 4 buys fewer misses for more CPU on the bigger maps
+// (docs/quake.md "Portals" has the figures).
 constexpr AdaptiveSpacing kBspPortalChords{128.0, 8.0, 128.0};
 
 // The segments a convex region's visibility is computed on (Quake coordinates in, scene
