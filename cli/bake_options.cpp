@@ -193,7 +193,7 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
     for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
-                          "--chord-floor", "--chord-piece", "--sweep"})
+                          "--chord-floor", "--chord-piece", "--sweep", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -208,6 +208,8 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
       throw CLI::ValidationError(o,
                                  "cannot be combined with --cells bsp-leaves (the cells are "
                                  "the map's BSP leaves)");
+  if (cmd.count("--bound") && a.sweep != "portals" && a.bound != "none")
+    throw CLI::ValidationError("--bound", "restricts the runs of --sweep portals only");
   if (!ends_with_bsp(a.scene))
     throw vislib::InputError(a.scene,
                              "--cells bsp-leaves needs a Quake map (.bsp): the cells are its BSP "
@@ -237,6 +239,10 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
     o.scene = load_options_of(a.import);
     o.sweep = a.sweep == "portals" ? vislib::BspSweep::Portals : vislib::BspSweep::Faces;
+    o.bound = !portals               ? vislib::BspBound::None
+              : a.bound == "portals" ? vislib::BspBound::Portals
+              : a.bound == "map-vis" ? vislib::BspBound::MapVis
+                                     : vislib::BspBound::None;
     return vislib::bsp_leaf_cells(bsp, o, &scene);
   }
   vislib::CellPlacement p = placement_of(a);
@@ -326,6 +332,13 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "directions split by its plane, plus the triangles on or in each leaf) or "
                   "'faces' (every face of each leaf's view region, walls included; docs/quake.md)")
       ->check(CLI::IsMember({"portals", "faces"}))
+      ->capture_default_str();
+  cmd->add_option("--bound", a.bound,
+                  "bsp-leaves, --sweep portals: restrict each portal's runs to the triangles that "
+                  "can be visible through it: 'portals' (our portal flow: exact), 'map-vis' (the "
+                  "leaves the map's own vis data says its two leaves see: exact only where that "
+                  "is conservative) or 'none' (docs/quake.md \"Restriction\")")
+      ->check(CLI::IsMember({"none", "portals", "map-vis"}))
       ->capture_default_str();
   cmd->add_option("--face-spacing", a.face_spacing,
                   "bsp-leaves: sweep each swept polygon (a portal, or a face of a leaf's view "

@@ -42,6 +42,7 @@ struct BakeArgs {
   // --face-sweep even|adaptive (bsp-leaves); unset: adaptive with --sweep portals, even with faces.
   std::optional<std::string> face_sweep;
   std::string sweep = "portals";  // --sweep portals|faces (bsp-leaves)
+  std::string bound = "portals";  // --bound none|portals|map-vis (bsp-leaves, --sweep portals)
   // --chord-coarse, --chord-floor, --chord-piece (adaptive); unset: kBspPortalChords with --sweep
   // portals, else AdaptiveSpacing's defaults.
   std::optional<double> chord_coarse, chord_floor, chord_piece;

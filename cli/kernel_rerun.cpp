@@ -45,6 +45,11 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
   const nlohmann::json kind = find_key(md, "sweep");
   if (kind.is_string() && kind.get<std::string>() == "portals")
     co.sweep = vislib::BspSweep::Portals;
+  const nlohmann::json bound = find_key(md, "bound");  // absent: none
+  if (bound.is_string() && co.sweep == vislib::BspSweep::Portals)
+    co.bound = bound.get<std::string>() == "portals"   ? vislib::BspBound::Portals
+               : bound.get<std::string>() == "map-vis" ? vislib::BspBound::MapVis
+                                                       : vislib::BspBound::None;
   ro_.segment.resolution = md["resolution"].get<int>();
   ro_.segment.near = md["near"].get<double>();
   co.near = ro_.segment.near;

@@ -190,8 +190,10 @@ Vec3 polytope_centre(const ConvexPolytope& p) {
 
 // The portal runs of the cells (BspSweep::Portals, bsp_leaf_cells): each portal's edges and
 // chords, or its sweep, for each of its two leaves that is a cell of `cells`, with the leaf's side.
-void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<uint32_t>& all,
-                     const BspCellOptions& options, const Scene& scene, ViewCells& cells) {
+// With options.bound, each portal's runs are restricted to its bound (bsp_bound.h).
+void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& pieces,
+                     const std::vector<uint32_t>& all, const BspCellOptions& options,
+                     const Scene& scene, ViewCells& cells) {
   // Each leaf's volume, when it is one piece (a leaf of several keeps no clearance from its
   // planes: its portals are swept whole on its side).
   std::vector<const ConvexPolytope*> volume(cells.layout.leaf_cell.size(), nullptr);
@@ -203,7 +205,16 @@ void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<
     }
   const ConvexPolytope none;
   const double clearance = kNearClearanceFactor * options.near;
-  for (const BspPortal& p : bsp_leaf_portals(pieces, all)) {
+  const std::vector<BspPortal> portals = bsp_leaf_portals(pieces, all);
+  const bool bounded = options.bound != BspBound::None;
+  if (bounded) {
+    cells.bound_leaves = bsp_portal_bound_leaves(bsp, portals, options.bound);
+    cells.leaf_triangles = bsp_leaf_triangles(bsp, scene);
+    cells.segment_bound.resize(cells.segments.size());
+    cells.sweep_bound.resize(cells.sweeps.size());
+  }
+  for (size_t index = 0; index < portals.size(); ++index) {
+    const BspPortal& p = portals[index];
     const BspPortalCover cover = bsp_portal_cover(p, scene);
     if (cover.closed) continue;  // each side sees the surface only
     auto side_volume = [&](int s) -> const ConvexPolytope& {
@@ -245,6 +256,11 @@ void add_portal_runs(const std::vector<BspLeafPiece>& pieces, const std::vector<
         f.side = side;
         add_sweep(cells.sweeps[c], f, options.adaptive->piece);
       }
+      if (bounded) {
+        cells.segment_bound[c].resize(cells.segments[c].size(), uint32_t(index));
+        if (!cells.sweeps.empty())
+          cells.sweep_bound[c].resize(cells.sweeps[c].size(), uint32_t(index));
+      }
     }
   }
 }
@@ -256,6 +272,8 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
   const bool portals = options.sweep == BspSweep::Portals;
   if (portals && !scene)
     throw std::invalid_argument("bsp_leaf_cells: a portal sweep needs the map's scene");
+  if (options.bound != BspBound::None && !portals)
+    throw std::invalid_argument("bsp_leaf_cells: a bound restricts the portal sweep's runs only");
   const std::vector<uint32_t> all = bsp_cell_leaves(bsp);
   std::vector<uint32_t> leaves = options.leaves.empty() ? all : options.leaves;
   for (size_t i = 0; i < leaves.size(); ++i)
@@ -271,7 +289,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
   std::vector<double> near_limit(leaves.size(), std::numeric_limits<double>::infinity());
   const std::vector<BspLeafPiece> pieces = bsp_leaf_pieces(bsp);
   if (portals) {
-    add_portal_runs(pieces, all, options, *scene, cells);
+    add_portal_runs(bsp, pieces, all, options, *scene, cells);
     cells.own.resize(leaves.size());
     cells.regions.resize(leaves.size());
     cells.shared_runs = true;
@@ -336,7 +354,10 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
       {"leaves_not_inset", uninset},
       {"leaves_near_clipped", clipped},
       {"bsp_models", options.scene.bsp_models == BspModels::all ? "all" : "world"},
-      {"bsp_liquids", liquids}};
+      {"bsp_liquids", liquids},
+      {"bound", options.bound == BspBound::Portals  ? "portals"
+                : options.bound == BspBound::MapVis ? "map-vis"
+                                                    : "none"}};
   if (options.adaptive) {
     d["chord_coarse"] = options.adaptive->coarse;
     d["chord_floor"] = options.adaptive->floor;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pvs_format/pvs_format.h"
+#include "vislib/bake/bsp_bound.h"
 #include "vislib/bake/view_cells.h"
 #include "vislib/base/tolerances.h"
 #include "vislib/kernel/region_visibility.h"
@@ -91,6 +92,9 @@ struct BspCellOptions {
   // leaf's surfaces by kNearClearanceFactor times it (bsp_leaf_view_region).
   double near = kDefaultNear;
   BspSweep sweep = BspSweep::Faces;
+  // The bound each portal's runs are restricted to (bsp_bound.h; BspSweep::Portals only): exact
+  // with Portals, trusting the map's vis with MapVis.
+  BspBound bound = BspBound::None;
 };
 
 // The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
@@ -100,8 +104,9 @@ struct BspCellOptions {
 // 0 and no adaptive sweep, its even chords (face_sweep.h), all in scene coordinates with the
 // portal's normal and the leaf's side; with an adaptive sweep, the portal's FaceSweep; and
 // ViewCells::own from bsp_volume_triangles of its volume, each with a witness eye at the vertex
-// mean of the view region. Portals need `scene`, the map as loaded with options.scene
-// (std::invalid_argument without it). The cells'
+// mean of the view region; with options.bound, the bound of each portal's segments and sweeps
+// (ViewCells::bound_leaves; std::invalid_argument with BspSweep::Faces). Portals need `scene`, the
+// map as loaded with options.scene (std::invalid_argument without it). The cells'
 // near_limit (only when some leaf's region clips the near distance), and a description (JSON)
 // recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
 // kBspLeafMinInset, the clearance, the counts of leaves inset less than kBspLeafInset, not inset

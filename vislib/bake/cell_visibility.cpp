@@ -6,8 +6,10 @@
 #include <cassert>
 #include <cmath>
 #include <iterator>
+#include <map>
 #include <optional>
 
+#include "vislib/bake/bsp_bound.h"
 #include "vislib/bake/face_sweep.h"
 #include "vislib/base/cubemap.h"
 #include "vislib/base/phase_times.h"
@@ -118,10 +120,35 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   double done_before = 0;
   double share = (adaptive ? kFixedShare : 1.0) / double(std::max<size_t>(1, fixed));
   bool wanted = true;
-  auto run_group = [&](const std::vector<Segment>& segs, size_t g,
-                       std::vector<uint32_t> users = {}) {
+  // Trees over the bounds of the cell's runs (ViewCells::bound_leaves), each built once.
+  const bool bounded = cells && !cells->segment_bound.empty();
+  std::map<uint32_t, TriangleBvh> trees;
+  auto tree_of = [&](uint32_t b) -> const TriangleBvh* {
+    if (b == ViewCells::kNoBound) return nullptr;
+    auto it = trees.find(b);
+    if (it == trees.end()) {
+      PhaseScope building(Phase::Run);
+      it = trees
+               .emplace(b, build_triangle_bvh(
+                               scene, options.segment.state,
+                               bound_triangles(cells->leaf_triangles, cells->bound_leaves.at(b))))
+               .first;
+    }
+    return &it->second;
+  };
+  // The trees of segments `segs`, whose bounds are bound_of(i); none when the cells have no bounds.
+  auto trees_of = [&](const std::vector<Segment>& segs,
+                      const std::function<uint32_t(size_t)>& bound_of) {
+    std::vector<const TriangleBvh*> out;
+    if (bounded)
+      for (size_t i = 0; i < segs.size(); ++i) out.push_back(tree_of(bound_of(i)));
+    return out;
+  };
+  auto run_group = [&](const std::vector<Segment>& segs, size_t g, std::vector<uint32_t> users,
+                       std::vector<const TriangleBvh*> bvhs) {
     RegionOptions o = group_options(options, seed, g);
     o.segment_users = std::move(users);
+    o.segment_bvhs = std::move(bvhs);
     std::function<void(size_t, size_t)> run_done;
     if (progress)
       run_done = [&](size_t done, size_t total) {
@@ -166,13 +193,14 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   // The runs that judge: `rr`, or with witnesses (whose sided runs keep their own side only) run 0
   // of `segs` again without them.
   std::vector<RunRecord> rerun;
-  auto judging = [&](const std::vector<Segment>& segs,
-                     const RegionResult& rr) -> const std::vector<RunRecord>& {
+  auto judging = [&](const std::vector<Segment>& segs, const RegionResult& rr,
+                     const std::vector<const TriangleBvh*>& bvhs) -> const std::vector<RunRecord>& {
     if (!(any_sided && options.segment.want_witnesses)) return rr.runs;
     RegionOptions o = options;
     o.segment.want_witnesses = false;
     o.runs = 1;
     o.shared_runs = nullptr;
+    o.segment_bvhs = bvhs;
     rerun = segments_visibility(scene, segs, o).runs;
     return rerun;
   };
@@ -187,12 +215,16 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     return from && to && s.side_normal == f.side_normal;
   };
   std::vector<uint32_t> base;
+  // A cell with bounds has one group, its own segments (cell_segment_groups).
+  assert(!bounded || (fixed == 1 && groups[0].size() == cells->segment_bound.at(cell).size()));
   for (size_t g = 0; g < fixed && (wanted || adaptive); ++g) {
-    const RegionResult rr = run_group(groups[g], g);
+    const std::vector<const TriangleBvh*> bvhs =
+        trees_of(groups[g], [&](size_t i) { return cells->segment_bound[cell][i]; });
+    const RegionResult rr = run_group(groups[g], g, {}, bvhs);
     if (!adaptive) continue;
     for (const RunRecord& r : rr.runs) ids_of_run(r, base);
     if (!any_sided) continue;
-    for (const RunRecord& r : judging(groups[g], rr)) {
+    for (const RunRecord& r : judging(groups[g], rr, bvhs)) {
       const Segment& s = groups[g].at(r.segment);
       if (r.run != 0 || s.side_normal == Vec3{0, 0, 0}) continue;
       for (size_t f = 0; f < sweeps.size(); ++f)
@@ -208,10 +240,12 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
                    share = (1.0 - done_before) * kRoundShare;
                    std::vector<uint32_t> segment_users(segs.size());
                    for (size_t i = 0; i < segs.size(); ++i) segment_users[i] = users[sweep_of[i]];
+                   const std::vector<const TriangleBvh*> bvhs = trees_of(
+                       segs, [&](size_t i) { return cells->sweep_bound.at(cell)[sweep_of[i]]; });
                    const RegionResult rr =
-                       run_group(segs, fixed + round++, std::move(segment_users));
+                       run_group(segs, fixed + round++, std::move(segment_users), bvhs);
                    std::vector<std::vector<uint32_t>> seen(segs.size());
-                   for (const RunRecord& r : judging(segs, rr)) {
+                   for (const RunRecord& r : judging(segs, rr, bvhs)) {
                      const Segment& s = segs.at(r.segment);
                      if (s.side_normal == Vec3{0, 0, 0})
                        ids_of_run(r, seen[r.segment]);

@@ -91,6 +91,13 @@ struct ViewCells {
   // portal's): a run's witness, an eye on the portal, is moved back along its ray into the
   // region, so that it is a ray from an eye of the cell (cell_witness_rays).
   std::vector<ConvexPolytope> regions;
+  // Empty, or the cells' runs restricted to bounds of what they can see (bsp_bound.h): bound b's
+  // leaves are bound_leaves[b] (increasing map leaf numbers), leaf_triangles[l] the triangles that
+  // touch leaf l, and segment_bound[c][i] is the bound of segments[c][i], sweep_bound[c][f] that
+  // of sweeps[c][f] (kNoBound: the whole scene). Each run composites its bound's triangles only
+  // (cell_visibility.h) and sees what it sees without the restriction.
+  static constexpr uint32_t kNoBound = UINT32_MAX;
+  std::vector<std::vector<uint32_t>> bound_leaves, leaf_triangles, segment_bound, sweep_bound;
 };
 
 pvs::Box to_pvs_box(const Box3& b);

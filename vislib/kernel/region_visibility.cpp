@@ -68,6 +68,8 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       SegmentOptions so = options.segment;
       so.orientation = run_orientation(options.seed, s, k);
       so.want_pieces = false;
+      if (!options.segment_bvhs.empty() && options.segment_bvhs.at(s))
+        so.bvh = options.segment_bvhs[s];
       const Segment& seg = result.segments[s];
       const bool sided = !(seg.side_normal == Vec3{0, 0, 0});
       so.side_normal = seg.side_normal;

@@ -53,6 +53,11 @@ struct RegionOptions {
   // for this many users in all when > 1 (SegmentRunCache::get's `users`: the two leaves of a
   // portal, whose adaptive chords are the same for both).
   std::vector<uint32_t> segment_users;
+  // Empty, or one per segment: the tree segment s's runs use instead of segment.bvh, when not
+  // null (a tree over a bound of what the segment can see: triangle_bvh.h). A run shared through
+  // shared_runs is computed with the tree of the region that computes it, so regions that share a
+  // segment must give it the same tree (or none).
+  std::vector<const TriangleBvh*> segment_bvhs;
 };
 
 struct RunRecord {

@@ -109,32 +109,48 @@ struct Builder {
   }
 };
 
-}  // namespace
-
-TriangleBvh build_triangle_bvh(const Scene& scene, size_t state) {
+// The tree over the triangles `order` (distinct ids of `scene`).
+TriangleBvh build_tree(const Scene& scene, size_t state, std::vector<uint32_t> order) {
   TriangleBvh bvh;
   bvh.scene = &scene;
   bvh.state = state;
   const size_t n = scene.triangle_count();
   bvh.triangle_count = n;
-  if (n == 0) return bvh;
   if (n >= (size_t(1) << 31)) throw std::invalid_argument("too many triangles for the BVH");
+  if (order.empty()) return bvh;
   if (state >= scene.positions.size())
     throw std::invalid_argument("BVH: key state " + std::to_string(state) + " out of range");
   Builder b{scene, state, std::vector<float>(n * 3), bvh, {}};
-  tbb::parallel_for(size_t(0), n, [&](size_t t) {
-    const auto c = scene.corners(uint32_t(t), state);
+  tbb::parallel_for(size_t(0), order.size(), [&](size_t i) {
+    const uint32_t t = order[i];
+    const auto c = scene.corners(t, state);
     for (int a = 0; a < 3; ++a) {
       const double l = std::min({c[0][a], c[1][a], c[2][a]});
       const double h = std::max({c[0][a], c[1][a], c[2][a]});
-      b.mid[t * 3 + a] = float(0.5 * (l + h));
+      b.mid[size_t(t) * 3 + size_t(a)] = float(0.5 * (l + h));
     }
   });
-  bvh.order.resize(n);
-  for (size_t t = 0; t < n; ++t) bvh.order[t] = uint32_t(t);
-  bvh.nodes.resize(1 + size_t(b.count_below(uint32_t(n))));
-  b.build(0, 0, uint32_t(n), 1);
+  const uint32_t m = uint32_t(order.size());
+  bvh.order = std::move(order);
+  bvh.nodes.resize(1 + size_t(b.count_below(m)));
+  b.build(0, 0, m, 1);
   return bvh;
+}
+
+}  // namespace
+
+TriangleBvh build_triangle_bvh(const Scene& scene, size_t state) {
+  std::vector<uint32_t> order(scene.triangle_count());
+  for (size_t t = 0; t < order.size(); ++t) order[t] = uint32_t(t);
+  return build_tree(scene, state, std::move(order));
+}
+
+TriangleBvh build_triangle_bvh(const Scene& scene, size_t state,
+                               const std::vector<uint32_t>& subset) {
+  for (size_t i = 0; i < subset.size(); ++i)
+    if (subset[i] >= scene.triangle_count() || (i > 0 && subset[i] <= subset[i - 1]))
+      throw std::invalid_argument("BVH: the subset is not increasing triangle ids of the scene");
+  return build_tree(scene, state, subset);
 }
 
 }  // namespace vislib

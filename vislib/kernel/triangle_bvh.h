@@ -46,6 +46,13 @@ struct TriangleBvh {
 constexpr uint32_t kBvhLeafSize = 4;
 TriangleBvh build_triangle_bvh(const Scene& scene, size_t state = 0);
 
+// The same over the triangles `subset` only (increasing ids of `scene`; std::invalid_argument
+// otherwise): a run given this tree composites those triangles alone, occluders included, and
+// reports ids of the scene. It restricts the scene exactly when `subset` holds every triangle the
+// run's segment sees (bake/bsp_bound.h); empty: a tree with no node, through which nothing is seen.
+TriangleBvh build_triangle_bvh(const Scene& scene, size_t state,
+                               const std::vector<uint32_t>& subset);
+
 // Whether a tree serves runs on `scene`: static triangles, no spheres (the dynamic kernel bins).
 inline bool bvh_applies(const Scene& scene) {
   return !scene.is_dynamic() && scene.sphere_count() == 0 && scene.triangle_count() > 0;
