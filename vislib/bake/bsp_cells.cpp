@@ -358,6 +358,11 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
       {"bound", options.bound == BspBound::Portals  ? "portals"
                 : options.bound == BspBound::MapVis ? "map-vis"
                                                     : "none"}};
+  if (!cells.bound_leaves.empty()) {
+    double leaves_sum = 0;
+    for (const std::vector<uint32_t>& b : cells.bound_leaves) leaves_sum += double(b.size());
+    d["bound_leaves_mean"] = leaves_sum / double(cells.bound_leaves.size());
+  }
   if (options.adaptive) {
     d["chord_coarse"] = options.adaptive->coarse;
     d["chord_floor"] = options.adaptive->floor;
