@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,14 +27,6 @@ using namespace vislib;
 using namespace vislib_test;
 
 namespace {
-
-std::optional<std::string> librequake(const std::string& name) {
-  auto shared = shared_dir();
-  if (!shared) return std::nullopt;
-  std::string p = *shared + "/scenes/librequake/" + name;
-  if (!std::filesystem::exists(p)) return std::nullopt;
-  return p;
-}
 
 Scene load_see_through(const std::string& path) {
   LoadOptions o;

@@ -175,14 +175,6 @@ Scene load(const std::string& path, BspModels models = BspModels::world,
   return load_scene(path, o);
 }
 
-std::optional<std::string> librequake(const std::string& name) {
-  auto shared = shared_dir();
-  if (!shared) return std::nullopt;
-  std::string p = *shared + "/scenes/librequake/" + name;
-  if (!std::filesystem::exists(p)) return std::nullopt;
-  return p;
-}
-
 }  // namespace
 
 TEST(QuakeBsp, WorldFacesFanTriangulatedInFaceOrderWithOwnVertexBlocks) {

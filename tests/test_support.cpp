@@ -27,6 +27,14 @@ std::optional<std::string> shared_dir() {
   return std::nullopt;
 }
 
+std::optional<std::string> librequake(const std::string& name) {
+  auto shared = shared_dir();
+  if (!shared) return std::nullopt;
+  std::string p = *shared + "/scenes/librequake/" + name;
+  if (!std::filesystem::exists(p)) return std::nullopt;
+  return p;
+}
+
 namespace {
 
 // Runs `cmd` through the shell; returns its exit code and captures its stdout into `output`.

@@ -14,6 +14,8 @@ std::string source_dir();
 // ../shared beside the repository, or std::nullopt when absent (tests that need it then call
 // GTEST_SKIP with a message).
 std::optional<std::string> shared_dir();
+// ../shared/scenes/librequake/NAME (a LibreQuake map), or std::nullopt when it is absent.
+std::optional<std::string> librequake(const std::string& name);
 // Runs the built `pvs` with `args` (a shell-quoted string); returns the exit code and captures
 // stdout+stderr into `output`.
 int run_pvs(const std::string& args, std::string* output = nullptr);
