@@ -11,13 +11,13 @@ namespace vislib {
 
 namespace {
 
-// A portal crossed in one direction: from leaf `from` into leaf `to`, its plane's normal pointing
-// into `to` (dot(normal, x) = offset on the plane).
+// A portal crossed in one direction, into leaf `to`, its plane's normal pointing into `to`
+// (dot(normal, x) = offset on the plane).
 struct DirectedPortal {
   const std::vector<Vec3>* polygon = nullptr;
   Vec3 normal;
   double offset = 0;
-  uint32_t from = 0, to = 0;
+  uint32_t to = 0;
 };
 
 // The largest and the smallest signed distance of `poly`'s vertices from the plane of `d`.
@@ -100,9 +100,8 @@ std::vector<std::vector<uint32_t>> bsp_portal_bound_leaves(const QuakeBsp& bsp,
   for (size_t p = 0; p < portals.size(); ++p) {
     const BspPortal& portal = portals[p];
     const double offset = dot(portal.normal, portal.polygon.at(0));
-    directed[2 * p] = {&portal.polygon, portal.normal, offset, portal.leaves[0], portal.leaves[1]};
-    directed[2 * p + 1] = {&portal.polygon, portal.normal * -1.0, -offset, portal.leaves[1],
-                           portal.leaves[0]};
+    directed[2 * p] = {&portal.polygon, portal.normal, offset, portal.leaves[1]};
+    directed[2 * p + 1] = {&portal.polygon, portal.normal * -1.0, -offset, portal.leaves[0]};
     leaving.at(portal.leaves[0]).push_back(uint32_t(2 * p));
     leaving.at(portal.leaves[1]).push_back(uint32_t(2 * p + 1));
   }
