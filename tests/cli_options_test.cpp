@@ -277,7 +277,7 @@ TEST(CliConventions, DashJIsThreads) {
 TEST(CliConventions, PresetSetsResolutionRunsAndCellSizeAndIsReported) {
   std::string dir = temp_dir("cli_preset");
   std::string out;
-  std::string bake = "bake " + city() + " --walkable --box -30,-1,-30,30,1,30 ";
+  std::string bake = "bake " + city() + " --walkable --box -12,-1,-12,12,1,12 ";
   ASSERT_EQ(
       run_pvs(bake + "--preset draft -q --json " + dir + "/d.json -o " + dir + "/d.pvs", &out), 0)
       << out;
