@@ -84,13 +84,14 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
       "seconds by phase: runs {:.2f} / {:.2f}, waiting on shared runs {:.2f} / {:.2f}, merge "
       "{:.2f} / {:.2f}, rest of cells {:.2f} / {:.2f}, progress {:.2f} / {:.2f}, checkpoint "
       "{:.2f} / {:.2f}, encode {:.2f} / {:.2f}, write {:.2f} / {:.2f}, helping other runs {:.2f} / "
-      "{:.2f}, idle {:.2f} / {:.2f}; "
+      "{:.2f}, trees over the runs' bounds {:.2f} / {:.2f}, idle {:.2f} / {:.2f}; "
       "before the cells: BVH {:.2f} / {:.2f}, pilot {:.2f} / {:.2f}",
       r.threads, r.seconds, r.threads * r.seconds, t.process_cpu, ph.runs.wall, ph.runs.cpu,
       ph.shared_waits.wall, ph.shared_waits.cpu, ph.merge.wall, ph.merge.cpu, ph.cell.wall,
       ph.cell.cpu, ph.progress.wall, ph.progress.cpu, ph.checkpoint.wall, ph.checkpoint.cpu,
       ph.encode.wall, ph.encode.cpu, ph.write.wall, ph.write.cpu, ph.helping.wall, ph.helping.cpu,
-      ph.idle.wall, ph.idle.cpu, ph.bvh.wall, ph.bvh.cpu, ph.pilot.wall, ph.pilot.cpu));
+      ph.bound_trees.wall, ph.bound_trees.cpu, ph.idle.wall, ph.idle.cpu, ph.bvh.wall, ph.bvh.cpu,
+      ph.pilot.wall, ph.pilot.cpu));
   if (a.json_out.empty()) return;
   const std::string text = vislib::bake_report_json(info, r);
   if (a.json_out == "-")

@@ -432,7 +432,7 @@ TEST(BakeReportJson, StatesTheRunTheCellsTimingsAndTheFileSizes) {
   const json& ph = t["phases"];
   double wall_sum = 0, cpu_sum = 0;
   for (const char* k : {"runs", "shared_waits", "merge", "cell", "progress", "checkpoint", "encode",
-                        "write", "helping", "idle"}) {
+                        "write", "helping", "bound_trees", "idle"}) {
     ASSERT_TRUE(ph.contains(k)) << k;
     EXPECT_GE(ph[k]["wall_seconds"].get<double>(), 0) << k;
     EXPECT_GE(ph[k]["cpu_seconds"].get<double>(), 0) << k;

@@ -245,6 +245,7 @@ void record_phases(const PhaseTimes& t, BakeReport& report) {
   p.encode = get(Phase::Encode);
   p.write = get(Phase::Write);
   p.helping = get(Phase::Helping);
+  p.bound_trees = get(Phase::BoundTrees);
   p.idle.wall = std::max(0.0, double(report.threads) * report.seconds - t.wall_total());
   p.idle.cpu = std::max(0.0, report.times.process_cpu - t.cpu_total());
 }

@@ -135,6 +135,7 @@ struct BakePhases {
   PhaseSeconds write;         // writing the bytes, the final fsync and rename
   PhaseSeconds helping;       // tiles of a run another thread computes, taken by a thread with
                               // no cell of its own (the scheduler lends it to that run)
+  PhaseSeconds bound_trees;   // building a cell's trees over its runs' bounds (--bound)
   // The rest: wall, threads x BakeReport::seconds less every phase (threads with no cell, block
   // or tile to work on); CPU, process_cpu less every phase (the scheduler's spinning while it
   // looks for work).

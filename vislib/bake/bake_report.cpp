@@ -47,7 +47,8 @@ json phases_json(const BakePhases& p) {
       {"merge", &p.merge},       {"cell", &p.cell},
       {"progress", &p.progress}, {"checkpoint", &p.checkpoint},
       {"encode", &p.encode},     {"write", &p.write},
-      {"helping", &p.helping},   {"idle", &p.idle}};
+      {"helping", &p.helping},   {"bound_trees", &p.bound_trees},
+      {"idle", &p.idle}};
   json j = json::object();
   for (const auto& [name, s] : phases)
     j[name] = {{"wall_seconds", s->wall}, {"cpu_seconds", s->cpu}};

@@ -127,7 +127,7 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     if (b == ViewCells::kNoBound) return nullptr;
     auto it = trees.find(b);
     if (it == trees.end()) {
-      PhaseScope building(Phase::Run);
+      PhaseScope building(Phase::BoundTrees);
       it = trees
                .emplace(b, build_triangle_bvh(
                                scene, options.segment.state,

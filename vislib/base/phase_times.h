@@ -26,8 +26,9 @@ enum class Phase : int {
   Encode,      // encoding a cell's block in the writer stage
   Write,       // writing the encoded bytes to the file
   Helping,     // tiles of another thread's run, taken by a thread outside any phase of its own
+  BoundTrees,  // building a cell's trees over its runs' bounds (ViewCells::bound_leaves)
 };
-constexpr int kPhaseCount = 11;
+constexpr int kPhaseCount = 12;
 
 // Wall and CPU seconds per phase, summed over threads. Thread-safe.
 class PhaseTimes {
