@@ -307,6 +307,7 @@ vislib::BakeSettings settings_of(const BakeArgs& a) {
   s.region.segment.tile_size = a.tile;
   s.long_segments = a.long_segments == "auto" ? 0 : std::stoi(a.long_segments);
   s.bvh = a.bvh == "on";
+  s.region.segment.fans = a.fans == "on";
   s.region.runs = a.runs;
   s.region.seed = a.seed;
   s.granularity =
@@ -450,6 +451,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "run. The file is the same either way")
       ->check(CLI::IsMember({"on", "off"}))
       ->capture_default_str();
+  add_fans_option(*cmd, a.fans);
   add_import_options(cmd, a.import);
   cmd->add_option("--states", a.states,
                   "Key states to sample glTF animations into (dynamic scenes)")

@@ -34,6 +34,7 @@ struct BakeArgs {
   ImportArgs import;
   std::string preset = "default";
   std::string bvh = "on";           // --bvh on|off
+  std::string fans = "on";          // --fans on|off
   std::string long_segments = "1";  // --long-segments: 1..8 or auto
   std::string cells;                // --cells: "" (grid or walkable) or bsp-leaves
   // --face-spacing (bsp-leaves), Quake units; unset: kBspPortalSpacing or kBspFaceSpacing.

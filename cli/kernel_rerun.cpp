@@ -57,6 +57,10 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
   ro_.segment.eps_z = md["eps_z"].get<double>();
   ro_.runs = md["runs"].get<int>();
   ro_.seed = md["seed"].get<uint64_t>();
+  // Files baked before fans were composited as polygons record none: their runs took the
+  // triangles one by one.
+  const nlohmann::json fans = find_key(md, "fans");
+  ro_.segment.fans = fans.is_boolean() && fans.get<bool>();
   const nlohmann::json coplanar = find_key(md, "coplanar");
   ro_.segment.coplanar = coplanar.is_string() && coplanar.get<std::string>() == "first"
                              ? vislib::CoplanarRule::First
@@ -79,7 +83,9 @@ KernelRerun::witnesses() {
   return [this](uint32_t cell, const std::vector<uint32_t>& extras) {
     // The tree and the edge lines the bake's runs used, built once the first leaf needs them.
     std::call_once(built_, [&] {
-      bvh_ = vislib::build_triangle_bvh(scene_);
+      bvh_ =
+          vislib::build_triangle_bvh(scene_, ro_.segment.fans ? vislib::BvhPrimitives::Groups
+                                                              : vislib::BvhPrimitives::Triangles);
       ro_.segment.bvh = &bvh_;
       lines_ = vislib::build_edge_lines(scene_);
       ro_.segment.edge_lines = &lines_;

@@ -95,6 +95,16 @@ void check_output_dir(const std::string& path, const std::string& option) {
   ensure_writable_dir(fs::path(path), option, path);
 }
 
+void add_fans_option(CLI::App& cmd, std::string& value) {
+  cmd.add_option("--fans", value,
+                 "Static scenes: composite each convex planar fan of triangles (a map's face, a "
+                 "mesh's quad) as one polygon, cut back into its triangles at the end (the same "
+                 "sets but for depth ties at corners, docs/visibility-math.md 2.6; faster); "
+                 "'off': triangle by triangle")
+      ->check(CLI::IsMember({"on", "off"}))
+      ->capture_default_str();
+}
+
 CLI::Validator in_range(double lo, double hi) {
   CLI::Validator v(
       [lo, hi](std::string& input) -> std::string {

@@ -39,6 +39,9 @@ CLI::Validator in_range(double lo, double hi);
 CLI::Validator positive();
 CLI::Validator non_negative();
 
+// --fans on|off into `value` (SegmentOptions::fans), for every command that runs the kernel.
+void add_fans_option(CLI::App& cmd, std::string& value);
+
 // argv scanned for options that the selected subcommand does not know; returns the first one
 // ("" if none). main.cpp reports it before any other parse error (a missing required option).
 std::string first_unknown_option(CLI::App& app, int argc, char** argv);

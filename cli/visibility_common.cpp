@@ -66,6 +66,7 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
                   "over many runs). 'auto' = on for region, off for a single segment")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
+  add_fans_option(*cmd, a.fans);
   cmd->add_option("--json", a.json_out, "Write the result as JSON to this file ('-' = stdout)")
       ->required();
 }
@@ -75,7 +76,8 @@ double maybe_build_bvh(const VisibilityArgs& a, bool auto_on, const vislib::Scen
   const bool want = a.bvh == "on" || (a.bvh == "auto" && auto_on);
   if (!want || !vislib::bvh_applies(scene)) return 0.0;
   const auto t0 = std::chrono::steady_clock::now();
-  tree = vislib::build_triangle_bvh(scene, so.state);
+  tree = vislib::build_triangle_bvh(
+      scene, so.fans ? vislib::BvhPrimitives::Groups : vislib::BvhPrimitives::Triangles, so.state);
   so.bvh = &tree;
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -97,6 +99,7 @@ vislib::SegmentOptions segment_options(const VisibilityArgs& a) {
   o.tile_size = a.tile;
   o.mode = a.mode == "decoupled" ? vislib::DynamicMode::Decoupled : vislib::DynamicMode::Diagonal;
   o.coplanar = a.coplanar == "first" ? vislib::CoplanarRule::First : vislib::CoplanarRule::Both;
+  o.fans = a.fans == "on";
   o.eps_z = a.eps_z;
   return o;
 }

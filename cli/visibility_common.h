@@ -32,6 +32,7 @@ struct VisibilityArgs {
   double eps_z = vislib::kDefaultEpsZ;
   std::string json_out;
   std::string bvh = "auto";  // auto | on | off (--bvh)
+  std::string fans = "on";   // on | off (--fans)
 };
 
 // Builds the triangle BVH the runs walk (SegmentOptions::bvh) when --bvh says so: "on", or

@@ -164,7 +164,9 @@ TEST(RunRestrictionLibreQuake, Lqdm1LeafSetsAreTheSameWithAndWithoutTheRestricti
     size_t smaller = 0;  // portals whose bound leaves some triangle out
     for (const std::vector<uint32_t>& leaves : cells.bound_leaves)
       smaller += bound_triangles(cells.leaf_triangles, leaves).size() < scene.triangle_count();
-    if (bound != BspBound::None) EXPECT_GT(smaller, 0u);
+    if (bound != BspBound::None) {
+      EXPECT_GT(smaller, 0u);
+    }
     for (uint32_t c = 0; c < cells.layout.cell_count(); ++c) {
       const std::vector<uint32_t> got = cell_visibility(scene, cells, c, ro).triangles;
       if (bound == BspBound::None)

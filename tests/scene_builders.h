@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "vislib/base/random.h"
+#include "vislib/scene/generate.h"
 #include "vislib/scene/scene.h"
 
 namespace vislib_test {
@@ -36,6 +37,16 @@ inline vislib::Scene random_soup(int n, uint64_t seed, double extent = 10, doubl
     tris.push_back(t);
   }
   return soup(tris);
+}
+
+// A generated city of 2 x 2 blocks with 4-unit panels (seed 3): walls of quads, each a fan of two
+// triangles.
+inline vislib::Scene panel_city() {
+  vislib::CityOptions o;
+  o.blocks_x = o.blocks_z = 2;
+  o.panel_size = 4;
+  o.seed = 3;
+  return vislib::generate_city(o);
 }
 
 // Appends an indexed quad (two triangles) a b c d (counter-clockwise) to `s` as one object.

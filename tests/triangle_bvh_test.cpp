@@ -1,6 +1,7 @@
 // The BVH walk of the tile driver: the tree is well formed, a node's
 // rectangle and depth bound those of every triangle inside it, and a run that walks the tree gives
-// bit-identical lists, sets and witnesses to a run that bins every triangle.
+// bit-identical lists, sets and witnesses to a run that bins every primitive (triangles, or fans:
+// triangle_groups_test.cpp compares the two).
 #include "vislib/kernel/triangle_bvh.h"
 
 #include <gtest/gtest.h>
@@ -26,27 +27,26 @@ using vislib_test::same_witnesses;
 
 namespace {
 
-// Runs with and without the tree; every result must be the same.
+// Runs with and without the tree, for its triangles and for its fans (SegmentOptions::fans); every
+// result must be the same.
 void expect_walk_equals_binning(const Scene& s, Vec3 v0, Vec3 v1, SegmentOptions o,
-                                const TriangleBvh& tree, const std::string& what) {
-  o.want_pieces = true;
-  o.want_witnesses = true;
-  o.bvh = nullptr;
-  const SegmentResult binned = segment_visibility(s, v0, v1, o);
-  o.bvh = &tree;
-  const SegmentResult walked = segment_visibility(s, v0, v1, o);
-  EXPECT_EQ(walked.visible, binned.visible) << what;
-  EXPECT_TRUE(identical_lists(walked.pieces, binned.pieces)) << what;
-  EXPECT_TRUE(same_witnesses(walked.witnesses, binned.witnesses)) << what;
-  EXPECT_EQ(walked.stats.final_pieces, binned.stats.final_pieces) << what;
-}
-
-Scene small_city() {
-  CityOptions o;
-  o.blocks_x = o.blocks_z = 2;
-  o.panel_size = 4;
-  o.seed = 3;
-  return generate_city(o);
+                                const std::string& what) {
+  for (const bool fans : {false, true}) {
+    const TriangleBvh tree =
+        build_triangle_bvh(s, fans ? BvhPrimitives::Groups : BvhPrimitives::Triangles);
+    const std::string which = what + (fans ? ", fans" : ", triangles");
+    o.want_pieces = true;
+    o.want_witnesses = true;
+    o.fans = fans;
+    o.bvh = nullptr;
+    const SegmentResult binned = segment_visibility(s, v0, v1, o);
+    o.bvh = &tree;
+    const SegmentResult walked = segment_visibility(s, v0, v1, o);
+    EXPECT_EQ(walked.visible, binned.visible) << which;
+    EXPECT_TRUE(identical_lists(walked.pieces, binned.pieces)) << which;
+    EXPECT_TRUE(same_witnesses(walked.witnesses, binned.witnesses)) << which;
+    EXPECT_EQ(walked.stats.final_pieces, binned.stats.final_pieces) << which;
+  }
 }
 
 }  // namespace
@@ -168,8 +168,7 @@ TEST(TriangleBvh, BoxFootprintContainsTheFootprintOfEveryTriangleInside) {
 }
 
 TEST(TriangleBvh, WalkGivesTheListsSetsAndWitnessesOfBinningOnACityStreet) {
-  const Scene s = small_city();
-  const TriangleBvh tree = build_triangle_bvh(s);
+  const Scene s = vislib_test::panel_city();
   Rng rng(5);
   for (int k = 0; k < 6; ++k) {
     SegmentOptions o;
@@ -181,32 +180,29 @@ TEST(TriangleBvh, WalkGivesTheListsSetsAndWitnessesOfBinningOnACityStreet) {
     const double len = k < 2 ? 2.0 : 16.0;
     const Vec3 v0{rng.uniform(-10, 10), 1.7, rng.uniform(-10, 10)};
     const Vec3 v1 = v0 + Vec3{len * 0.6, 0.3, len * 0.8};
-    expect_walk_equals_binning(s, v0, v1, o, tree, "street case " + std::to_string(k));
+    expect_walk_equals_binning(s, v0, v1, o, "street case " + std::to_string(k));
   }
 }
 
 TEST(TriangleBvh, WalkGivesTheListsSetsAndWitnessesOfBinningInARandomSoup) {
   const Scene s = random_soup(600, 41);
-  const TriangleBvh tree = build_triangle_bvh(s);
   for (int k = 0; k < 3; ++k) {
     SegmentOptions o;
     o.resolution = 40;
     o.tile_size = k == 2 ? 8 : 32;
     if (k) o.orientation = random_orientation(7 + uint64_t(k));
-    expect_walk_equals_binning(s, {-2, 0, 0}, {2, 0.5, 0.25}, o, tree,
-                               "soup case " + std::to_string(k));
+    expect_walk_equals_binning(s, {-2, 0, 0}, {2, 0.5, 0.25}, o, "soup case " + std::to_string(k));
   }
 }
 
 TEST(TriangleBvh, WalkGivesTheResultsOfBinningOnSauerPandora) {
   VISLIB_REQUIRE_SHARED(shared);
   const Scene s = load_scene(shared + "/scenes/sauer_pandora/pandora.obj");
-  const TriangleBvh tree = build_triangle_bvh(s);
   SegmentOptions o;
   o.resolution = 48;
-  expect_walk_equals_binning(s, {-200, 40, 0}, {-100, 40, 0}, o, tree, "pandora");
+  expect_walk_equals_binning(s, {-200, 40, 0}, {-100, 40, 0}, o, "pandora");
   o.orientation = random_orientation(3);
-  expect_walk_equals_binning(s, {-150, 40, 20}, {-148, 41, 20}, o, tree, "pandora short");
+  expect_walk_equals_binning(s, {-150, 40, 20}, {-148, 41, 20}, o, "pandora short");
 }
 
 TEST(TriangleBvh, ATreeOfAnotherSceneOrStateIsRefused) {

@@ -50,6 +50,7 @@ pvs::FileInfo bake_file_info(const Scene& scene, const ViewCells& cells,
       {"mode", s.mode == DynamicMode::Decoupled ? "decoupled" : "diagonal"},
       {"coplanar", s.coplanar == CoplanarRule::First ? "first" : "both"},
       {"eps_z", s.eps_z},
+      {"fans", s.fans},
       {"boundary", cells.segments.empty()
                        ? "perimeter of the eye band's bottom and top rectangles"
                        : "segments sweeping the boundary faces of each cell's view region"}};
@@ -152,7 +153,9 @@ const TriangleBvh* bake_bvh(const Scene& scene, const BakeSettings& requested, T
   const TriangleBvh* bvh = requested.region.segment.bvh;
   if (requested.bvh && !bvh && bvh_applies(scene)) {
     const auto t0 = std::chrono::steady_clock::now();
-    tree = build_triangle_bvh(scene, requested.region.segment.state);
+    tree = build_triangle_bvh(
+        scene, requested.region.segment.fans ? BvhPrimitives::Groups : BvhPrimitives::Triangles,
+        requested.region.segment.state);
     bvh = &tree;
     report.bvh_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -123,16 +123,24 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   // Trees over the bounds of the cell's runs (ViewCells::bound_leaves), each built once.
   const bool bounded = cells && !cells->segment_bound.empty();
   std::map<uint32_t, TriangleBvh> trees;
+  // Their primitives: the bake's tree's, or without one the scene's fans when the runs take them.
+  std::optional<TriangleGroups> fans;
   auto tree_of = [&](uint32_t b) -> const TriangleBvh* {
     if (b == ViewCells::kNoBound) return nullptr;
     auto it = trees.find(b);
     if (it == trees.end()) {
       PhaseScope building(Phase::BoundTrees);
-      it = trees
-               .emplace(b, build_triangle_bvh(
-                               scene, options.segment.state,
-                               bound_triangles(cells->leaf_triangles, cells->bound_leaves.at(b))))
-               .first;
+      if (!fans) {
+        if (options.segment.bvh)
+          fans = options.segment.bvh->groups;
+        else if (options.segment.fans)
+          fans = build_triangle_groups(scene, options.segment.state);
+        else
+          fans = TriangleGroups{};
+      }
+      const std::vector<uint32_t> subset =
+          bound_triangles(cells->leaf_triangles, cells->bound_leaves.at(b));
+      it = trees.emplace(b, build_triangle_bvh(scene, options.segment.state, subset, *fans)).first;
     }
     return &it->second;
   };

@@ -460,7 +460,10 @@ class DynamicKind {
     keep_ties_ = opt.coplanar == CoplanarRule::Both;
     far_scale_ = keep_ties_ ? 1 + 2 * opt.eps_z : 1.0;  // as in the static kernel
     // The faces each triangle can reach.
-    faces_ = classify_faces(ntri_, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
+    faces_ = classify_faces(ntri_, opt, [this](size_t t, Vec3* rel) {
+      relative_corners(t, rel);
+      return 6;
+    });
   }
 
   size_t count() const { return ntri_ + scene_.sphere_count(); }

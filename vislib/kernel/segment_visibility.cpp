@@ -35,31 +35,42 @@
 
 namespace vislib {
 
-StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1, const EdgeLines* lines,
-                                       uint32_t tri) {
+void static_edge(Vec3 a, Vec3 b, Vec3 v0, Vec3 delta, const EdgeLines* lines, EdgeRef ref, Vec3& KA,
+                 Vec3& KB, double& rho) {
+  // Canonical orientation: P is the lexicographically smaller world endpoint (§2.5).
+  const bool forward = !lex_less(b, a);
+  Vec3 P = forward ? a - v0 : b - v0;  // re-centred (docs/visibility-math.md §6)
+  Vec3 Q = forward ? b - v0 : a - v0;
+  Vec3 LP, LQ;  // a T-junction's edges: their run's line, the same for all (§2.5)
+  if (lines && lines->line_of(ref.tri, ref.e, LP, LQ)) {
+    P = LP - v0;
+    Q = LQ - v0;
+  }
+  const Vec3 E = Q - P;
+  KA = cross(E, delta);
+  KB = cross(E, -P);
+  rho = forward ? 1.0 : -1.0;
+}
+
+StaticTriangle prepare_static_polygon(const Vec3* c, int count, Vec3 v0, Vec3 v1,
+                                      const EdgeLines* lines, const EdgeRef* refs) {
+  assert(count >= 3 && count <= kMaxGroupCorners);
   StaticTriangle st;
   const Vec3 delta = v1 - v0;
-  Vec3 r[3] = {c[0] - v0, c[1] - v0, c[2] - v0};  // re-centred (docs/visibility-math.md §6)
-  for (int e = 0; e < 3; ++e) {
-    int i = e, j = (e + 1) % 3;
-    // Canonical orientation: P is the lexicographically smaller world endpoint (§2.5).
-    bool forward = !lex_less(c[j], c[i]);
-    Vec3 P = forward ? r[i] : r[j];
-    Vec3 Q = forward ? r[j] : r[i];
-    Vec3 LP, LQ;  // a T-junction's edges: their run's line, the same for all (§2.5)
-    if (lines && lines->line_of(tri, e, LP, LQ)) {
-      P = LP - v0;
-      Q = LQ - v0;
-    }
-    Vec3 E = Q - P;
-    st.KA[e] = cross(E, delta);
-    st.KB[e] = cross(E, -P);
-    st.rho[e] = forward ? 1.0 : -1.0;
-  }
-  st.n = cross(r[1] - r[0], r[2] - r[0]);
-  st.N0 = dot(st.n, r[0]);
+  st.edges = count;
+  for (int e = 0; e < count; ++e)
+    static_edge(c[e], c[(e + 1) % count], v0, delta, lines, refs[e], st.KA[e], st.KB[e], st.rho[e]);
+  const Vec3 r0 = c[0] - v0, r1 = c[1] - v0, r2 = c[2] - v0;
+  st.n = cross(r1 - r0, r2 - r0);
+  st.N0 = dot(st.n, r0);
   st.N1 = dot(st.n, delta);
   return st;
+}
+
+StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1, const EdgeLines* lines,
+                                       uint32_t tri) {
+  const EdgeRef refs[3] = {{tri, 0}, {tri, 1}, {tri, 2}};
+  return prepare_static_polygon(c, 3, v0, v1, lines, refs);
 }
 
 namespace {
@@ -85,7 +96,7 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
   const double sigma = Dn > 0 ? 1.0 : -1.0;
   lo = 0;
   hi = 1;
-  for (int e = 0; e < 3; ++e) {
+  for (int e = 0; e < tri.edges; ++e) {
     double A = dot(d, tri.KA[e]), B = dot(d, tri.KB[e]);
     if (A == 0 && B == 0) {  // persistent on-edge tie: perturb d -> d + eps S + eps^2 T (§2.5)
       A = dot(S, tri.KA[e]);
@@ -221,7 +232,7 @@ VISLIB_AVX2 void coverage4_avx2(const StaticTriangle& st, const FaceAxes& ax, co
   __m256d fail = _mm256_cmp_pd(Dn, zero, _CMP_EQ_OQ);
   const __m256d sigma = _mm256_blendv_pd(mone, one, _mm256_cmp_pd(Dn, zero, _CMP_GT_OQ));
   __m256d lo = zero, hi = one, tie = zero;
-  for (int e = 0; e < 3; ++e) {
+  for (int e = 0; e < st.edges; ++e) {
     const __m256d A = dot4(dx, dy, dz, st.KA[e]), B = dot4(dx, dy, dz, st.KB[e]);
     tie = _mm256_or_pd(
         tie, _mm256_and_pd(_mm256_cmp_pd(A, zero, _CMP_EQ_OQ), _mm256_cmp_pd(B, zero, _CMP_EQ_OQ)));
@@ -291,7 +302,6 @@ class StaticKind {
   StaticKind(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt,
              std::vector<PieceList>* pieces)
       : scene_(scene), v0_(v0), v1_(v1), opt_(opt), pieces_(pieces) {
-    const size_t ntri = scene.triangle_count();
     const int N = opt.resolution;
     keep_ties_ = opt.coplanar == CoplanarRule::Both;
     // Depth culling stays exact with ties: a triangle tied with the front lies within eps_z of
@@ -318,13 +328,20 @@ class StaticKind {
       own_lines_ = build_edge_lines(scene, opt.state);
       lines_ = &own_lines_;
     }
+    // The primitives: the tree's (triangle_groups.h), or without a tree the fans when asked for.
+    if (opt.bvh && !opt.bvh->groups.first.empty()) groups_ = &opt.bvh->groups;
+    if (!opt.bvh && opt.fans) {
+      own_groups_ = build_triangle_groups(scene, opt.state);
+      if (!own_groups_.first.empty()) groups_ = &own_groups_;
+    }
     if (!opt.bvh)
-      faces_ = classify_faces(ntri, opt, [this](size_t t, Vec3* rel) { relative_corners(t, rel); });
+      faces_ = classify_faces(count(), opt,
+                              [this](size_t p, Vec3* rel) { return relative_corners(p, rel); });
+    for (int f = 0; f < kCubeFaces; ++f) face_axes_[size_t(f)] = face_axes(f, opt.orientation);
     has_see_through_ = scene.has_see_through();
     if (!(opt.side_normal == Vec3{0, 0, 0})) {
       sides_ = true;
       all_sides_ = opt.side_only < 0 ? 3 : 1;
-      for (int f = 0; f < kCubeFaces; ++f) side_axes_[size_t(f)] = face_axes(f, opt.orientation);
     }
   }
 
@@ -338,8 +355,9 @@ class StaticKind {
                                 b[2], b[3], zmin);
   }
 
+  // The primitives: the groups of the tree's fans, or the triangles.
   size_t count() const {
-    return scene_.triangle_count();
+    return groups_ ? groups_->count(scene_.triangle_count()) : scene_.triangle_count();
   }
 
   Scratch make_scratch(int ts) const {
@@ -355,9 +373,9 @@ class StaticKind {
   // hull) and the nearest depth, on the faces the triangle can reach.
   bool bounds(size_t t, int face, const FaceAxes& axes, int* b, double& zmin) const {
     if (!faces_.empty() && !(faces_[t] >> face & 1)) return false;
-    Vec3 rel[6];
-    relative_corners(t, rel);
-    return footprint_bounds(rel, 6, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], zmin);
+    Vec3 rel[2 * kMaxGroupCorners];
+    const int n = relative_corners(t, rel);
+    return footprint_bounds(rel, n, axes, opt_.near, opt_.resolution, b[0], b[1], b[2], b[3], zmin);
   }
 
   // A triangle of the tile, set up and put in the batch; the batch is composited row by row
@@ -373,7 +391,7 @@ class StaticKind {
   // without them pay one predictable branch per (triangle, tile).
   void cover(Scratch& sc, const TileItem& item, const int* box, const TileRect& rect,
              const FaceAxes& axes, SegmentStats& stats) const {
-    if (has_see_through_ && scene_.triangle_see_through(item.id)) {
+    if (has_see_through_ && scene_.triangle_see_through(first_triangle(item.id))) {
       sc.see_through.emplace_back();
       sc.see_through_hulls.resize(sc.see_through.size() * kMaxFootprintPoints);
       if (!set_up(sc.see_through.back(),
@@ -422,7 +440,8 @@ class StaticKind {
     const bool witnesses = !found.witness_len.empty();
     for (size_t i = 0; i < sc.see_through.size(); ++i) {
       const Pending& b = sc.see_through[i];
-      if (!witnesses && part_bounds_.empty() && found.seen(b.id) == all_sides_)
+      const uint32_t tri = first_triangle(b.id);  // (a see-through group is one triangle)
+      if (!witnesses && part_bounds_.empty() && found.seen(tri) == all_sides_)
         continue;  // nothing to add
       const Vec2* hull = &sc.see_through_hulls[i * kMaxFootprintPoints];
       const StaticTriangle& st = b.st;
@@ -451,23 +470,11 @@ class StaticKind {
           for_each_see_through_stretch(sc.lists[k], Piece{lo, hi, b.id, depth}, keep_ties_,
                                        opt_.eps_z, [&](double t0, double t1) {
                                          if (!part_bounds_.empty()) {
-                                           mark_parts(found, part_bounds_, opt_.eps_len, b.id, t0,
+                                           mark_parts(found, part_bounds_, opt_.eps_len, tri, t0,
                                                       t1);
                                            return;
                                          }
-                                         const double len = t1 - t0;
-                                         if (!(len > opt_.eps_len)) return;
-                                         if (!witnesses) {
-                                           found.add(b.id, sides);
-                                           return;
-                                         }
-                                         Witness w;
-                                         w.tri = b.id;
-                                         w.face = face;
-                                         w.x = x;
-                                         w.y = y;
-                                         w.t = 0.5 * (t0 + t1);
-                                         found.mark(b.id, len, w);
+                                         mark(found, tri, sides, face, x, y, t0, t1);
                                        });
         }
       }
@@ -479,15 +486,20 @@ class StaticKind {
   // covers nothing there.
   bool set_up(Pending& b, Vec2* hull, const TileItem& item, const int* box, const TileRect& rect,
               const FaceAxes& axes) const {
-    auto c = scene_.corners(item.id, opt_.state);
-    Vec3 corners[3] = {c[0], c[1], c[2]};
-    b.st = prepare_static_triangle(corners, v0_, v1_, lines_, item.id);
+    Vec3 c[kMaxGroupCorners];
+    EdgeRef refs[kMaxGroupCorners];
+    const int n = primitive_corners(item.id, c, refs);
+    b.st = prepare_static_polygon(c, n, v0_, v1_, lines_, refs);
     if (b.st.n == Vec3{0, 0, 0}) return false;  // degenerate: never covers (H5)
     b.y0 = std::max(rect.y0, box[2]);
     b.y1 = std::min(rect.y1, box[3]);
     if (b.y0 > b.y1) return false;
-    Vec3 rel[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
-    b.hull_size = compute_footprint_hull(rel, 6, axes, opt_.near, hull, b.margin);
+    Vec3 rel[2 * kMaxGroupCorners];
+    for (int i = 0; i < n; ++i) {
+      rel[i] = c[i] - v0_;
+      rel[n + i] = c[i] - v1_;
+    }
+    b.hull_size = compute_footprint_hull(rel, 2 * n, axes, opt_.near, hull, b.margin);
     if (b.hull_size == 0) return false;  // nothing in front of the near plane on this face
     b.id = item.id;
     b.zmin = item.zmin;
@@ -556,50 +568,83 @@ class StaticKind {
  public:
   void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found) const {
     const PieceList& l = sc.lists[k];
-    if (!part_bounds_.empty()) {  // a split segment: marks per part, no witnesses
-      for_each_visible(l, sc.ties[k], [&](uint32_t id, double t0, double t1) {
-        mark_parts(found, part_bounds_, opt_.eps_len, id, t0, t1);
-      });
-      const int N = opt_.resolution;
-      if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
-      return;
-    }
     const int N = opt_.resolution;
-    const uint8_t sides = side_mask(face, x, y);
-    if (sides == 0) {  // a pixel of the side not asked for
-      if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
+    if (pieces_) store_pieces(l, face, x, y, (*pieces_)[(size_t(face) * N + y) * N + x]);
+    if (!part_bounds_.empty()) {  // a split segment: marks per part, no witnesses
+      for_each_visible(l, sc.ties[k], [&](uint32_t p, double t0, double t1) {
+        for_each_triangle_part(p, face, x, y, t0, t1, [&](uint32_t id, double a, double b) {
+          mark_parts(found, part_bounds_, opt_.eps_len, id, a, b);
+        });
+      });
       return;
     }
+    const uint8_t sides = side_mask(face, x, y);
+    if (sides == 0) return;  // a pixel of the side not asked for
     const bool witnesses = !found.witness_len.empty();
-    auto settled = [&](uint32_t id) { return !witnesses && (found.seen(id) & sides) == sides; };
+    auto settled = [&](uint32_t p) {
+      if (witnesses) return false;
+      for (uint32_t t = first_triangle(p), e = groups_ ? groups_->end(p) : p + 1; t < e; ++t)
+        if ((found.seen(t) & sides) != sides) return false;
+      return true;
+    };
     for_each_visible(
         l, sc.ties[k],
-        [&](uint32_t id, double t0, double t1) {
-          double len = t1 - t0;
-          if (!(len > opt_.eps_len)) return;
-          if (!witnesses) {  // the mark alone (no witness to build and compare)
-            found.add(id, sides);
-            return;
-          }
-          Witness w;
-          w.tri = id;
-          w.face = face;
-          w.x = x;
-          w.y = y;
-          w.t = 0.5 * (t0 + t1);
-          found.mark(id, len, w);
+        [&](uint32_t p, double t0, double t1) {
+          // A fan whose triangles are all marked already gains nothing from its parts: most
+          // pieces of a run, once their triangles are found.
+          if (groups_ && settled(p)) return;
+          for_each_triangle_part(p, face, x, y, t0, t1, [&](uint32_t id, double a, double b) {
+            mark(found, id, sides, face, x, y, a, b);
+          });
         },
         settled);
-    if (pieces_) (*pieces_)[(size_t(face) * N + y) * N + x] = l;
   }
 
  private:
+  // Triangle `tri` seen on `sides` over [t0, t1) at pixel (x, y) of `face`, when the stretch is
+  // longer than eps_len: its mark, and with witnesses the stretch's middle as a candidate.
+  void mark(FoundMarks& found, uint32_t tri, uint8_t sides, int face, int x, int y, double t0,
+            double t1) const {
+    const double len = t1 - t0;
+    if (!(len > opt_.eps_len)) return;
+    if (found.witness_len.empty()) {  // the mark alone (no witness to build and compare)
+      found.add(tri, sides);
+      return;
+    }
+    Witness w;
+    w.tri = tri;
+    w.face = face;
+    w.x = x;
+    w.y = y;
+    w.t = 0.5 * (t0 + t1);
+    found.mark(tri, len, w);
+  }
+
+  // The final list of a pixel as SegmentResult::pieces holds it: triangle ids (a fan's pieces
+  // cut into its triangles' parts, with the fan's depth).
+  void store_pieces(const PieceList& l, int face, int x, int y, PieceList& out) const {
+    if (!groups_) {
+      out = l;
+      return;
+    }
+    out.clear();
+    for (const Piece& q : l) {
+      const size_t first = out.size();
+      for_each_triangle_part(q.id, face, x, y, q.t0, q.t1, [&](uint32_t id, double a, double b) {
+        out.push_back(Piece{a, b, id, q.depth});
+      });
+      // (in triangle order, which runs either way along t)
+      std::sort(out.begin() + long(first), out.end(),
+                [](const Piece& u, const Piece& v) { return u.t0 < v.t0; });
+    }
+  }
+
   // The sides (SegmentOptions::side_normal) pixel (x, y) of `face` counts for, as the mark's
   // bits: 1 (side 0), 2 (side 1) or 3 (both, on the plane) when the sides are split; 1 when it
   // is on the side asked for (side_only), 0 when not; 1 without sides.
   uint8_t side_mask(int face, int x, int y) const {
     if (!sides_) return 1;
-    const FaceAxes& a = side_axes_[size_t(face)];
+    const FaceAxes& a = face_axes_[size_t(face)];
     const double sc = pixel_centers_[size_t(x)], tc = pixel_centers_[size_t(y)];
     const Vec3 d = a.F + a.S * sc + a.T * tc;
     const double dn = dot(d, opt_.side_normal);
@@ -609,12 +654,84 @@ class StaticKind {
     return uint8_t(mask >> opt_.side_only & 1);
   }
 
-  void relative_corners(size_t t, Vec3* rel) const {
-    auto c = scene_.corners(uint32_t(t), opt_.state);
-    const Vec3 r[6] = {c[0] - v0_, c[1] - v0_, c[2] - v0_, c[0] - v1_, c[1] - v1_, c[2] - v1_};
-    std::copy(r, r + 6, rel);
+  // Primitive p's corners minus v0, then minus v1 (room for 2 kMaxGroupCorners); their count.
+  int relative_corners(size_t p, Vec3* rel) const {
+    Vec3 c[kMaxGroupCorners];
+    EdgeRef refs[kMaxGroupCorners];
+    const int n = primitive_corners(uint32_t(p), c, refs);
+    for (int i = 0; i < n; ++i) {
+      rel[i] = c[i] - v0_;
+      rel[n + i] = c[i] - v1_;
+    }
+    return 2 * n;
   }
 
+  uint32_t first_triangle(uint32_t p) const {
+    return groups_ ? groups_->begin(p) : p;
+  }
+
+  // Primitive p's corners (room for kMaxGroupCorners) and the scene's edge of each of its edges
+  // (corner i to i + 1): a triangle's three, or a fan's polygon (triangle_groups.h); their count.
+  int primitive_corners(uint32_t p, Vec3* c, EdgeRef* refs) const {
+    const uint32_t b = first_triangle(p), e = groups_ ? groups_->end(p) : p + 1;
+    const int n = group_corners(scene_, opt_.state, b, e, c);
+    // Edge 0 (a b) of the first triangle, edge 1 (its second and third corners) of each, edge 2
+    // (back to a) of the last.
+    refs[0] = {b, 0};
+    for (uint32_t t = b; t < e; ++t) refs[1 + (t - b)] = {t, 1};
+    refs[n - 1] = {e - 1, 2};
+    return n;
+  }
+
+ public:
+  // Calls f(tri, a, b) for each triangle of primitive p and its part [a, b) (not empty) of the
+  // stretch [t0, t1) of p at pixel (x, y) of `face`: the stretch itself for a triangle; for a
+  // fan, the stretch cut at its inner edges, each cut computed as the triangle kernel computes
+  // that edge's (static_edge, the §2.5 tie rule), so that the parts are the pieces the triangles
+  // would have had (§2.6).
+  template <class F>
+  void for_each_triangle_part(uint32_t p, int face, int x, int y, double t0, double t1, F f) const {
+    if (!groups_ || groups_->end(p) - groups_->begin(p) == 1) {
+      f(first_triangle(p), t0, t1);
+      return;
+    }
+    Vec3 c[kMaxGroupCorners];
+    EdgeRef refs[kMaxGroupCorners];
+    const int n = primitive_corners(p, c, refs);
+    const FaceAxes& ax = face_axes_[size_t(face)];
+    const Vec3 d = ax.F + ax.S * pixel_centers_[size_t(x)] + ax.T * pixel_centers_[size_t(y)];
+    const Vec3 delta = v1_ - v0_;
+    const Vec3 r0 = c[0] - v0_;
+    const double Dn = dot(d, cross((c[1] - v0_) - r0, (c[2] - v0_) - r0));
+    const double sigma = Dn > 0 ? 1.0 : -1.0;
+    // Keeps the side of edge a -> b (scene edge `ref`) that the triangle holding it covers.
+    auto keep = [&](Vec3 a, Vec3 b, EdgeRef ref, double& lo, double& hi) {
+      Vec3 KA, KB;
+      double rho;
+      static_edge(a, b, v0_, delta, lines_, ref, KA, KB, rho);
+      double A = dot(d, KA), B = dot(d, KB);
+      if (A == 0 && B == 0) {  // persistent on-edge tie (§2.5), as static_coverage decides it
+        A = dot(ax.S, KA);
+        B = dot(ax.S, KB);
+        if (A == 0 && B == 0) {
+          A = dot(ax.T, KA);
+          B = dot(ax.T, KB);
+        }
+      }
+      const double fs = sigma * rho;
+      return halfline(fs * A, fs * B, lo, hi);
+    };
+    const uint32_t first = refs[0].tri;
+    for (int j = 0; j < n - 2; ++j) {  // triangle first + j: c[0], c[j + 1], c[j + 2]
+      double lo = t0, hi = t1;
+      const uint32_t tri = first + uint32_t(j);
+      if (j > 0 && !keep(c[0], c[j + 1], EdgeRef{tri, 0}, lo, hi)) continue;
+      if (j < n - 3 && !keep(c[j + 2], c[0], EdgeRef{tri, 2}, lo, hi)) continue;
+      if (lo < hi) f(tri, lo, hi);
+    }
+  }
+
+ private:
   const Scene& scene_;
   Vec3 v0_, v1_;
   const SegmentOptions& opt_;
@@ -624,7 +741,9 @@ class StaticKind {
   std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
   bool sides_ = false;               // side_normal given
   uint8_t all_sides_ = 1;            // the mark of an id seen on every side that counts
-  std::array<FaceAxes, kCubeFaces> side_axes_{};  // world axes of each face (sides_ only)
+  std::array<FaceAxes, kCubeFaces> face_axes_{};  // world axes of each face
+  TriangleGroups own_groups_;                     // built for this call (no tree, fans)
+  const TriangleGroups* groups_ = nullptr;        // the primitives' fans; null: triangles
   bool keep_ties_ = false;
   bool has_see_through_ = false;
   double far_scale_ = 1.0;

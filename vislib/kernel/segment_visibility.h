@@ -78,9 +78,14 @@ struct SegmentOptions {
   std::vector<double> splits;
   // Static scenes: a BVH of the scene's triangles in key state `state` (build_triangle_bvh), so
   // that each tile walks the tree front to back instead of every triangle getting footprint
-  // bounds on every face. Null: no tree. The results are the same either way;
-  // a tree built for another scene or state is refused (std::invalid_argument).
+  // bounds on every face. Null: no tree. The results are the same either way when the tree's
+  // primitives are what `fans` asks for; a tree built for another scene or state is refused
+  // (std::invalid_argument).
   const TriangleBvh* bvh = nullptr;
+  // Static scenes: composite the scene's fans as polygons (triangle_groups.h, the same visible
+  // sets but for ties at corners: docs/visibility-math.md §2.6), or its triangles one by one.
+  // With a tree, its primitives decide (BvhPrimitives).
+  bool fans = true;
   // Static scenes: the runs of collinear edges (build_edge_lines), so that T-junctions do not leak
   // (edge_lines.h). Null: the kernel builds them for the call (the same results; callers running
   // many segments on one scene build them once). Built for another scene or state: refused

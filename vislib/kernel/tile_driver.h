@@ -107,9 +107,9 @@ std::vector<uint8_t> classify_faces(size_t n, const SegmentOptions& opt, const R
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1024),
                     [&](const tbb::blocked_range<size_t>& r) {
                       for (size_t t = r.begin(); t != r.end(); ++t) {
-                        Vec3 rel[6];
-                        relative(t, rel);
-                        faces[t] = uint8_t(reachable_faces(rel, 6, opt.orientation, opt.near));
+                        Vec3 rel[12];
+                        const int k = relative(t, rel);
+                        faces[t] = uint8_t(reachable_faces(rel, k, opt.orientation, opt.near));
                       }
                     });
   return faces;

@@ -32,7 +32,7 @@ float up(double x) {
 struct Builder {
   const Scene& scene;
   size_t state;
-  std::vector<float> mid;  // per triangle: centre of its box, 3 each
+  std::vector<float> mid;  // per primitive: centre of its box, 3 each
   TriangleBvh& bvh;
   std::map<uint32_t, uint32_t> below_size;  // filled by count_below before the build, then read
 
@@ -56,11 +56,12 @@ struct Builder {
     if (end - begin <= kBvhLeafSize) {
       double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
       for (uint32_t i = begin; i < end; ++i)
-        for (const Vec3& c : scene.corners(bvh.order[i], state))
-          for (int a = 0; a < 3; ++a) {
-            lo[a] = std::min(lo[a], c[a]);
-            hi[a] = std::max(hi[a], c[a]);
-          }
+        for (uint32_t t = bvh.groups.begin(bvh.order[i]); t < bvh.groups.end(bvh.order[i]); ++t)
+          for (const Vec3& c : scene.corners(t, state))
+            for (int a = 0; a < 3; ++a) {
+              lo[a] = std::min(lo[a], c[a]);
+              hi[a] = std::max(hi[a], c[a]);
+            }
       for (int a = 0; a < 3; ++a) {
         n.lo[a] = down(lo[a]);
         n.hi[a] = up(hi[a]);
@@ -109,26 +110,32 @@ struct Builder {
   }
 };
 
-// The tree over the triangles `order` (distinct ids of `scene`).
-TriangleBvh build_tree(const Scene& scene, size_t state, std::vector<uint32_t> order) {
+// The tree over the primitives `order` (distinct groups of `groups`, a group per triangle when
+// it is empty).
+TriangleBvh build_tree(const Scene& scene, size_t state, TriangleGroups groups,
+                       std::vector<uint32_t> order) {
   TriangleBvh bvh;
   bvh.scene = &scene;
   bvh.state = state;
   const size_t n = scene.triangle_count();
   bvh.triangle_count = n;
+  bvh.groups = std::move(groups);
   if (n >= (size_t(1) << 31)) throw std::invalid_argument("too many triangles for the BVH");
   if (order.empty()) return bvh;
   if (state >= scene.positions.size())
     throw std::invalid_argument("BVH: key state " + std::to_string(state) + " out of range");
-  Builder b{scene, state, std::vector<float>(n * 3), bvh, {}};
+  Builder b{scene, state, std::vector<float>(bvh.groups.count(n) * 3), bvh, {}};
   tbb::parallel_for(size_t(0), order.size(), [&](size_t i) {
-    const uint32_t t = order[i];
-    const auto c = scene.corners(t, state);
-    for (int a = 0; a < 3; ++a) {
-      const double l = std::min({c[0][a], c[1][a], c[2][a]});
-      const double h = std::max({c[0][a], c[1][a], c[2][a]});
-      b.mid[size_t(t) * 3 + size_t(a)] = float(0.5 * (l + h));
+    const uint32_t g = order[i];
+    double l[3] = {INFINITY, INFINITY, INFINITY}, h[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t t = bvh.groups.begin(g); t < bvh.groups.end(g); ++t) {
+      const auto c = scene.corners(t, state);
+      for (int a = 0; a < 3; ++a) {
+        l[a] = std::min({l[a], c[0][a], c[1][a], c[2][a]});
+        h[a] = std::max({h[a], c[0][a], c[1][a], c[2][a]});
+      }
     }
+    for (int a = 0; a < 3; ++a) b.mid[size_t(g) * 3 + size_t(a)] = float(0.5 * (l[a] + h[a]));
   });
   const uint32_t m = uint32_t(order.size());
   bvh.order = std::move(order);
@@ -137,20 +144,44 @@ TriangleBvh build_tree(const Scene& scene, size_t state, std::vector<uint32_t> o
   return bvh;
 }
 
+TriangleGroups groups_for(const Scene& scene, size_t state, BvhPrimitives primitives) {
+  return primitives == BvhPrimitives::Groups ? build_triangle_groups(scene, state)
+                                             : TriangleGroups{};
+}
+
 }  // namespace
 
+TriangleBvh build_triangle_bvh(const Scene& scene, BvhPrimitives primitives, size_t state) {
+  TriangleGroups groups = groups_for(scene, state, primitives);
+  std::vector<uint32_t> order(groups.count(scene.triangle_count()));
+  for (size_t g = 0; g < order.size(); ++g) order[g] = uint32_t(g);
+  return build_tree(scene, state, std::move(groups), std::move(order));
+}
+
 TriangleBvh build_triangle_bvh(const Scene& scene, size_t state) {
-  std::vector<uint32_t> order(scene.triangle_count());
-  for (size_t t = 0; t < order.size(); ++t) order[t] = uint32_t(t);
-  return build_tree(scene, state, std::move(order));
+  return build_triangle_bvh(scene, BvhPrimitives::Groups, state);
 }
 
 TriangleBvh build_triangle_bvh(const Scene& scene, size_t state,
                                const std::vector<uint32_t>& subset) {
+  return build_triangle_bvh(scene, state, subset, groups_for(scene, state, BvhPrimitives::Groups));
+}
+
+TriangleBvh build_triangle_bvh(const Scene& scene, size_t state,
+                               const std::vector<uint32_t>& subset, const TriangleGroups& groups) {
   for (size_t i = 0; i < subset.size(); ++i)
     if (subset[i] >= scene.triangle_count() || (i > 0 && subset[i] <= subset[i - 1]))
       throw std::invalid_argument("BVH: the subset is not increasing triangle ids of the scene");
-  return build_tree(scene, state, subset);
+  if (!groups.first.empty() && groups.first.back() != scene.triangle_count())
+    throw std::invalid_argument("BVH: the groups were built for another scene");
+  if (groups.first.empty()) return build_tree(scene, state, groups, subset);
+  std::vector<uint32_t> order;  // the groups holding a triangle of the subset, increasing
+  uint32_t g = 0;
+  for (uint32_t t : subset) {
+    while (groups.end(g) <= t) ++g;
+    if (order.empty() || order.back() != g) order.push_back(g);
+  }
+  return build_tree(scene, state, groups, std::move(order));
 }
 
 }  // namespace vislib
