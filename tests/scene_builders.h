@@ -1,9 +1,11 @@
 // scene_builders.h: tiny scenes for semantic tests, built in code.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "vislib/base/random.h"
+#include "vislib/kernel/segment_visibility.h"
 #include "vislib/scene/generate.h"
 #include "vislib/scene/scene.h"
 
@@ -47,6 +49,18 @@ inline vislib::Scene panel_city() {
   o.panel_size = 4;
   o.seed = 3;
   return vislib::generate_city(o);
+}
+
+// Case k of runs down panel_city()'s streets: the segment at eye height, from `rng`, k < 2 short
+// (2 units), then long (16 units, crossing a building: boxes that straddle the segment); `o` gets
+// N = 48 and, for odd k, a random cube orientation.
+inline std::pair<vislib::Vec3, vislib::Vec3> panel_city_street(vislib::Rng& rng, int k,
+                                                               vislib::SegmentOptions& o) {
+  o.resolution = 48;
+  if (k % 2) o.orientation = vislib::random_orientation(100 + uint64_t(k));
+  const double len = k < 2 ? 2.0 : 16.0;
+  const vislib::Vec3 v0{rng.uniform(-10, 10), 1.7, rng.uniform(-10, 10)};
+  return {v0, v0 + vislib::Vec3{len * 0.6, 0.3, len * 0.8}};
 }
 
 // Appends an indexed quad (two triangles) a b c d (counter-clockwise) to `s` as one object.

@@ -172,14 +172,9 @@ TEST(TriangleBvh, WalkGivesTheListsSetsAndWitnessesOfBinningOnACityStreet) {
   Rng rng(5);
   for (int k = 0; k < 6; ++k) {
     SegmentOptions o;
-    o.resolution = 48;
-    if (k % 2) o.orientation = random_orientation(100 + uint64_t(k));
+    const auto [v0, v1] = vislib_test::panel_city_street(rng, k, o);
     if (k == 4) o.coplanar = CoplanarRule::First;
     if (k == 5) o.depth_culling = false;
-    // Short and long segments at eye height, one crossing a building (straddling boxes).
-    const double len = k < 2 ? 2.0 : 16.0;
-    const Vec3 v0{rng.uniform(-10, 10), 1.7, rng.uniform(-10, 10)};
-    const Vec3 v1 = v0 + Vec3{len * 0.6, 0.3, len * 0.8};
     expect_walk_equals_binning(s, v0, v1, o, "street case " + std::to_string(k));
   }
 }

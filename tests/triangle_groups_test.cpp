@@ -183,12 +183,8 @@ TEST(TriangleGroups, GroupsKeepTheVisibleTrianglesOfACityStreet) {
   Rng rng(5);
   for (int k = 0; k < 6; ++k) {
     SegmentOptions o;
-    o.resolution = 48;
-    if (k % 2) o.orientation = random_orientation(100 + uint64_t(k));
+    const auto [v0, v1] = vislib_test::panel_city_street(rng, k, o);
     if (k >= 4) o.coplanar = CoplanarRule::First;
-    const double len = k < 2 ? 2.0 : 16.0;
-    const Vec3 v0{rng.uniform(-10, 10), 1.7, rng.uniform(-10, 10)};
-    const Vec3 v1 = v0 + Vec3{len * 0.6, 0.3, len * 0.8};
     expect_groups_keep_the_triangles_sets(s, v0, v1, o, "street case " + std::to_string(k));
   }
 }

@@ -123,20 +123,19 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   // Trees over the bounds of the cell's runs (ViewCells::bound_leaves), each built once.
   const bool bounded = cells && !cells->segment_bound.empty();
   std::map<uint32_t, TriangleBvh> trees;
-  // Their primitives: the bake's tree's, or without one the scene's fans when the runs take them.
-  std::optional<TriangleGroups> fans;
+  // Their primitives: the bake's tree's, or without one the scene's fans when the runs take them
+  // (built on the first bound).
+  std::optional<TriangleGroups> own_fans;
+  const TriangleGroups* fans = options.segment.bvh ? &options.segment.bvh->groups : nullptr;
   auto tree_of = [&](uint32_t b) -> const TriangleBvh* {
     if (b == ViewCells::kNoBound) return nullptr;
     auto it = trees.find(b);
     if (it == trees.end()) {
       PhaseScope building(Phase::BoundTrees);
       if (!fans) {
-        if (options.segment.bvh)
-          fans = options.segment.bvh->groups;
-        else if (options.segment.fans)
-          fans = build_triangle_groups(scene, options.segment.state);
-        else
-          fans = TriangleGroups{};
+        own_fans = options.segment.fans ? build_triangle_groups(scene, options.segment.state)
+                                        : TriangleGroups{};
+        fans = &*own_fans;
       }
       const std::vector<uint32_t> subset =
           bound_triangles(cells->leaf_triangles, cells->bound_leaves.at(b));

@@ -87,6 +87,24 @@ inline bool halfline(double A, double B, double& lo, double& hi) {
   return lo < hi;
 }
 
+// Keeps the side of one edge (KA, KB, rho: static_edge) that its primitive covers at pixel
+// direction d, for the primitive's sign sigma = sign(d.n): an edge with A = B = 0 takes the
+// symbolic perturbation d -> d + eps S + eps^2 T (§2.5). False when nothing is left.
+inline bool keep_edge_side(Vec3 KA, Vec3 KB, double rho, double sigma, Vec3 d, Vec3 S, Vec3 T,
+                           double& lo, double& hi) {
+  double A = dot(d, KA), B = dot(d, KB);
+  if (A == 0 && B == 0) {  // persistent on-edge tie
+    A = dot(S, KA);
+    B = dot(S, KB);
+    if (A == 0 && B == 0) {
+      A = dot(T, KA);
+      B = dot(T, KB);
+    }
+  }
+  const double f = sigma * rho;
+  return halfline(f * A, f * B, lo, hi);
+}
+
 }  // namespace
 
 bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double near, double& lo,
@@ -96,19 +114,8 @@ bool static_coverage(const StaticTriangle& tri, Vec3 d, Vec3 S, Vec3 T, double n
   const double sigma = Dn > 0 ? 1.0 : -1.0;
   lo = 0;
   hi = 1;
-  for (int e = 0; e < tri.edges; ++e) {
-    double A = dot(d, tri.KA[e]), B = dot(d, tri.KB[e]);
-    if (A == 0 && B == 0) {  // persistent on-edge tie: perturb d -> d + eps S + eps^2 T (§2.5)
-      A = dot(S, tri.KA[e]);
-      B = dot(S, tri.KB[e]);
-      if (A == 0 && B == 0) {
-        A = dot(T, tri.KA[e]);
-        B = dot(T, tri.KB[e]);
-      }
-    }
-    double f = sigma * tri.rho[e];
-    if (!halfline(f * A, f * B, lo, hi)) return false;
-  }
+  for (int e = 0; e < tri.edges; ++e)
+    if (!keep_edge_side(tri.KA[e], tri.KB[e], tri.rho[e], sigma, d, S, T, lo, hi)) return false;
   // In front of the near plane: lambda(t) > near  <=>  sigma (N0 - near Dn - N1 t) > 0.
   if (!halfline(-sigma * tri.N1, sigma * (tri.N0 - near * Dn), lo, hi)) return false;
   depth = LinearDepth{tri.N0, tri.N1, Dn};
@@ -583,7 +590,7 @@ class StaticKind {
     const bool witnesses = !found.witness_len.empty();
     auto settled = [&](uint32_t p) {
       if (witnesses) return false;
-      for (uint32_t t = first_triangle(p), e = groups_ ? groups_->end(p) : p + 1; t < e; ++t)
+      for (uint32_t t = first_triangle(p), e = end_triangle(p); t < e; ++t)
         if ((found.seen(t) & sides) != sides) return false;
       return true;
     };
@@ -666,14 +673,18 @@ class StaticKind {
     return 2 * n;
   }
 
+  // Primitive p's triangles: first_triangle(p) ... end_triangle(p) - 1.
   uint32_t first_triangle(uint32_t p) const {
     return groups_ ? groups_->begin(p) : p;
+  }
+  uint32_t end_triangle(uint32_t p) const {
+    return groups_ ? groups_->end(p) : p + 1;
   }
 
   // Primitive p's corners (room for kMaxGroupCorners) and the scene's edge of each of its edges
   // (corner i to i + 1): a triangle's three, or a fan's polygon (triangle_groups.h); their count.
   int primitive_corners(uint32_t p, Vec3* c, EdgeRef* refs) const {
-    const uint32_t b = first_triangle(p), e = groups_ ? groups_->end(p) : p + 1;
+    const uint32_t b = first_triangle(p), e = end_triangle(p);
     const int n = group_corners(scene_, opt_.state, b, e, c);
     // Edge 0 (a b) of the first triangle, edge 1 (its second and third corners) of each, edge 2
     // (back to a) of the last.
@@ -691,7 +702,7 @@ class StaticKind {
   // would have had (§2.6).
   template <class F>
   void for_each_triangle_part(uint32_t p, int face, int x, int y, double t0, double t1, F f) const {
-    if (!groups_ || groups_->end(p) - groups_->begin(p) == 1) {
+    if (end_triangle(p) - first_triangle(p) == 1) {
       f(first_triangle(p), t0, t1);
       return;
     }
@@ -709,19 +720,9 @@ class StaticKind {
       Vec3 KA, KB;
       double rho;
       static_edge(a, b, v0_, delta, lines_, ref, KA, KB, rho);
-      double A = dot(d, KA), B = dot(d, KB);
-      if (A == 0 && B == 0) {  // persistent on-edge tie (§2.5), as static_coverage decides it
-        A = dot(ax.S, KA);
-        B = dot(ax.S, KB);
-        if (A == 0 && B == 0) {
-          A = dot(ax.T, KA);
-          B = dot(ax.T, KB);
-        }
-      }
-      const double fs = sigma * rho;
-      return halfline(fs * A, fs * B, lo, hi);
+      return keep_edge_side(KA, KB, rho, sigma, d, ax.S, ax.T, lo, hi);
     };
-    const uint32_t first = refs[0].tri;
+    const uint32_t first = first_triangle(p);
     for (int j = 0; j < n - 2; ++j) {  // triangle first + j: c[0], c[j + 1], c[j + 2]
       double lo = t0, hi = t1;
       const uint32_t tri = first + uint32_t(j);
