@@ -277,6 +277,13 @@ bool cpu_has_avx2() {
 #endif
 }
 
+// A number for each StaticKind, never 0, so that a thread's cached fan edges (FanEdges) tell
+// their segment apart.
+uint64_t next_kind_serial() {
+  static std::atomic<uint64_t> last{0};
+  return ++last;
+}
+
 // The static triangles of one segment for the tile driver (tile_driver.h): footprint bounds on
 // the faces each triangle can reach, coverage 4 pixels at a time, exact per-pixel depth culling,
 // lists of linear depths.
@@ -292,6 +299,22 @@ class StaticKind {
     int y0, y1;  // its rows in the tile
   };
   static constexpr size_t kBatch = 16;
+  // The inner edges of a fan of m triangles for one segment, as for_each_triangle_part cuts at
+  // them: edge 2 of triangle j < m - 1 (cut[2 j]) and edge 0 of triangle j > 0 (cut[2 j - 1]), each
+  // computed by static_edge with its own edge reference; and the fan's plane normal relative to
+  // v0, the sign of whose dot product with a pixel ray is the fan's side (sigma).
+  static constexpr int kMaxFanCuts = 2 * (kMaxGroupCorners - 3);
+  struct FanEdges {
+    uint64_t kind = 0;  // the StaticKind (its serial) and primitive they belong to; 0: none
+    uint32_t p = 0;
+    Vec3 n;
+    Vec3 KA[kMaxFanCuts], KB[kMaxFanCuts];
+    double rho[kMaxFanCuts];
+  };
+  // Slots of the per-thread cache of fans' inner edges (Scratch::fan_edges, 376 KiB): fan p takes
+  // slot p mod kFanEdgeSlots, and one that another fan took since is computed again. Without it,
+  // computing the cuts' coefficients pixel after pixel was about a tenth of a Quake bake's CPU.
+  static constexpr size_t kFanEdgeSlots = 1024;
   struct Scratch {
     std::vector<PieceList> lists;
     std::vector<double> far;  // per pixel: an upper bound of its list's depth (inf unless the list
@@ -304,6 +327,9 @@ class StaticKind {
     // (finish_tile); their hulls, a slot each.
     std::vector<Pending> see_through;
     std::vector<Vec2> see_through_hulls;
+    // The inner edges of the fans this thread cut last (fan_edges_of): a direct-mapped cache of
+    // kFanEdgeSlots, empty until a fan is cut.
+    std::vector<FanEdges> fan_edges;
   };
 
   StaticKind(const Scene& scene, Vec3 v0, Vec3 v1, const SegmentOptions& opt,
@@ -416,7 +442,7 @@ class StaticKind {
   void begin_tile(Scratch& sc) const {  // the driver resets the per-pixel state
     sc.see_through.clear();
   }
-  size_t held_bytes(const Scratch&) const {
+  size_t held_bytes(const Scratch&) const {  // (the fan edge cache is a fixed size, not a tile's)
     return 0;
   }
 
@@ -576,10 +602,10 @@ class StaticKind {
   void finish_pixel(Scratch& sc, size_t k, int face, int x, int y, FoundMarks& found) const {
     const PieceList& l = sc.lists[k];
     const int N = opt_.resolution;
-    if (pieces_) store_pieces(l, face, x, y, (*pieces_)[(size_t(face) * N + y) * N + x]);
+    if (pieces_) store_pieces(sc, l, face, x, y, (*pieces_)[(size_t(face) * N + y) * N + x]);
     if (!part_bounds_.empty()) {  // a split segment: marks per part, no witnesses
       for_each_visible(l, sc.ties[k], [&](uint32_t p, double t0, double t1) {
-        for_each_triangle_part(p, face, x, y, t0, t1, [&](uint32_t id, double a, double b) {
+        for_each_triangle_part(sc, p, face, x, y, t0, t1, [&](uint32_t id, double a, double b) {
           mark_parts(found, part_bounds_, opt_.eps_len, id, a, b);
         });
       });
@@ -600,7 +626,7 @@ class StaticKind {
           // A fan whose triangles are all marked already gains nothing from its parts: most
           // pieces of a run, once their triangles are found.
           if (groups_ && settled(p)) return;
-          for_each_triangle_part(p, face, x, y, t0, t1, [&](uint32_t id, double a, double b) {
+          for_each_triangle_part(sc, p, face, x, y, t0, t1, [&](uint32_t id, double a, double b) {
             mark(found, id, sides, face, x, y, a, b);
           });
         },
@@ -629,7 +655,7 @@ class StaticKind {
 
   // The final list of a pixel as SegmentResult::pieces holds it: triangle ids (a fan's pieces
   // cut into its triangles' parts, with the fan's depth).
-  void store_pieces(const PieceList& l, int face, int x, int y, PieceList& out) const {
+  void store_pieces(Scratch& sc, const PieceList& l, int face, int x, int y, PieceList& out) const {
     if (!groups_) {
       out = l;
       return;
@@ -637,9 +663,10 @@ class StaticKind {
     out.clear();
     for (const Piece& q : l) {
       const size_t first = out.size();
-      for_each_triangle_part(q.id, face, x, y, q.t0, q.t1, [&](uint32_t id, double a, double b) {
-        out.push_back(Piece{a, b, id, q.depth});
-      });
+      for_each_triangle_part(sc, q.id, face, x, y, q.t0, q.t1,
+                             [&](uint32_t id, double a, double b) {
+                               out.push_back(Piece{a, b, id, q.depth});
+                             });
       // (in triangle order, which runs either way along t)
       std::sort(out.begin() + long(first), out.end(),
                 [](const Piece& u, const Piece& v) { return u.t0 < v.t0; });
@@ -701,40 +728,62 @@ class StaticKind {
   // that edge's (static_edge, the §2.5 tie rule), so that the parts are the pieces the triangles
   // would have had (§2.6).
   template <class F>
-  void for_each_triangle_part(uint32_t p, int face, int x, int y, double t0, double t1, F f) const {
-    if (end_triangle(p) - first_triangle(p) == 1) {
-      f(first_triangle(p), t0, t1);
+  void for_each_triangle_part(Scratch& sc, uint32_t p, int face, int x, int y, double t0, double t1,
+                              F f) const {
+    const uint32_t first = first_triangle(p), m = end_triangle(p) - first;
+    if (m == 1) {
+      f(first, t0, t1);
       return;
     }
-    Vec3 c[kMaxGroupCorners];
-    EdgeRef refs[kMaxGroupCorners];
-    const int n = primitive_corners(p, c, refs);
+    const FanEdges& fe = fan_edges_of(sc, p);
     const FaceAxes& ax = face_axes_[size_t(face)];
     const Vec3 d = ax.F + ax.S * pixel_centers_[size_t(x)] + ax.T * pixel_centers_[size_t(y)];
-    const Vec3 delta = v1_ - v0_;
-    const Vec3 r0 = c[0] - v0_;
-    const double Dn = dot(d, cross((c[1] - v0_) - r0, (c[2] - v0_) - r0));
-    const double sigma = Dn > 0 ? 1.0 : -1.0;
-    // Keeps the side of edge a -> b (scene edge `ref`) that the triangle holding it covers.
-    auto keep = [&](Vec3 a, Vec3 b, EdgeRef ref, double& lo, double& hi) {
-      Vec3 KA, KB;
-      double rho;
-      static_edge(a, b, v0_, delta, lines_, ref, KA, KB, rho);
-      return keep_edge_side(KA, KB, rho, sigma, d, ax.S, ax.T, lo, hi);
+    const double sigma = dot(d, fe.n) > 0 ? 1.0 : -1.0;
+    auto keep = [&](int cut, double& lo, double& hi) {
+      return keep_edge_side(fe.KA[cut], fe.KB[cut], fe.rho[cut], sigma, d, ax.S, ax.T, lo, hi);
     };
-    const uint32_t first = first_triangle(p);
-    for (int j = 0; j < n - 2; ++j) {  // triangle first + j: c[0], c[j + 1], c[j + 2]
+    for (uint32_t j = 0; j < m; ++j) {  // triangle first + j
       double lo = t0, hi = t1;
-      const uint32_t tri = first + uint32_t(j);
-      if (j > 0 && !keep(c[0], c[j + 1], EdgeRef{tri, 0}, lo, hi)) continue;
-      if (j < n - 3 && !keep(c[j + 2], c[0], EdgeRef{tri, 2}, lo, hi)) continue;
-      if (lo < hi) f(tri, lo, hi);
+      if (j > 0 && !keep(int(2 * j) - 1, lo, hi)) continue;
+      if (j + 1 < m && !keep(int(2 * j), lo, hi)) continue;
+      if (lo < hi) f(first + j, lo, hi);
     }
   }
 
  private:
+  // The inner edges of fan p (FanEdges) for this segment, from this thread's cache.
+  const FanEdges& fan_edges_of(Scratch& sc, uint32_t p) const {
+    if (sc.fan_edges.empty()) sc.fan_edges.resize(kFanEdgeSlots);
+    FanEdges& fe = sc.fan_edges[p % kFanEdgeSlots];
+    if (fe.kind == serial_ && fe.p == p) return fe;
+    Vec3 c[kMaxGroupCorners];
+    EdgeRef refs[kMaxGroupCorners];
+    const int n = primitive_corners(p, c, refs);
+    const Vec3 delta = v1_ - v0_;
+    const Vec3 r0 = c[0] - v0_;
+    fe.n = cross((c[1] - v0_) - r0, (c[2] - v0_) - r0);
+    const uint32_t first = first_triangle(p);
+    for (int j = 0; j < n - 2; ++j) {  // triangle first + j: c[0], c[j + 1], c[j + 2]
+      const uint32_t tri = first + uint32_t(j);
+      if (j > 0) {
+        const int cut = 2 * j - 1;
+        static_edge(c[0], c[j + 1], v0_, delta, lines_, EdgeRef{tri, 0}, fe.KA[cut], fe.KB[cut],
+                    fe.rho[cut]);
+      }
+      if (j < n - 3) {
+        const int cut = 2 * j;
+        static_edge(c[j + 2], c[0], v0_, delta, lines_, EdgeRef{tri, 2}, fe.KA[cut], fe.KB[cut],
+                    fe.rho[cut]);
+      }
+    }
+    fe.kind = serial_;
+    fe.p = p;
+    return fe;
+  }
+
   const Scene& scene_;
   Vec3 v0_, v1_;
+  const uint64_t serial_ = next_kind_serial();  // tells this segment's cached fan edges apart
   const SegmentOptions& opt_;
   std::vector<PieceList>* pieces_;
   EdgeLines own_lines_;  // built for this call when the caller passes none
