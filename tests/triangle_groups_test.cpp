@@ -6,12 +6,14 @@
 #include "vislib/kernel/triangle_groups.h"
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <iterator>
 #include <limits>
 #include <optional>
+#include <thread>
 
 #include "tests/scene_builders.h"
 #include "tests/test_support.h"
@@ -187,6 +189,41 @@ TEST(TriangleGroups, GroupsKeepTheVisibleTrianglesOfACityStreet) {
     if (k >= 4) o.coplanar = CoplanarRule::First;
     expect_groups_keep_the_triangles_sets(s, v0, v1, o, "street case " + std::to_string(k));
   }
+}
+
+// A thread keeps the coefficients of the fans it cut (their inner edges, for one segment) from
+// one segment to the next: a segment run after another on the same thread cuts its fans at its
+// own edges, piece for piece as on a thread that ran nothing before.
+TEST(TriangleGroups, AFanIsCutAtItsOwnSegmentsEdgesAfterAnotherSegmentOnTheSameThread) {
+  const Scene s = vislib_test::panel_city();
+  Rng rng(11);
+  SegmentOptions o;
+  o.want_pieces = true;
+  const auto [a0, a1] = vislib_test::panel_city_street(rng, 2, o);
+  const auto [b0, b1] = vislib_test::panel_city_street(rng, 3, o);
+  // Every tile of a run on the calling thread: the reference on a new thread, then B and A here.
+  auto on_one_thread = [](auto f) { tbb::task_arena(1).execute(f); };
+  SegmentResult fresh, after;
+  std::thread([&] { on_one_thread([&] { fresh = segment_visibility(s, a0, a1, o); }); }).join();
+  on_one_thread([&] {
+    segment_visibility(s, b0, b1, o);
+    after = segment_visibility(s, a0, a1, o);
+  });
+  ASSERT_EQ(fresh.pieces.size(), after.pieces.size());
+  size_t differ = 0, fan_parts = 0;
+  for (size_t k = 0; k < fresh.pieces.size(); ++k) {
+    const PieceList &u = fresh.pieces[k], &v = after.pieces[k];
+    bool same = u.size() == v.size();
+    for (size_t i = 0; same && i < u.size(); ++i)
+      same = u[i].t0 == v[i].t0 && u[i].t1 == v[i].t1 && u[i].id == v[i].id;
+    differ += !same;
+    // Consecutive parts of one quad's two triangles: a cut at its inner edge.
+    for (size_t i = 0; i + 1 < u.size(); ++i)
+      fan_parts += u[i].t1 == u[i + 1].t0 && u[i].id / 2 == u[i + 1].id / 2;
+  }
+  EXPECT_EQ(differ, 0u) << "pixels whose pieces changed";
+  EXPECT_GT(fan_parts, 0u) << "no fan is cut at an inner edge: the case tests nothing";
+  EXPECT_EQ(fresh.visible, after.visible);
 }
 
 // On a map, whose faces are fans, a surface often meets a face along a line; composited by
