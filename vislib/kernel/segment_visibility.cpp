@@ -312,8 +312,8 @@ class StaticKind {
     double rho[kMaxFanCuts];
   };
   // Slots of the per-thread cache of fans' inner edges (Scratch::fan_edges, 376 KiB): fan p takes
-  // slot p mod kFanEdgeSlots, and one that another fan took since is computed again. Without it,
-  // computing the cuts' coefficients pixel after pixel was about a tenth of a Quake bake's CPU.
+  // slot p mod kFanEdgeSlots, and one that another fan took since is computed again. Computing
+  // the cuts' coefficients pixel after pixel instead took lqdm1's bake 1.22 times the CPU.
   static constexpr size_t kFanEdgeSlots = 1024;
   struct Scratch {
     std::vector<PieceList> lists;
