@@ -15,7 +15,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cassert>
 #include <chrono>
 #include <cmath>
@@ -277,13 +276,6 @@ bool cpu_has_avx2() {
 #endif
 }
 
-// A number for each StaticKind, never 0, so that a thread's cached fan edges (FanEdges) tell
-// their segment apart.
-uint64_t next_kind_serial() {
-  static std::atomic<uint64_t> last{0};
-  return ++last;
-}
-
 // The static triangles of one segment for the tile driver (tile_driver.h): footprint bounds on
 // the faces each triangle can reach, coverage 4 pixels at a time, exact per-pixel depth culling,
 // lists of linear depths.
@@ -305,7 +297,7 @@ class StaticKind {
   // v0, the sign of whose dot product with a pixel ray is the fan's side (sigma).
   static constexpr int kMaxFanCuts = 2 * (kMaxGroupCorners - 3);
   struct FanEdges {
-    uint64_t kind = 0;  // the StaticKind (its serial) and primitive they belong to; 0: none
+    uint64_t segment = 0;  // the StaticKind (its serial) and primitive they belong to; 0: none
     uint32_t p = 0;
     Vec3 n;
     Vec3 KA[kMaxFanCuts], KB[kMaxFanCuts];
@@ -755,7 +747,7 @@ class StaticKind {
   const FanEdges& fan_edges_of(Scratch& sc, uint32_t p) const {
     if (sc.fan_edges.empty()) sc.fan_edges.resize(kFanEdgeSlots);
     FanEdges& fe = sc.fan_edges[p % kFanEdgeSlots];
-    if (fe.kind == serial_ && fe.p == p) return fe;
+    if (fe.segment == serial_ && fe.p == p) return fe;
     Vec3 c[kMaxGroupCorners];
     EdgeRef refs[kMaxGroupCorners];
     const int n = primitive_corners(p, c, refs);
@@ -776,14 +768,14 @@ class StaticKind {
                     fe.rho[cut]);
       }
     }
-    fe.kind = serial_;
+    fe.segment = serial_;
     fe.p = p;
     return fe;
   }
 
   const Scene& scene_;
   Vec3 v0_, v1_;
-  const uint64_t serial_ = next_kind_serial();  // tells this segment's cached fan edges apart
+  const uint64_t serial_ = next_serial();  // tells this segment's cached fan edges apart
   const SegmentOptions& opt_;
   std::vector<PieceList>* pieces_;
   EdgeLines own_lines_;  // built for this call when the caller passes none

@@ -437,11 +437,12 @@ template <class Scratch>
 struct TileWork {
   Scratch sc;
   std::vector<QueueItem> queue;
-  uint64_t over_budget_run = 0;  // the run (next_tile_run) that left it over budget; 0: within
+  uint64_t over_budget_run = 0;  // the run (next_serial) that left it over budget; 0: within
 };
 
-// A number for each run of the tile driver, never 0, so that a thread can tell its runs apart.
-inline uint64_t next_tile_run() {
+// A number unique in the process, never 0: tells the tile driver's runs apart, and the segments
+// whose per-thread caches hold results of theirs (StaticKind's fan edges).
+inline uint64_t next_serial() {
   static std::atomic<uint64_t> last{0};
   return ++last;
 }
@@ -486,7 +487,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
   const size_t count = kind.count();
   using Work = ThreadTileWork<typename Kind::Scratch>;
-  const uint64_t run = next_tile_run();
+  const uint64_t run = next_serial();
   auto take_work = [&kind, TS, run] {
     return Work::take(TS, run, [&] { return kind.make_scratch(TS); });
   };
