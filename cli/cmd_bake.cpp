@@ -69,15 +69,16 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
   if (show_progress())
     std::fprintf(
         stderr,
-        "pvs bake: %u cells (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
+        "pvs bake: %u cell%s (%u baked, %u resumed) in %.2f s (%.3f s kernel per baked cell), "
         "%llu bytes (%.1f per cell) written to %s; %llu from-segment runs, %llu of them served "
-        "by shared edges and long segments; %d threads: %.0f%% in runs, %.0f%% waiting on shared "
+        "by shared edges and long segments; %d thread%s: %.0f%% in runs, %.0f%% waiting on shared "
         "runs, %.0f%% helping other runs, %.0f%% idle, %.2f CPU s\n",
-        r.shard_cells, r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
+        r.shard_cells, r.shard_cells == 1 ? "" : "s", r.baked, r.resumed, r.seconds, r.baked ? kernel / r.baked : 0.0,
         static_cast<unsigned long long>(r.stats.file_bytes),
         r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a.output.c_str(),
         static_cast<unsigned long long>(r.segment_runs_computed + r.segment_runs_shared),
-        static_cast<unsigned long long>(r.segment_runs_shared), r.threads, share(ph.runs.wall),
+        static_cast<unsigned long long>(r.segment_runs_shared), r.threads, r.threads == 1 ? "" : "s",
+        share(ph.runs.wall),
         share(ph.shared_waits.wall), share(ph.helping.wall), share(ph.idle.wall), t.process_cpu);
   pvs_cli::info(fmt::format(
       "bake: {} threads x {:.2f} s = {:.2f} thread-seconds; process CPU {:.2f} s; wall / CPU "
