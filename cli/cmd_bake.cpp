@@ -81,13 +81,13 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
         share(ph.runs.wall),
         share(ph.shared_waits.wall), share(ph.helping.wall), share(ph.idle.wall), t.process_cpu);
   pvs_cli::info(fmt::format(
-      "bake: {} threads x {:.2f} s = {:.2f} thread-seconds; process CPU {:.2f} s; wall / CPU "
+      "bake: {} thread{} x {:.2f} s = {:.2f} thread-seconds; process CPU {:.2f} s; wall / CPU "
       "seconds by phase: runs {:.2f} / {:.2f}, waiting on shared runs {:.2f} / {:.2f}, merge "
       "{:.2f} / {:.2f}, rest of cells {:.2f} / {:.2f}, progress {:.2f} / {:.2f}, checkpoint "
       "{:.2f} / {:.2f}, encode {:.2f} / {:.2f}, write {:.2f} / {:.2f}, helping other runs {:.2f} / "
       "{:.2f}, trees over the runs' bounds {:.2f} / {:.2f}, idle {:.2f} / {:.2f}; "
       "before the cells: BVH {:.2f} / {:.2f}, pilot {:.2f} / {:.2f}",
-      r.threads, r.seconds, r.threads * r.seconds, t.process_cpu, ph.runs.wall, ph.runs.cpu,
+      r.threads, r.threads == 1 ? "" : "s", r.seconds, r.threads * r.seconds, t.process_cpu, ph.runs.wall, ph.runs.cpu,
       ph.shared_waits.wall, ph.shared_waits.cpu, ph.merge.wall, ph.merge.cpu, ph.cell.wall,
       ph.cell.cpu, ph.progress.wall, ph.progress.cpu, ph.checkpoint.wall, ph.checkpoint.cpu,
       ph.encode.wall, ph.encode.cpu, ph.write.wall, ph.write.cpu, ph.helping.wall, ph.helping.cpu,
