@@ -160,9 +160,10 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
           for (const vislib::Segment& s : g)
             distinct.insert(vislib::SegmentRunCache::key_of(s.from, s.to, s.side_normal));
       }
-    std::printf("%u cells (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s", n,
-                kind_name(cells), (n + shard.count - 1 - shard.index) / shard.count, shard.index,
-                shard.count, segments / n, a.runs, cells.segments.empty() ? "" : " (mean)");
+    std::printf("%u cell%s (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s", n,
+                n == 1 ? "" : "s", kind_name(cells),
+                (n + shard.count - 1 - shard.index) / shard.count, shard.index, shard.count,
+                segments / n, a.runs, cells.segments.empty() ? "" : " (mean)");
     if (cells.shared_runs)
       std::printf("; %zu distinct segments in all (a portal's serve both of its leaves)",
                   distinct.size());
@@ -173,8 +174,9 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     std::fprintf(stderr, "pvs bake: no checkpoint %s: starting from the beginning\n",
                  checkpoint.c_str());
   if (show_progress())
-    std::fprintf(stderr, "pvs bake: %u cells (%s), %zu triangles, shard %u/%u\n", n,
-                 kind_name(cells), scene.triangle_count(), shard.index, shard.count);
+    std::fprintf(stderr, "pvs bake: %u cell%s (%s), %zu triangles, shard %u/%u\n", n,
+                 n == 1 ? "" : "s", kind_name(cells), scene.triangle_count(), shard.index,
+                 shard.count);
   const vislib::BakeSettings settings = settings_of(a);
   if (settings.long_segments == 0 && show_progress() &&
       vislib::long_segments_apply(scene, settings))
