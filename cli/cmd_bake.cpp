@@ -73,13 +73,13 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
         "%llu bytes (%.1f per cell) written to %s; %llu from-segment runs, %llu of them served "
         "by shared edges and long segments; %d thread%s: %.0f%% in runs, %.0f%% waiting on shared "
         "runs, %.0f%% helping other runs, %.0f%% idle, %.2f CPU s\n",
-        r.shard_cells, r.shard_cells == 1 ? "" : "s", r.baked, r.resumed, r.seconds,
+        r.shard_cells, plural_s(r.shard_cells), r.baked, r.resumed, r.seconds,
         r.baked ? kernel / r.baked : 0.0, static_cast<unsigned long long>(r.stats.file_bytes),
         r.shard_cells ? double(r.stats.block_bytes) / r.shard_cells : 0.0, a.output.c_str(),
         static_cast<unsigned long long>(r.segment_runs_computed + r.segment_runs_shared),
-        static_cast<unsigned long long>(r.segment_runs_shared), r.threads,
-        r.threads == 1 ? "" : "s", share(ph.runs.wall), share(ph.shared_waits.wall),
-        share(ph.helping.wall), share(ph.idle.wall), t.process_cpu);
+        static_cast<unsigned long long>(r.segment_runs_shared), r.threads, plural_s(r.threads),
+        share(ph.runs.wall), share(ph.shared_waits.wall), share(ph.helping.wall),
+        share(ph.idle.wall), t.process_cpu);
   pvs_cli::info(fmt::format(
       "bake: {} thread{} x {:.2f} s = {:.2f} thread-seconds; process CPU {:.2f} s; wall / CPU "
       "seconds by phase: runs {:.2f} / {:.2f}, waiting on shared runs {:.2f} / {:.2f}, merge "
@@ -87,12 +87,12 @@ void report_bake(const BakeArgs& a, const vislib::BakeRunInfo& info, const visli
       "{:.2f} / {:.2f}, encode {:.2f} / {:.2f}, write {:.2f} / {:.2f}, helping other runs {:.2f} / "
       "{:.2f}, trees over the runs' bounds {:.2f} / {:.2f}, idle {:.2f} / {:.2f}; "
       "before the cells: BVH {:.2f} / {:.2f}, pilot {:.2f} / {:.2f}",
-      r.threads, r.threads == 1 ? "" : "s", r.seconds, r.threads * r.seconds, t.process_cpu,
-      ph.runs.wall, ph.runs.cpu, ph.shared_waits.wall, ph.shared_waits.cpu, ph.merge.wall,
-      ph.merge.cpu, ph.cell.wall, ph.cell.cpu, ph.progress.wall, ph.progress.cpu,
-      ph.checkpoint.wall, ph.checkpoint.cpu, ph.encode.wall, ph.encode.cpu, ph.write.wall,
-      ph.write.cpu, ph.helping.wall, ph.helping.cpu, ph.bound_trees.wall, ph.bound_trees.cpu,
-      ph.idle.wall, ph.idle.cpu, ph.bvh.wall, ph.bvh.cpu, ph.pilot.wall, ph.pilot.cpu));
+      r.threads, plural_s(r.threads), r.seconds, r.threads * r.seconds, t.process_cpu, ph.runs.wall,
+      ph.runs.cpu, ph.shared_waits.wall, ph.shared_waits.cpu, ph.merge.wall, ph.merge.cpu,
+      ph.cell.wall, ph.cell.cpu, ph.progress.wall, ph.progress.cpu, ph.checkpoint.wall,
+      ph.checkpoint.cpu, ph.encode.wall, ph.encode.cpu, ph.write.wall, ph.write.cpu,
+      ph.helping.wall, ph.helping.cpu, ph.bound_trees.wall, ph.bound_trees.cpu, ph.idle.wall,
+      ph.idle.cpu, ph.bvh.wall, ph.bvh.cpu, ph.pilot.wall, ph.pilot.cpu));
   if (a.json_out.empty()) return;
   const std::string text = vislib::bake_report_json(info, r);
   if (a.json_out == "-")
@@ -161,9 +161,9 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
             distinct.insert(vislib::SegmentRunCache::key_of(s.from, s.to, s.side_normal));
       }
     std::printf("%u cell%s (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s", n,
-                n == 1 ? "" : "s", kind_name(cells),
-                (n + shard.count - 1 - shard.index) / shard.count, shard.index, shard.count,
-                segments / n, a.runs, cells.segments.empty() ? "" : " (mean)");
+                plural_s(n), kind_name(cells), (n + shard.count - 1 - shard.index) / shard.count,
+                shard.index, shard.count, segments / n, a.runs,
+                cells.segments.empty() ? "" : " (mean)");
     if (cells.shared_runs)
       std::printf("; %zu distinct segments in all (a portal's serve both of its leaves)",
                   distinct.size());
@@ -174,9 +174,8 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
     std::fprintf(stderr, "pvs bake: no checkpoint %s: starting from the beginning\n",
                  checkpoint.c_str());
   if (show_progress())
-    std::fprintf(stderr, "pvs bake: %u cell%s (%s), %zu triangles, shard %u/%u\n", n,
-                 n == 1 ? "" : "s", kind_name(cells), scene.triangle_count(), shard.index,
-                 shard.count);
+    std::fprintf(stderr, "pvs bake: %u cell%s (%s), %zu triangles, shard %u/%u\n", n, plural_s(n),
+                 kind_name(cells), scene.triangle_count(), shard.index, shard.count);
   const vislib::BakeSettings settings = settings_of(a);
   if (settings.long_segments == 0 && show_progress() &&
       vislib::long_segments_apply(scene, settings))

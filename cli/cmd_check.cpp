@@ -100,7 +100,7 @@ void run_check(CheckArgs a, const CLI::App& cmd) {
     std::printf("%s against %s\n", a.pvs.c_str(), a.scene.c_str());
     std::printf("  cells                %zu\n", r.cells.size());
     std::printf("  sampling             %d eyes a cell, N = %d, %d orientation%s, seed %llu\n",
-                a.samples, bake.resolution, runs, runs == 1 ? "" : "s", (unsigned long long)a.seed);
+                a.samples, bake.resolution, runs, plural_s(runs), (unsigned long long)a.seed);
     std::printf(
         "  eyes                 %llu sampled; %llu draws inside solids redrawn, %llu eyes "
         "given up\n",
@@ -111,8 +111,9 @@ void run_check(CheckArgs a, const CLI::App& cmd) {
                 (unsigned long long)t.ambiguous);
     std::printf(
         "  misses               %llu rays: %zu triangles, %zu (cell, triangle) pairs, in "
-        "%zu cells\n",
-        (unsigned long long)t.miss_rays, t.missed_triangles, t.missed_pairs, t.cells_with_misses);
+        "%zu cell%s\n",
+        (unsigned long long)t.miss_rays, t.missed_triangles, t.missed_pairs, t.cells_with_misses,
+        plural_s(t.cells_with_misses));
     std::vector<const vislib::PvsCheckCell*> worst;
     for (const vislib::PvsCheckCell& c : r.cells)
       if (!c.missed.empty()) worst.push_back(&c);

@@ -17,6 +17,10 @@ void set_verbosity(int level);
 inline bool show_progress() {
   return verbosity() >= 1;
 }
+// The plural ending of a count in the CLI's English: "" for 1, "s" otherwise ("1 cell", "2 cells").
+inline const char* plural_s(unsigned long long n) {
+  return n == 1 ? "" : "s";
+}
 // A line on stderr with -v only.
 void info(const std::string& message);
 
