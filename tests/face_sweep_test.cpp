@@ -152,5 +152,36 @@ TEST(FaceSweep, AdaptiveSweepInsertsChordsWhereTheSetChangesAndFindsASlit) {
   EXPECT_EQ(again, fine);
 }
 
+// The sweep's estimate of what it runs, which the bake's progress and ETA use: exact at both
+// ends of the refine rate (an interval of 128 over a floor of 8 holds 15 positions of the even
+// grid at 8, one when nothing refines), and, over a face where every probe sees a new id, exact
+// from the first round judged on.
+TEST(FaceSweep, AdaptiveSweepEstimatesTheChordsItRunsFromTheRefineRateItSees) {
+  EXPECT_EQ(expected_probes(128, 8, 1.0), 15.0);
+  EXPECT_EQ(expected_probes(128, 8, 0.0), 1.0);
+  EXPECT_EQ(expected_probes(8, 8, 1.0), 0.0);  // not wider than the floor: closed
+  EXPECT_EQ(expected_probes(128, 8, 0.5), 4.0);
+  uint32_t next_id = 10;
+  FakeScene changing{[&](double) { return std::vector<uint32_t>{next_id++}; }, {}};
+  std::vector<std::pair<size_t, double>> told;
+  const AdaptiveSpacing spacing{32, 4};
+  const size_t run = adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, changing.round(),
+                                    [&](size_t r, double expected) {
+                                      told.push_back({r, expected});
+                                    });
+  ASSERT_EQ(told.size(), changing.rounds.size());
+  EXPECT_EQ(told[0].first, 0u);
+  EXPECT_EQ(told[0].second, expected_adaptive_probes({wide()}, spacing, kRefinePrior));
+  // Every probe refined: the even grid at the floor (25 intervals of 4), every round after the
+  // first judged one foreseeing it.
+  EXPECT_EQ(run, 31u);  // 4 intervals of 25 units: 3 coarse chords, 1 + 2 + 4 probes in each
+  EXPECT_EQ(double(run), expected_adaptive_probes({wide()}, spacing, 1.0));
+  for (size_t k = 2; k < told.size(); ++k) EXPECT_EQ(told[k].second, double(run)) << k;
+  // A flat wall: the coarse chords and one probe an interval, foreseen at a refine rate of 0.
+  FakeScene flat{[](double) { return std::vector<uint32_t>{1}; }, {}};
+  EXPECT_EQ(double(adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, flat.round())),
+            expected_adaptive_probes({wide()}, spacing, 0.0));
+}
+
 }  // namespace
 }  // namespace vislib

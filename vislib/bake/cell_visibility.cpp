@@ -103,9 +103,9 @@ RegionOptions cell_options(const ViewCells& cells, uint32_t cell, const RegionOp
 // groups (cell_segment_groups), then, for a cell with adaptive face sweeps (ViewCells::sweeps),
 // the sweep's rounds (face_sweep.h), round r seeded as group (fixed groups + r), whose neighbours
 // at a face's ends see what the fixed groups saw. Ids of spheres count after the triangles in
-// the sweep's comparisons. `progress(fraction)` as in cell_visibility: for an adaptive cell the
-// fraction of the fixed groups and each round is an estimate (the rounds to come are unknown),
-// never decreasing.
+// the sweep's comparisons. `progress(fraction)` as in cell_visibility: the runs done over the
+// runs to do; for an adaptive cell the rounds' runs are an estimate (expected_adaptive_probes,
+// then the sweep's own before each round), and the fraction never decreases.
 void run_cell_groups(const Scene& scene, const ViewCells* cells,
                      const std::vector<std::vector<Segment>>& groups, uint32_t cell,
                      const RegionOptions& options, const std::function<void(double)>& progress,
@@ -114,11 +114,16 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   const bool adaptive = cells && !cells->sweeps.empty() && !cells->sweeps.at(cell).empty();
   const uint64_t seed = cell_seed(options.seed, cell);
   const size_t fixed = groups.size();
-  // The share of the progress bar the fixed groups take when rounds follow, and each round's
-  // share of what is left (an estimate: rounds shrink as intervals close).
-  constexpr double kFixedShare = 0.5, kRoundShare = 0.5;
-  double done_before = 0;
-  double share = (adaptive ? kFixedShare : 1.0) / double(std::max<size_t>(1, fixed));
+  // Progress: runs done over runs to do, the rounds' an estimate (set below).
+  double runs_before = 0, runs_total = 0, shown = 0;
+  for (const std::vector<Segment>& g : groups)
+    runs_total += double(g.size() * size_t(options.runs));
+  const double fixed_runs = runs_total;
+  auto report = [&](double runs_in_group) {
+    const double fraction = (runs_before + runs_in_group) / std::max(1.0, runs_total);
+    shown = std::max(shown, std::min(1.0, fraction));
+    progress(shown);
+  };
   bool wanted = true;
   // Trees over the bounds of the cell's runs (ViewCells::bound_leaves), each built once.
   const bool bounded = cells && !cells->segment_bound.empty();
@@ -157,12 +162,9 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     o.segment_users = std::move(users);
     o.segment_bvhs = std::move(bvhs);
     std::function<void(size_t, size_t)> run_done;
-    if (progress)
-      run_done = [&](size_t done, size_t total) {
-        progress(done_before + share * double(done) / double(std::max<size_t>(1, total)));
-      };
+    if (progress) run_done = [&](size_t done, size_t) { report(double(done)); };
     RegionResult rr = segments_visibility(scene, segs, o, run_done);
-    done_before += share;
+    runs_before += double(segs.size() * size_t(o.runs));
     wanted = consume(segs, rr, o) && wanted;
     return rr;
   };
@@ -179,6 +181,9 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   // first's runs from the cache (sweep_family_key, SegmentRunCache::expect_family).
   static const std::vector<FaceSweep> kNoSweeps;
   const std::vector<FaceSweep>& sweeps = adaptive ? cells->sweeps[cell] : kNoSweeps;
+  if (adaptive)
+    runs_total +=
+        expected_adaptive_probes(sweeps, cells->sweep_spacing, kRefinePrior) * double(options.runs);
   std::vector<std::vector<uint32_t>> bases(sweeps.size());
   std::vector<uint32_t> users(sweeps.size(), 0);
   bool any_sided = false;
@@ -242,25 +247,25 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   for (size_t f = 0; f < sweeps.size(); ++f)
     if (sweeps[f].side_normal == Vec3{0, 0, 0}) bases[f] = base;
   size_t round = 0;
-  adaptive_sweep(sweeps, cells->sweep_spacing, bases, kSweepMinChord,
-                 [&](const std::vector<Segment>& segs, const std::vector<size_t>& sweep_of) {
-                   share = (1.0 - done_before) * kRoundShare;
-                   std::vector<uint32_t> segment_users(segs.size());
-                   for (size_t i = 0; i < segs.size(); ++i) segment_users[i] = users[sweep_of[i]];
-                   const std::vector<const TriangleBvh*> bvhs = trees_of(
-                       segs, [&](size_t i) { return cells->sweep_bound.at(cell)[sweep_of[i]]; });
-                   const RegionResult rr =
-                       run_group(segs, fixed + round++, std::move(segment_users), bvhs);
-                   std::vector<std::vector<uint32_t>> seen(segs.size());
-                   for (const RunRecord& r : judging(segs, rr, bvhs)) {
-                     const Segment& s = segs.at(r.segment);
-                     if (s.side_normal == Vec3{0, 0, 0})
-                       ids_of_run(r, seen[r.segment]);
-                     else if (r.run == 0)
-                       both_sides(r, s.side, seen[r.segment]);
-                   }
-                   return seen;
-                 });
+  adaptive_sweep(
+      sweeps, cells->sweep_spacing, bases, kSweepMinChord,
+      [&](const std::vector<Segment>& segs, const std::vector<size_t>& sweep_of) {
+        std::vector<uint32_t> segment_users(segs.size());
+        for (size_t i = 0; i < segs.size(); ++i) segment_users[i] = users[sweep_of[i]];
+        const std::vector<const TriangleBvh*> bvhs =
+            trees_of(segs, [&](size_t i) { return cells->sweep_bound.at(cell)[sweep_of[i]]; });
+        const RegionResult rr = run_group(segs, fixed + round++, std::move(segment_users), bvhs);
+        std::vector<std::vector<uint32_t>> seen(segs.size());
+        for (const RunRecord& r : judging(segs, rr, bvhs)) {
+          const Segment& s = segs.at(r.segment);
+          if (s.side_normal == Vec3{0, 0, 0})
+            ids_of_run(r, seen[r.segment]);
+          else if (r.run == 0)
+            both_sides(r, s.side, seen[r.segment]);
+        }
+        return seen;
+      },
+      [&](size_t, double expected) { runs_total = fixed_runs + expected * double(options.runs); });
 }
 
 // The middle of the points q - s d (s >= 0) inside `region`, if any.

@@ -106,9 +106,32 @@ std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double 
   return out;
 }
 
+double expected_probes(double width, double floor, double refine) {
+  assert(floor > 0 && refine >= 0 && refine <= 1);
+  // One probe a level, the children's share 2 refine a level down, while the halves are wider
+  // than the floor (as adaptive_sweep inserts them).
+  double expected = 0, weight = 1;
+  for (double w = width; w > floor; w *= 0.5) {
+    expected += weight;
+    weight *= 2 * refine;
+  }
+  return expected;
+}
+
+double expected_adaptive_probes(const std::vector<FaceSweep>& sweeps,
+                                const AdaptiveSpacing& spacing, double refine) {
+  double expected = 0;
+  for (const FaceSweep& f : sweeps) {
+    const int steps = even_steps(f, spacing.coarse);
+    const double width = (f.hi - f.lo) / double(steps);
+    expected += double(steps - 1) + double(steps) * expected_probes(width, spacing.floor, refine);
+  }
+  return expected;
+}
+
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
                       const std::vector<std::vector<uint32_t>>& bases, double min_length,
-                      const ChordRound& run_round) {
+                      const ChordRound& run_round, const SweepEstimate& estimate) {
   assert(spacing.floor > 0 && spacing.floor <= spacing.coarse);
   assert(bases.size() == sweeps.size());
   // Every position's set, by index (f < sweeps.size(): face f's base, what its extreme positions
@@ -159,6 +182,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     }
     return index;
   };
+  if (estimate) estimate(0, expected_adaptive_probes(sweeps, spacing, kRefinePrior));
   {
     const std::vector<size_t> index = run_probes();
     size_t p = 0;
@@ -170,10 +194,17 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
           open.push_back({f, grid[f][k], grid[f][k + 1], at[k], at[k + 1]});
     }
   }
+  double refine = kRefinePrior;  // the share of the last round's probes that saw a new id
   while (!open.empty()) {
     probes.clear();
     for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b)});
+    if (estimate) {
+      double expected = double(run);
+      for (const Interval& i : open) expected += expected_probes(i.b - i.a, spacing.floor, refine);
+      estimate(run, expected);
+    }
     const std::vector<size_t> index = run_probes();
+    size_t refined = 0;
     std::vector<Interval> next;
     std::vector<uint32_t> both;
     for (size_t k = 0; k < open.size(); ++k) {
@@ -184,11 +215,13 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
                      sets[i.set_b].end(), std::back_inserter(both));
       const std::vector<uint32_t>& s = sets[index[k]];
       if (std::includes(both.begin(), both.end(), s.begin(), s.end())) continue;
+      ++refined;
       if (m - i.a > spacing.floor) {
         next.push_back({i.face, i.a, m, i.set_a, index[k]});
         next.push_back({i.face, m, i.b, index[k], i.set_b});
       }
     }
+    refine = double(refined) / double(open.size());
     open = std::move(next);
   }
   return run;

@@ -81,6 +81,27 @@ struct AdaptiveSpacing {
 using ChordRound = std::function<std::vector<std::vector<uint32_t>>(
     const std::vector<Segment>& chords, const std::vector<size_t>& sweep_of)>;
 
+// What an adaptive sweep is expected to run, for progress and its ETA only (the chords run do
+// not depend on it). An open interval of width `width` gets one probe and, with probability
+// `refine` (in [0, 1]: the share of probes that see a new id), its two halves, each probed in
+// turn while wider than `floor` (> 0). Positions, not runs: a chord too short to run counts too.
+double expected_probes(double width, double floor, double refine);
+
+// The refine rate assumed before any probe has been judged: open leaves refine nearly every
+// probe, flat walls almost none.
+constexpr double kRefinePrior = 0.5;
+
+// The positions adaptive_sweep(sweeps, spacing, ...) is expected to probe in all, with every
+// interval refined at rate `refine`: the coarse grid's, then expected_probes of each coarse
+// interval wider than the floor.
+double expected_adaptive_probes(const std::vector<FaceSweep>& sweeps,
+                                const AdaptiveSpacing& spacing, double refine);
+
+// Told before each round: the chords run so far and the positions expected in all (those run,
+// this round's, and the later rounds' at the refine rate of the last round judged, or
+// kRefinePrior before round 1 is judged).
+using SweepEstimate = std::function<void(size_t run, double expected)>;
+
 // Runs the adaptive sweep of `sweeps` together, round by round: round 0 holds every face's even
 // chords at `spacing.coarse`, round r + 1 the midpoints of the intervals that round r (or, for
 // round 1, the coarse grid with its ends) left open. `bases[f]` (sorted; one per sweep) is what
@@ -89,6 +110,6 @@ using ChordRound = std::function<std::vector<std::vector<uint32_t>>(
 // order, then increasing position. Returns the number of chords run.
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
                       const std::vector<std::vector<uint32_t>>& bases, double min_length,
-                      const ChordRound& run_round);
+                      const ChordRound& run_round, const SweepEstimate& estimate = {});
 
 }  // namespace vislib
