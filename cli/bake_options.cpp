@@ -193,7 +193,7 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
     for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
-                          "--chord-floor", "--chord-piece", "--sweep", "--bound"})
+                          "--chord-floor", "--chord-piece", "--chord-tiles", "--sweep", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -231,7 +231,7 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
           portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
       const vislib::AdaptiveSpacing chords{a.chord_coarse.value_or(d.coarse),
                                            a.chord_floor.value_or(d.floor),
-                                           a.chord_piece.value_or(d.piece)};
+                                           a.chord_piece.value_or(d.piece), a.chord_tiles == "new"};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
       o.adaptive = chords;
@@ -366,6 +366,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "along its chords, each refined on its own (Quake units; 0 = whole chords; "
                   "default 128 with --sweep portals, 0 with faces)")
       ->check(in_range(0.0, 1e6));
+  cmd->add_option("--chord-tiles", a.chord_tiles,
+                  "bsp-leaves, adaptive: 'all' (every chord computes its whole cube) or 'new' "
+                  "(a chord inserted because its parent saw new ids computes only the cube tiles "
+                  "where those can appear, one tile around; docs/quake.md)")
+      ->check(CLI::IsMember({"all", "new"}))
+      ->capture_default_str();
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

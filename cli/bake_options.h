@@ -47,6 +47,7 @@ struct BakeArgs {
   // --chord-coarse, --chord-floor, --chord-piece (adaptive); unset: kBspPortalChords with --sweep
   // portals, else AdaptiveSpacing's defaults.
   std::optional<double> chord_coarse, chord_floor, chord_piece;
+  std::string chord_tiles = "all";  // --chord-tiles all|new (adaptive): AdaptiveSpacing::toward_new
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)

@@ -37,8 +37,14 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     const nlohmann::json piece = find_key(md, "chord_piece");  // absent: whole chords
     if (!piece.is_null() && !(piece.is_number() && piece.get<double>() >= 0))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_piece");
-    co.adaptive = vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>(),
-                                          piece.is_null() ? 0.0 : piece.get<double>()};
+    const nlohmann::json tiles = find_key(md, "chord_tiles");  // absent: all
+    if (!tiles.is_null() && !(tiles == "all" || tiles == "new"))
+      throw vislib::InputError(pvs, "metadata holds an invalid chord_tiles (all or new)");
+    if (tiles == "new" && find_key(md, "chord_tile_margin") != vislib::kChordTileMargin)
+      throw vislib::InputError(pvs, "metadata holds a chord_tile_margin this build cannot re-run");
+    co.adaptive =
+        vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>(),
+                                piece.is_null() ? 0.0 : piece.get<double>(), tiles == "new"};
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

@@ -5,8 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <set>
+
+#include "tests/scene_builders.h"
+#include "vislib/base/cubemap.h"
 
 namespace vislib {
 namespace {
@@ -91,17 +96,23 @@ double position(const Segment& s) {
   return s.from.x;
 }
 
-// A fake round: what a chord at x sees is `see(x)`; records every position run, by round.
+// A fake round: what a chord at x sees is `see(x)`; records every position run, by round, and
+// the new ids of its parent that the sweep handed it.
 struct FakeScene {
   std::function<std::vector<uint32_t>(double)> see;
   std::vector<std::vector<double>> rounds;
+  std::map<double, std::vector<uint32_t>> fresh_at;
   ChordRound round() {
-    return [this](const std::vector<Segment>& chords, const std::vector<size_t>&) {
+    return [this](const std::vector<Segment>& chords, const std::vector<size_t>&,
+                  const std::vector<std::vector<uint32_t>>& fresh) {
+      EXPECT_EQ(fresh.size(), chords.size());
       rounds.emplace_back();
       std::vector<std::vector<uint32_t>> out;
-      for (const Segment& c : chords) {
-        rounds.back().push_back(position(c));
-        out.push_back(see(position(c)));
+      for (size_t i = 0; i < chords.size(); ++i) {
+        const double x = position(chords[i]);
+        rounds.back().push_back(x);
+        fresh_at[x] = fresh.at(i);
+        out.push_back(see(x));
       }
       return out;
     };
@@ -111,7 +122,7 @@ struct FakeScene {
 // Over a flat wall (every chord sees what the edges see) the sweep runs the coarse chords and one
 // probe between each two neighbours, and stops: far fewer than an even sweep at the floor.
 TEST(FaceSweep, AdaptiveSweepOverAFlatWallStopsAfterTheFirstProbes) {
-  FakeScene flat{[](double) { return std::vector<uint32_t>{1, 2}; }, {}};
+  FakeScene flat{[](double) { return std::vector<uint32_t>{1, 2}; }, {}, {}};
   const size_t run = adaptive_sweep({wide()}, {32, 4}, {{1, 2}}, kSweepMinChord, flat.round());
   ASSERT_EQ(flat.rounds.size(), 2u);
   EXPECT_EQ(flat.rounds[0].size(), 3u);  // ceil(100 / 32) = 4 intervals: 3 coarse chords
@@ -132,7 +143,7 @@ TEST(FaceSweep, AdaptiveSweepInsertsChordsWhereTheSetChangesAndFindsASlit) {
     return ids;
   };
   auto found_slit = [&](const AdaptiveSpacing& spacing, size_t* runs) {
-    FakeScene scene{see, {}};
+    FakeScene scene{see, {}, {}};
     *runs = adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, scene.round());
     std::set<double> all;
     for (const auto& r : scene.rounds) all.insert(r.begin(), r.end());
@@ -152,6 +163,103 @@ TEST(FaceSweep, AdaptiveSweepInsertsChordsWhereTheSetChangesAndFindsASlit) {
   EXPECT_EQ(again, fine);
 }
 
+// Each chord is handed what made the sweep insert it: the ids its parent probe saw that neither
+// of the parent's neighbours saw (the caller may look only toward them). The coarse chords and the
+// first probes between them have no parent; a slit's id 2, seen from 44.5 < x < 45.5 only, reaches
+// the chords inserted on both sides of the probe that saw it.
+TEST(FaceSweep, AdaptiveSweepHandsEachInsertedChordItsParentsNewIds) {
+  auto see = [](double x) {
+    std::vector<uint32_t> ids = {1};
+    if (x > 20 && x < 60) ids.push_back(100 + uint32_t(std::lround(x)));
+    if (x > 44.5 && x < 45.5) ids.push_back(2);
+    std::sort(ids.begin(), ids.end());  // a round's sets are sorted
+    return ids;
+  };
+  FakeScene scene{see, {}, {}};
+  adaptive_sweep({wide()}, {64, 1}, {{1}}, kSweepMinChord, scene.round());
+  ASSERT_GE(scene.rounds.size(), 3u);
+  for (size_t r = 0; r < 2; ++r)
+    for (double x : scene.rounds[r]) EXPECT_TRUE(scene.fresh_at.at(x).empty()) << x;
+  size_t with_slit = 0;
+  for (size_t r = 2; r < scene.rounds.size(); ++r)
+    for (double x : scene.rounds[r]) {
+      const std::vector<uint32_t>& f = scene.fresh_at.at(x);
+      EXPECT_FALSE(f.empty()) << x;  // only refined intervals are probed again
+      EXPECT_TRUE(std::find(f.begin(), f.end(), 1u) == f.end()) << x;  // the base: never new
+      EXPECT_TRUE(std::is_sorted(f.begin(), f.end()));
+      if (std::find(f.begin(), f.end(), 2u) != f.end()) {
+        ++with_slit;
+        EXPECT_GT(x, 44.5 - 2) << "a child of the probe that saw the slit lies beside it";
+        EXPECT_LT(x, 45.5 + 2);
+      }
+    }
+  EXPECT_GE(with_slit, 2u);
+}
+
+// The tiles toward some triangles hold every pixel where one of them can appear from an eye of
+// the chord (sampled: eyes along it, points of the triangles), and a run on those tiles sees
+// every one of them that the whole run sees; the whole cube (none) where a triangle is not in
+// front of one face from both ends.
+TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
+  const Scene s = vislib_test::random_soup(400, 5);
+  const Segment chord{{-1, 0, 0}, {1, 0.5, 0.3}};
+  const int n = 64, ts = 8, tiles = tiles_per_side(n, ts);
+  Rng rng(11);
+  size_t masked = 0, whole = 0, flagged = 0;
+  for (uint32_t t = 0; t < s.triangle_count(); ++t) {
+    const auto m = chord_tiles_toward(s, 0, chord, {t}, n, ts, 0);
+    if (!m) {
+      ++whole;
+      continue;
+    }
+    ++masked;
+    ASSERT_EQ(m->size(), size_t(6 * tiles * tiles));
+    flagged += size_t(std::count(m->begin(), m->end(), 1));
+    const auto c = s.corners(t);
+    for (int k = 0; k < 50; ++k) {
+      const Vec3 eye = chord.from + (chord.to - chord.from) * rng.uniform();
+      double u = rng.uniform(), v = rng.uniform();
+      if (u + v > 1) u = 1 - u, v = 1 - v;
+      const Vec3 d = c[0] + (c[1] - c[0]) * u + (c[2] - c[0]) * v - eye;
+      int f = 0;
+      for (int g = 1; g < 6; ++g)
+        if (dot(d, face_axes(g, Mat3{}).F) > dot(d, face_axes(f, Mat3{}).F)) f = g;
+      const FaceAxes a = face_axes(f, Mat3{});
+      const double depth = dot(d, a.F);
+      const int x =
+          std::clamp(int(std::floor(pixel_coord(dot(d, a.S) / depth, n) + 0.5)), 0, n - 1);
+      const int y =
+          std::clamp(int(std::floor(pixel_coord(dot(d, a.T) / depth, n) + 0.5)), 0, n - 1);
+      ASSERT_TRUE(
+          (*m)[(size_t(f) * size_t(tiles) + size_t(y / ts)) * size_t(tiles) + size_t(x / ts)])
+          << "triangle " << t << " face " << f << " pixel " << x << "," << y;
+    }
+  }
+  EXPECT_GT(masked, 150u);  // of 400: the others cross a face's edge seen from the chord
+  EXPECT_GT(whole, 0u);     // near the chord, across two faces
+  EXPECT_LT(flagged, masked * size_t(6 * tiles * tiles) / 10);  // a small part of the cube
+  EXPECT_FALSE(chord_tiles_toward(s, 0, chord, {}, n, ts, 0).has_value());
+
+  // A run on the tiles toward 30 triangles sees each of them that the whole run sees.
+  std::vector<uint32_t> some;
+  for (uint32_t t = 0; t < s.triangle_count() && some.size() < 30; t += 7)
+    if (chord_tiles_toward(s, 0, chord, {t}, n, ts, 0)) some.push_back(t);
+  SegmentOptions o;
+  o.resolution = n;
+  o.tile_size = ts;
+  const SegmentResult all = segment_visibility(s, chord.from, chord.to, o);
+  o.tile_mask = *chord_tiles_toward(s, 0, chord, some, n, ts, 0);
+  const SegmentResult toward = segment_visibility(s, chord.from, chord.to, o);
+  std::vector<uint32_t> in_all, in_toward;
+  std::set_intersection(all.visible.begin(), all.visible.end(), some.begin(), some.end(),
+                        std::back_inserter(in_all));
+  std::set_intersection(toward.visible.begin(), toward.visible.end(), some.begin(), some.end(),
+                        std::back_inserter(in_toward));
+  EXPECT_GT(in_all.size(), 5u);
+  EXPECT_EQ(in_toward, in_all);
+  EXPECT_LT(toward.visible.size(), all.visible.size());
+}
+
 // The sweep's estimate of what it runs, which the bake's progress and ETA use: exact at both
 // ends of the refine rate (an interval of 128 over a floor of 8 holds 15 positions of the even
 // grid at 8, one when nothing refines), and, over a face where every probe sees a new id, exact
@@ -162,7 +270,7 @@ TEST(FaceSweep, AdaptiveSweepEstimatesTheChordsItRunsFromTheRefineRateItSees) {
   EXPECT_EQ(expected_probes(8, 8, 1.0), 0.0);  // not wider than the floor: closed
   EXPECT_EQ(expected_probes(128, 8, 0.5), 4.0);
   uint32_t next_id = 10;
-  FakeScene changing{[&](double) { return std::vector<uint32_t>{next_id++}; }, {}};
+  FakeScene changing{[&](double) { return std::vector<uint32_t>{next_id++}; }, {}, {}};
   std::vector<std::pair<size_t, double>> told;
   const AdaptiveSpacing spacing{32, 4};
   const size_t run = adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, changing.round(),
@@ -178,7 +286,7 @@ TEST(FaceSweep, AdaptiveSweepEstimatesTheChordsItRunsFromTheRefineRateItSees) {
   EXPECT_EQ(double(run), expected_adaptive_probes({wide()}, spacing, 1.0));
   for (size_t k = 2; k < told.size(); ++k) EXPECT_EQ(told[k].second, double(run)) << k;
   // A flat wall: the coarse chords and one probe an interval, foreseen at a refine rate of 0.
-  FakeScene flat{[](double) { return std::vector<uint32_t>{1}; }, {}};
+  FakeScene flat{[](double) { return std::vector<uint32_t>{1}; }, {}, {}};
   EXPECT_EQ(double(adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, flat.round())),
             expected_adaptive_probes({wide()}, spacing, 0.0));
 }

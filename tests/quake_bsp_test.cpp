@@ -1260,16 +1260,17 @@ TEST(QuakeBake, AdaptivePortalSweepInsertsTheSameChordsForBothLeavesAndRunsEachO
   const std::string path = write_map(dir, "tiny.bsp", encode_bsp(tiny_map()));
   const Scene scene = load(path, BspModels::world, BspLiquids::see_through);
   const QuakeBsp m = read_quake_bsp(path);
-  for (double piece : {0.0, 16.0}) {
+  for (double piece : {0.0, 16.0, -1.0}) {
     SCOPED_TRACE(piece);
     BspCellOptions o;
     o.scene.bsp_liquids = BspLiquids::see_through;
     o.sweep = BspSweep::Portals;
-    o.adaptive = AdaptiveSpacing{32, 2, piece};
+    // -1: whole chords, each inserted chord looking only toward its parent's new ids.
+    o.adaptive = AdaptiveSpacing{32, 2, std::max(piece, 0.0), piece < 0};
     const ViewCells cells = bsp_leaf_cells(m, o, &scene);
     ASSERT_EQ(cells.sweeps.size(), 2u);
     ASSERT_EQ(cells.sweeps[0].size(), cells.sweeps[1].size());
-    if (piece == 0) {
+    if (piece <= 0) {
       ASSERT_EQ(cells.sweeps[0].size(), 1u);
     } else {
       ASSERT_GT(cells.sweeps[0].size(), 1u);
@@ -1282,8 +1283,9 @@ TEST(QuakeBake, AdaptivePortalSweepInsertsTheSameChordsForBothLeavesAndRunsEachO
     EXPECT_EQ(families.size(), cells.sweeps[0].size());
     BakeSettings s;
     s.region.segment.resolution = 32;
-    const TwoLeafBake baked = bake_two_leaves(
-        scene, cells, s, temp_dir("quake_bake_adaptive_portals_p" + std::to_string(int(piece))));
+    const TwoLeafBake baked =
+        bake_two_leaves(scene, cells, s,
+                        temp_dir("quake_bake_adaptive_portals_p" + std::to_string(int(piece + 1))));
     // More than the polygon's edges: the sweep ran chords, and each was computed once.
     EXPECT_GT(baked.report.segment_runs_shared, cells.segments[0].size());
     EXPECT_EQ(baked.report.segment_runs_computed, baked.report.segment_runs_shared);
@@ -1340,6 +1342,11 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_EQ(c["chord_coarse"], kBspPortalChords.coarse);
   EXPECT_EQ(c["chord_floor"], kBspPortalChords.floor);
   EXPECT_EQ(c["chord_piece"], kBspPortalChords.piece);
+  EXPECT_EQ(c["chord_tiles"], "all");
+  EXPECT_FALSE(c.contains("chord_tile_margin"));
+  c = cells_of("--chord-tiles new");
+  EXPECT_EQ(c["chord_tiles"], "new");
+  EXPECT_EQ(c["chord_tile_margin"], kChordTileMargin);
   c = cells_of("--face-sweep even");
   EXPECT_EQ(c["face_sweep"], "even");
   EXPECT_FALSE(c.contains("chord_coarse"));
@@ -1390,13 +1397,13 @@ namespace {
 // holds each cell's set against rays from random points of its region (ray_misses). Prints the
 // bake's seconds, the cells, the mean set size and the misses.
 void bake_lqdm1_and_cast(const std::string& path, const std::string& leaves, size_t cells_expected,
-                         int eyes, int dirs) {
+                         int eyes, int dirs, const std::string& options = "") {
   const std::string dir = temp_dir("quake_bake_lqdm1");
   const std::string out_pvs = dir + "/lqdm1.pvs";
   std::string out;
   const auto t0 = std::chrono::steady_clock::now();
   ASSERT_EQ(run_pvs("bake -q " + path + " --cells bsp-leaves --res 128 -j 2 -o " + out_pvs +
-                        (leaves.empty() ? "" : " --leaves " + leaves),
+                        (leaves.empty() ? "" : " --leaves " + leaves) + options,
                     &out),
             0)
       << out;
@@ -1422,11 +1429,11 @@ void bake_lqdm1_and_cast(const std::string& path, const std::string& leaves, siz
   size_t rays = 0;
   const auto misses = ray_misses(scene, m, cells, r, eyes, dirs, 3604, &rays);
   std::printf(
-      "lqdm1 leaves %s: %u cells baked in %.1f s (CLI, --res 128 -j 2; budget 90 s for leaves 1-4 "
-      "on the 2-core host), mean set %.1f of %zu "
+      "lqdm1 leaves %s%s: %u cells baked in %.1f s (CLI, --res 128 -j 2; budget 90 s for leaves "
+      "1-4 on the 2-core host), mean set %.1f of %zu "
       "triangles; %zu rays from random points of the regions, %zu hits not in the set\n",
-      leaves.empty() ? "all" : leaves.c_str(), r.cell_count(), seconds, total / r.cell_count(),
-      scene.triangle_count(), rays, misses.size());
+      leaves.empty() ? "all" : leaves.c_str(), options.c_str(), r.cell_count(), seconds,
+      total / r.cell_count(), scene.triangle_count(), rays, misses.size());
   // A sampled check with a failure-rate threshold: the faces are swept at kBspFaceSpacing, so a
   // triangle seen only between two chords can be missed (docs/quake.md measures how often).
   EXPECT_LE(misses.size(), rays / 1000);
@@ -1443,6 +1450,15 @@ TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourBakeThroughTheCliAndHoldTheirRays)
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256);
+}
+
+// The same with refinement chords that compute only the cube tiles toward the ids that made
+// them (--chord-tiles new): the sets hold the rays as well. Time budget:
+// 15 s wall on the 2-core host (the bake about 3 s).
+TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourWithChordsTowardNewIdsHoldTheirRays) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256, " --chord-tiles new");
 }
 
 // --leaves picks the listed leaves of a real map: every 10th from 1 to 40, and 3.

@@ -423,3 +423,60 @@ TEST(SegmentVisibility, DirectionSidesHoldWhatThePixelsOfEachSideOfThePlaneSee) 
   bad.splits = {0.5};
   EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
 }
+
+// A tile mask computes the flagged tiles' pixels only, each as the whole run does: two
+// complementary masks give the whole run's pixel lists between them and its set as their union,
+// and a mask of every tile is the whole run. The bake's refinement chords rely on this to look
+// only toward the ids that made them.
+TEST(SegmentVisibility, ATileMaskComputesExactlyTheWholeRunsPixelsInItsTiles) {
+  const Scene s = random_soup(600, 17);
+  SegmentOptions o;
+  o.resolution = 64;
+  o.tile_size = 16;
+  o.want_pieces = true;
+  const Vec3 a{-1, 0.5, 0}, b{1.5, -0.5, 1};
+  const SegmentResult whole = segment_visibility(s, a, b, o);
+  const int tiles = tiles_per_side(o.resolution, o.tile_size);
+  std::vector<uint8_t> even(size_t(6 * tiles * tiles)), odd(even.size());
+  for (size_t i = 0; i < even.size(); ++i) {
+    even[i] = uint8_t((i + i / size_t(tiles)) % 2 == 0);  // a checkerboard on every face
+    odd[i] = uint8_t(1 - even[i]);
+  }
+  o.tile_mask = even;
+  const SegmentResult r0 = segment_visibility(s, a, b, o);
+  o.tile_mask = odd;
+  const SegmentResult r1 = segment_visibility(s, a, b, o);
+  const int n = o.resolution;
+  size_t compared = 0;
+  for (int f = 0; f < 6; ++f)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const size_t k = (size_t(f) * size_t(n) + size_t(y)) * size_t(n) + size_t(x);
+        const bool in_even =
+            even[(size_t(f) * size_t(tiles) + size_t(y / o.tile_size)) * size_t(tiles) +
+                 size_t(x / o.tile_size)] != 0;
+        const std::vector<PieceList>& masked = in_even ? r0.pieces : r1.pieces;
+        const std::vector<PieceList>& other = in_even ? r1.pieces : r0.pieces;
+        ASSERT_TRUE(other[k].empty()) << "a pixel outside the mask was computed";
+        ASSERT_EQ(masked[k].size(), whole.pieces[k].size());
+        for (size_t i = 0; i < masked[k].size(); ++i) {
+          EXPECT_EQ(masked[k][i].id, whole.pieces[k][i].id);
+          EXPECT_EQ(masked[k][i].t0, whole.pieces[k][i].t0);
+          EXPECT_EQ(masked[k][i].t1, whole.pieces[k][i].t1);
+        }
+        compared += masked[k].size();
+      }
+  EXPECT_GT(compared, 1000u);
+  std::vector<uint32_t> both;
+  std::set_union(r0.visible.begin(), r0.visible.end(), r1.visible.begin(), r1.visible.end(),
+                 std::back_inserter(both));
+  EXPECT_EQ(both, whole.visible);
+  EXPECT_LT(r0.visible.size(), whole.visible.size());
+  EXPECT_LT(r0.stats.pair_tests, whole.stats.pair_tests);
+  o.tile_mask.assign(even.size(), 1);
+  EXPECT_EQ(segment_visibility(s, a, b, o).visible, whole.visible);
+  o.tile_mask.assign(even.size(), 0);
+  EXPECT_TRUE(segment_visibility(s, a, b, o).visible.empty());
+  o.tile_mask.resize(even.size() - 1);
+  EXPECT_THROW(segment_visibility(s, a, b, o), std::invalid_argument);
+}

@@ -157,10 +157,12 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     return out;
   };
   auto run_group = [&](const std::vector<Segment>& segs, size_t g, std::vector<uint32_t> users,
-                       std::vector<const TriangleBvh*> bvhs) {
+                       std::vector<const TriangleBvh*> bvhs,
+                       std::vector<std::vector<uint8_t>> masks = {}) {
     RegionOptions o = group_options(options, seed, g);
     o.segment_users = std::move(users);
     o.segment_bvhs = std::move(bvhs);
+    o.segment_tile_masks = std::move(masks);
     std::function<void(size_t, size_t)> run_done;
     if (progress) run_done = [&](size_t done, size_t) { report(double(done)); };
     RegionResult rr = segments_visibility(scene, segs, o, run_done);
@@ -203,16 +205,19 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     out = std::move(merged);
   };
   // The runs that judge: `rr`, or with witnesses (whose sided runs keep their own side only) run 0
-  // of `segs` again without them.
+  // of `segs` again without them (on the same tiles).
   std::vector<RunRecord> rerun;
-  auto judging = [&](const std::vector<Segment>& segs, const RegionResult& rr,
-                     const std::vector<const TriangleBvh*>& bvhs) -> const std::vector<RunRecord>& {
+  auto judging =
+      [&](const std::vector<Segment>& segs, const RegionResult& rr,
+          const std::vector<const TriangleBvh*>& bvhs,
+          const std::vector<std::vector<uint8_t>>& masks = {}) -> const std::vector<RunRecord>& {
     if (!(any_sided && options.segment.want_witnesses)) return rr.runs;
     RegionOptions o = options;
     o.segment.want_witnesses = false;
     o.runs = 1;
     o.shared_runs = nullptr;
     o.segment_bvhs = bvhs;
+    o.segment_tile_masks = masks;
     rerun = segments_visibility(scene, segs, o).runs;
     return rerun;
   };
@@ -246,17 +251,47 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   if (!adaptive) return;
   for (size_t f = 0; f < sweeps.size(); ++f)
     if (sweeps[f].side_normal == Vec3{0, 0, 0}) bases[f] = base;
+  // A chord below a probe that saw new ids looks only toward them (AdaptiveSpacing::toward_new):
+  // the tiles of its run 0 where they can appear (chord_tiles_toward), a sided run's ids of
+  // either side being triangles; the whole cube when one is a sphere.
+  const bool toward_new =
+      cells && cells->sweep_spacing.toward_new && scene.sphere_count() == 0 && !scene.is_dynamic();
+  auto tiles_toward = [&](const std::vector<Segment>& segs,
+                          const std::vector<std::vector<uint32_t>>& fresh) {
+    std::vector<std::vector<uint8_t>> masks;
+    if (!toward_new) return masks;
+    masks.resize(segs.size());
+    bool any = false;
+    std::vector<uint32_t> tri;
+    for (size_t i = 0; i < segs.size(); ++i) {
+      tri.clear();
+      for (uint32_t id : fresh[i]) tri.push_back(id >= ids ? id - ids : id);
+      if (std::any_of(tri.begin(), tri.end(), [&](uint32_t t) { return t >= tris; })) continue;
+      std::optional<std::vector<uint8_t>> m = chord_tiles_toward(
+          scene, options.segment.state, segs[i], tri, options.segment.resolution,
+          options.segment.tile_size > 0 ? options.segment.tile_size : kStaticTileSize,
+          kChordTileMargin);
+      if (!m) continue;
+      masks[i] = std::move(*m);
+      any = true;
+    }
+    if (!any) masks.clear();
+    return masks;
+  };
   size_t round = 0;
   adaptive_sweep(
       sweeps, cells->sweep_spacing, bases, kSweepMinChord,
-      [&](const std::vector<Segment>& segs, const std::vector<size_t>& sweep_of) {
+      [&](const std::vector<Segment>& segs, const std::vector<size_t>& sweep_of,
+          const std::vector<std::vector<uint32_t>>& fresh) {
         std::vector<uint32_t> segment_users(segs.size());
         for (size_t i = 0; i < segs.size(); ++i) segment_users[i] = users[sweep_of[i]];
         const std::vector<const TriangleBvh*> bvhs =
             trees_of(segs, [&](size_t i) { return cells->sweep_bound.at(cell)[sweep_of[i]]; });
-        const RegionResult rr = run_group(segs, fixed + round++, std::move(segment_users), bvhs);
+        const std::vector<std::vector<uint8_t>> masks = tiles_toward(segs, fresh);
+        const RegionResult rr =
+            run_group(segs, fixed + round++, std::move(segment_users), bvhs, masks);
         std::vector<std::vector<uint32_t>> seen(segs.size());
-        for (const RunRecord& r : judging(segs, rr, bvhs)) {
+        for (const RunRecord& r : judging(segs, rr, bvhs, masks)) {
           const Segment& s = segs.at(r.segment);
           if (s.side_normal == Vec3{0, 0, 0})
             ids_of_run(r, seen[r.segment]);

@@ -6,6 +6,9 @@
 #include <cmath>
 #include <iterator>
 
+#include "vislib/base/cubemap.h"
+#include "vislib/kernel/segment_visibility.h"
+
 namespace vislib {
 
 std::optional<FaceSweep> face_sweep_of(const std::vector<Vec3>& face, Vec3 normal,
@@ -129,6 +132,49 @@ double expected_adaptive_probes(const std::vector<FaceSweep>& sweeps,
   return expected;
 }
 
+std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_t state,
+                                                       const Segment& chord,
+                                                       const std::vector<uint32_t>& tris, int n,
+                                                       int tile_size, int margin) {
+  assert(n >= 1 && tile_size >= 1 && margin >= 0);
+  if (tris.empty()) return std::nullopt;
+  const int tiles = tiles_per_side(n, tile_size);
+  std::vector<uint8_t> mask(size_t(kCubeFaces) * size_t(tiles) * size_t(tiles), 0);
+  FaceAxes axes[kCubeFaces];
+  for (int f = 0; f < kCubeFaces; ++f) axes[f] = face_axes(f, Mat3{});
+  for (uint32_t t : tris) {
+    int face = -1;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};  // pixel coordinates
+    for (const Vec3& eye : {chord.from, chord.to})
+      for (const Vec3& p : scene.corners(t, state)) {
+        const Vec3 d = p - eye;
+        int best = 0;
+        for (int f = 1; f < kCubeFaces; ++f)
+          if (dot(d, axes[f].F) > dot(d, axes[best].F)) best = f;
+        const double depth = dot(d, axes[best].F);
+        if (!(depth > 0) || (face >= 0 && best != face)) return std::nullopt;
+        face = best;
+        const double c[2] = {pixel_coord(dot(d, axes[face].S) / depth, n),
+                             pixel_coord(dot(d, axes[face].T) / depth, n)};
+        for (int k = 0; k < 2; ++k) {
+          lo[k] = std::min(lo[k], c[k]);
+          hi[k] = std::max(hi[k], c[k]);
+        }
+      }
+    int first[2], last[2];  // tiles
+    for (int k = 0; k < 2; ++k) {
+      const int x0 = std::clamp(int(std::floor(lo[k])) - 1, 0, n - 1);
+      const int x1 = std::clamp(int(std::ceil(hi[k])) + 1, 0, n - 1);
+      first[k] = std::max(0, x0 / tile_size - margin);
+      last[k] = std::min(tiles - 1, x1 / tile_size + margin);
+    }
+    for (int y = first[1]; y <= last[1]; ++y)
+      for (int x = first[0]; x <= last[0]; ++x)
+        mask[(size_t(face) * size_t(tiles) + size_t(y)) * size_t(tiles) + size_t(x)] = 1;
+  }
+  return mask;
+}
+
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
                       const std::vector<std::vector<uint32_t>>& bases, double min_length,
                       const ChordRound& run_round, const SweepEstimate& estimate) {
@@ -142,6 +188,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     size_t face;
     double a, b;
     size_t set_a, set_b;
+    size_t fresh;  // index in `fresh`: what the probe that opened it saw new
   };
   std::vector<Interval> open;
   // Round 0: the coarse grid.
@@ -149,13 +196,16 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
   struct Probe {
     size_t face;
     double h;
+    size_t fresh;
   };
+  // The new ids of the probes that opened intervals (index 0: none).
+  std::vector<std::vector<uint32_t>> fresh(1);
   std::vector<Probe> probes;
   std::vector<std::vector<double>> grid(sweeps.size());
   for (size_t f = 0; f < sweeps.size(); ++f) {
     const int steps = even_steps(sweeps[f], spacing.coarse);
     for (int k = 0; k <= steps; ++k) grid[f].push_back(even_position(sweeps[f], k, steps));
-    for (int k = 1; k < steps; ++k) probes.push_back({f, grid[f][size_t(k)]});
+    for (int k = 1; k < steps; ++k) probes.push_back({f, grid[f][size_t(k)], 0});
   }
   // Runs `probes` as one round; returns the set index of each (its face's base for a degenerate
   // chord).
@@ -163,6 +213,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
   auto run_probes = [&]() {
     std::vector<Segment> segs;
     std::vector<size_t> which, sweep_of;
+    std::vector<std::vector<uint32_t>> parents_fresh;
     std::vector<size_t> index(probes.size());
     for (size_t i = 0; i < probes.size(); ++i) {
       index[i] = probes[i].face;
@@ -170,10 +221,11 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
         segs.push_back(*c);
         which.push_back(i);
         sweep_of.push_back(probes[i].face);
+        parents_fresh.push_back(fresh[probes[i].fresh]);
       }
     }
     if (segs.empty()) return index;
-    std::vector<std::vector<uint32_t>> seen = run_round(segs, sweep_of);
+    std::vector<std::vector<uint32_t>> seen = run_round(segs, sweep_of, parents_fresh);
     assert(seen.size() == segs.size());
     run += segs.size();
     for (size_t j = 0; j < which.size(); ++j) {
@@ -191,13 +243,13 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
       for (size_t k = 1; k + 1 < grid[f].size(); ++k) at[k] = index[p++];
       for (size_t k = 0; k + 1 < grid[f].size(); ++k)
         if (grid[f][k + 1] - grid[f][k] > spacing.floor)
-          open.push_back({f, grid[f][k], grid[f][k + 1], at[k], at[k + 1]});
+          open.push_back({f, grid[f][k], grid[f][k + 1], at[k], at[k + 1], 0});
     }
   }
   double refine = kRefinePrior;  // the share of the last round's probes that saw a new id
   while (!open.empty()) {
     probes.clear();
-    for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b)});
+    for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b), i.fresh});
     if (estimate) {
       double expected = double(run);
       for (const Interval& i : open) expected += expected_probes(i.b - i.a, spacing.floor, refine);
@@ -217,8 +269,12 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
       if (std::includes(both.begin(), both.end(), s.begin(), s.end())) continue;
       ++refined;
       if (m - i.a > spacing.floor) {
-        next.push_back({i.face, i.a, m, i.set_a, index[k]});
-        next.push_back({i.face, m, i.b, index[k], i.set_b});
+        std::vector<uint32_t> seen_new;
+        std::set_difference(s.begin(), s.end(), both.begin(), both.end(),
+                            std::back_inserter(seen_new));
+        fresh.push_back(std::move(seen_new));
+        next.push_back({i.face, i.a, m, i.set_a, index[k], fresh.size() - 1});
+        next.push_back({i.face, m, i.b, index[k], i.set_b, fresh.size() - 1});
       }
     }
     refine = double(refined) / double(open.size());

@@ -677,7 +677,7 @@ SegmentResult dynamic_segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1,
   if (opt.want_pieces) result.general_pieces.resize(size_t(6) * opt.resolution * opt.resolution);
   tbb::enumerable_thread_specific<FoundMarks> found_by_thread(
       [&] { return FoundMarks(nprim, opt.want_witnesses); });
-  const int tiles_x = (opt.resolution + opt.tile_size - 1) / opt.tile_size;
+  const int tiles_x = tiles_per_side(opt.resolution, opt.tile_size);
   std::vector<SegmentStats> stats(size_t(6) * tiles_x * tiles_x);
   for (const Run& run : runs) {
     DynamicKind kind(scene, run, opt, opt.want_pieces ? &result.general_pieces : nullptr);

@@ -70,6 +70,9 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       so.want_pieces = false;
       if (!options.segment_bvhs.empty() && options.segment_bvhs.at(s))
         so.bvh = options.segment_bvhs[s];
+      if (k == 0 && !options.segment_tile_masks.empty())
+        so.tile_mask = options.segment_tile_masks.at(s);
+      const uint32_t users = options.segment_users.empty() ? 0 : options.segment_users.at(s);
       const Segment& seg = result.segments[s];
       const bool sided = !(seg.side_normal == Vec3{0, 0, 0});
       so.side_normal = seg.side_normal;
@@ -80,7 +83,7 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       // thread computes (whose tiles this thread joins while it waits).
       // A planned long segment keeps no witnesses per part, nor a run split by a plane one per
       // side: such regions compute their own.
-      if (options.shared_runs && k == 0 &&
+      if (options.shared_runs && k == 0 && (so.tile_mask.empty() || users > 1) &&
           !(witnesses && (sided || options.shared_runs->chains_planned() > 0))) {
         PhaseScope waiting(Phase::SharedWait);
         auto shared = options.shared_runs->get(
@@ -91,8 +94,7 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
               o.splits = splits;
               return segment_visibility(scene, a, b, o);
             },
-            &computed, seg.side_normal,
-            options.segment_users.empty() ? 0 : options.segment_users.at(s));
+            &computed, seg.side_normal, users);
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;
       } else {

@@ -58,6 +58,11 @@ struct RegionOptions {
   // shared_runs is computed with the tree of the region that computes it, so regions that share a
   // segment must give it the same tree (or none).
   std::vector<const TriangleBvh*> segment_bvhs;
+  // Empty, or one per segment: the tiles run 0 (world-aligned) of segment s computes
+  // (SegmentOptions::tile_mask; empty: the whole cube); the other runs compute the whole cube. A
+  // masked run goes through shared_runs only as a run of a family (segment_users > 1), whose
+  // users must give it the same mask.
+  std::vector<std::vector<uint8_t>> segment_tile_masks;
 };
 
 struct RunRecord {

@@ -818,6 +818,16 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     if (opt.side_only < 0 && opt.want_witnesses)
       throw std::invalid_argument("witnesses need one side (side_only 0 or 1), not both");
   }
+  if (!opt.tile_mask.empty()) {
+    if (scene.sphere_count() > 0 || scene.is_dynamic())
+      throw std::invalid_argument("a tile mask applies only to a static scene without spheres");
+    const size_t tiles =
+        size_t(tiles_per_side(opt.resolution, opt.tile_size ? opt.tile_size : kStaticTileSize));
+    if (opt.tile_mask.size() != size_t(kCubeFaces) * tiles * tiles)
+      throw std::invalid_argument("a tile mask needs one flag per tile of the cube (" +
+                                  std::to_string(size_t(kCubeFaces) * tiles * tiles) + "), not " +
+                                  std::to_string(opt.tile_mask.size()));
+  }
   if (scene.sphere_count() > 0 || scene.is_dynamic()) {
     if (scene.has_see_through()) throw std::invalid_argument(kSeeThroughStaticOnly);
     return dynamic_segment_visibility(scene, v0, v1, opt);  // resolves tile_size 0 itself
@@ -835,7 +845,7 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
         "the edge lines given to segment_visibility were built for another scene or key state");
   auto start = std::chrono::steady_clock::now();
   const int N = opt.resolution;
-  const int tiles_x = (N + opt.tile_size - 1) / opt.tile_size;
+  const int tiles_x = tiles_per_side(N, opt.tile_size);
   const size_t ntri = scene.triangle_count();
 
   SegmentResult result;

@@ -53,6 +53,11 @@ enum class CoplanarRule { Both, First };
 constexpr int kStaticTileSize = 32;
 constexpr int kDynamicTileSize = 16;
 
+// Tiles along a cube face's side at resolution `n` and tile side `tile_size` (> 0).
+constexpr int tiles_per_side(int n, int tile_size) {
+  return (n + tile_size - 1) / tile_size;
+}
+
 struct SegmentOptions {
   int resolution = 512;             // N: each cube face is N x N pixels; must be >= 1
   double near = kDefaultNear;       // z_near > 0, view depth in scene units
@@ -103,6 +108,12 @@ struct SegmentOptions {
   // on both sides, each with the directions that leave it (docs/quake.md "Portals").
   Vec3 side_normal{0, 0, 0};
   int side_only = -1;
+  // Static scenes without spheres: empty (the whole cube), or one flag per tile of the cube,
+  // face-major then row-major (index (face * tiles + y) * tiles + x, tiles = ceil(resolution /
+  // tile size), the tile size tile_size or kStaticTileSize when 0), and only the flagged tiles'
+  // pixels are computed: the result is the whole run's ids seen in those pixels (pixels are
+  // independent). Of another size, or in another scene: std::invalid_argument.
+  std::vector<uint8_t> tile_mask;
 };
 
 constexpr size_t kMaxSplitParts = 8;

@@ -484,7 +484,8 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                tbb::enumerable_thread_specific<FoundMarks>& found_by_thread,
                std::vector<SegmentStats>& tile_stats) {
   const int N = opt.resolution, TS = opt.tile_size;
-  const int tiles_x = (N + TS - 1) / TS, tile_count = tiles_x * tiles_x;
+  const int tiles_x = tiles_per_side(N, TS), tile_count = tiles_x * tiles_x;
+  const std::vector<uint8_t>& mask = opt.tile_mask;  // empty: every tile
   const size_t count = kind.count();
   using Work = ThreadTileWork<typename Kind::Scratch>;
   const uint64_t run = next_serial();
@@ -502,6 +503,14 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
 
   for (int face = 0; face < kCubeFaces; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
+    auto computed = [&](int tile) {
+      return mask.empty() || mask[size_t(face) * size_t(tile_count) + size_t(tile)];
+    };
+    if (!mask.empty()) {
+      bool any = false;
+      for (int tile = 0; tile < tile_count && !any; ++tile) any = computed(tile);
+      if (!any) continue;
+    }
     if (bvh) {
       node_cache.next_face(bvh->nodes.size());
       tri_cache.next_face(count);
@@ -540,6 +549,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
                         size_t held = 0;
                         FoundMarks& found = found_by_thread.local();
                         for (int tile = r.begin(); tile != r.end(); ++tile) {
+                          if (!computed(tile)) continue;
                           // Counted apart, added once at the tile's end: the entries of
                           // neighbouring tiles share cache lines, and another thread may be
                           // running the next tile.
