@@ -230,8 +230,7 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
           std::clamp(int(std::floor(pixel_coord(dot(d, a.S) / depth, n) + 0.5)), 0, n - 1);
       const int y =
           std::clamp(int(std::floor(pixel_coord(dot(d, a.T) / depth, n) + 0.5)), 0, n - 1);
-      ASSERT_TRUE(
-          (*m)[(size_t(f) * size_t(tiles) + size_t(y / ts)) * size_t(tiles) + size_t(x / ts)])
+      ASSERT_TRUE((*m)[tile_mask_index(f, x / ts, y / ts, tiles)])
           << "triangle " << t << " face " << f << " pixel " << x << "," << y;
     }
   }

@@ -452,9 +452,7 @@ TEST(SegmentVisibility, ATileMaskComputesExactlyTheWholeRunsPixelsInItsTiles) {
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         const size_t k = (size_t(f) * size_t(n) + size_t(y)) * size_t(n) + size_t(x);
-        const bool in_even =
-            even[(size_t(f) * size_t(tiles) + size_t(y / o.tile_size)) * size_t(tiles) +
-                 size_t(x / o.tile_size)] != 0;
+        const bool in_even = even[tile_mask_index(f, x / o.tile_size, y / o.tile_size, tiles)] != 0;
         const std::vector<PieceList>& masked = in_even ? r0.pieces : r1.pieces;
         const std::vector<PieceList>& other = in_even ? r1.pieces : r0.pieces;
         ASSERT_TRUE(other[k].empty()) << "a pixel outside the mask was computed";

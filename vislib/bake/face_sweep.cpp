@@ -169,8 +169,7 @@ std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_
       last[k] = std::min(tiles - 1, x1 / tile_size + margin);
     }
     for (int y = first[1]; y <= last[1]; ++y)
-      for (int x = first[0]; x <= last[0]; ++x)
-        mask[(size_t(face) * size_t(tiles) + size_t(y)) * size_t(tiles) + size_t(x)] = 1;
+      for (int x = first[0]; x <= last[0]; ++x) mask[tile_mask_index(face, x, y, tiles)] = 1;
   }
   return mask;
 }

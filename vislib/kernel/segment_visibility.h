@@ -58,6 +58,12 @@ constexpr int tiles_per_side(int n, int tile_size) {
   return (n + tile_size - 1) / tile_size;
 }
 
+// The index of tile (x, y) of cube face `face` in a tile mask (SegmentOptions::tile_mask) of
+// `tiles` tiles a side: face-major, then row-major.
+constexpr size_t tile_mask_index(int face, int x, int y, int tiles) {
+  return (size_t(face) * size_t(tiles) + size_t(y)) * size_t(tiles) + size_t(x);
+}
+
 struct SegmentOptions {
   int resolution = 512;             // N: each cube face is N x N pixels; must be >= 1
   double near = kDefaultNear;       // z_near > 0, view depth in scene units
@@ -109,8 +115,8 @@ struct SegmentOptions {
   Vec3 side_normal{0, 0, 0};
   int side_only = -1;
   // Static scenes without spheres: empty (the whole cube), or one flag per tile of the cube,
-  // face-major then row-major (index (face * tiles + y) * tiles + x, tiles = ceil(resolution /
-  // tile size), the tile size tile_size or kStaticTileSize when 0), and only the flagged tiles'
+  // at tile_mask_index(face, x, y, tiles) (tiles = tiles_per_side(resolution, tile size), the tile
+  // size tile_size or kStaticTileSize when 0), and only the flagged tiles'
   // pixels are computed: the result is the whole run's ids seen in those pixels (pixels are
   // independent). Of another size, or in another scene: std::invalid_argument.
   std::vector<uint8_t> tile_mask;

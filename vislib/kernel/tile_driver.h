@@ -504,7 +504,7 @@ void run_tiles(Kind& kind, const SegmentOptions& opt,
   for (int face = 0; face < kCubeFaces; ++face) {
     const FaceAxes axes = face_axes(face, opt.orientation);
     auto computed = [&](int tile) {
-      return mask.empty() || mask[size_t(face) * size_t(tile_count) + size_t(tile)];
+      return mask.empty() || mask[tile_mask_index(face, tile % tiles_x, tile / tiles_x, tiles_x)];
     };
     if (!mask.empty()) {
       bool any = false;
