@@ -229,9 +229,10 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     if (a.face_sweep.value_or(portals ? "adaptive" : "even") == "adaptive") {
       const vislib::AdaptiveSpacing d =
           portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
-      const vislib::AdaptiveSpacing chords{a.chord_coarse.value_or(d.coarse),
-                                           a.chord_floor.value_or(d.floor),
-                                           a.chord_piece.value_or(d.piece), a.chord_tiles == "new"};
+      const vislib::AdaptiveSpacing chords{
+          a.chord_coarse.value_or(d.coarse), a.chord_floor.value_or(d.floor),
+          a.chord_piece.value_or(d.piece),
+          a.chord_tiles.value_or(d.toward_new ? "new" : "all") == "new"};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
       o.adaptive = chords;
@@ -358,8 +359,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->check(in_range(1e-3, 1e6));
   cmd->add_option("--chord-floor", a.chord_floor,
                   "bsp-leaves, adaptive: no chord is inserted closer than this to a neighbour "
-                  "(Quake units, at most --chord-coarse; default 8 with --sweep portals, 4 with "
-                  "faces)")
+                  "(Quake units, at most --chord-coarse; default 4)")
       ->check(in_range(1e-3, 1e6));
   cmd->add_option("--chord-piece", a.chord_piece,
                   "bsp-leaves, adaptive: cut each swept polygon into strips at most this long "
@@ -369,9 +369,9 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--chord-tiles", a.chord_tiles,
                   "bsp-leaves, adaptive: 'all' (every chord computes its whole cube) or 'new' "
                   "(a chord inserted because its parent saw new ids computes only the cube tiles "
-                  "where those can appear, one tile around; docs/quake.md)")
-      ->check(CLI::IsMember({"all", "new"}))
-      ->capture_default_str();
+                  "where those can appear, one tile around; docs/quake.md); default new with "
+                  "--sweep portals, all with faces")
+      ->check(CLI::IsMember({"all", "new"}));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

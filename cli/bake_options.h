@@ -44,10 +44,11 @@ struct BakeArgs {
   std::optional<std::string> face_sweep;
   std::string sweep = "portals";  // --sweep portals|faces (bsp-leaves)
   std::string bound = "portals";  // --bound none|portals|map-vis (bsp-leaves, --sweep portals)
-  // --chord-coarse, --chord-floor, --chord-piece (adaptive); unset: kBspPortalChords with --sweep
-  // portals, else AdaptiveSpacing's defaults.
+  // --chord-coarse, --chord-floor, --chord-piece, --chord-tiles all|new (adaptive: the last is
+  // AdaptiveSpacing::toward_new); unset: kBspPortalChords with --sweep portals, else
+  // AdaptiveSpacing's defaults.
   std::optional<double> chord_coarse, chord_floor, chord_piece;
-  std::string chord_tiles = "all";  // --chord-tiles all|new (adaptive): AdaptiveSpacing::toward_new
+  std::optional<std::string> chord_tiles;
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)

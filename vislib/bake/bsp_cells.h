@@ -51,11 +51,12 @@ constexpr double kBspFaceSpacing = 16.0;
 constexpr double kBspPortalSpacing = 8.0;
 // The default chords of a portal sweep (BspSweep::Portals, Quake units; `pvs bake` sweeps portals
 // adaptively unless told --face-sweep even): the first chords at most 128 apart, inserted down to
-// 8, each portal cut into strips at most 128 long along its chords. For about the even sweep at
-// 8's sampled misses it costs less CPU on lqdm1 whole and on leaf samples of e1m2 and e2m3, but
-// more on e2m3 whole; a floor of 4 buys fewer misses for more CPU on the bigger maps
-// (docs/quake.md "Portals" has the figures).
-constexpr AdaptiveSpacing kBspPortalChords{128.0, 8.0, 128.0};
+// 4, each portal cut into strips at most 128 long along its chords, a chord inserted below a
+// probe that saw new ids computing only the cube tiles toward them. Against the whole cube down
+// to 8 it costs less CPU on lqdm1 whole and about as much on leaf samples of e1m2 and e2m3, for
+// fewer sampled misses on all three: the floor of 4 buys the misses back that the tiles give up,
+// and the tiles pay for the floor (docs/quake.md "Chords that look toward what made them").
+constexpr AdaptiveSpacing kBspPortalChords{128.0, 4.0, 128.0, true};
 
 // The segments a convex region's visibility is computed on (Quake coordinates in, scene
 // coordinates out, quake_to_scene): first every edge of every face of `region`, in face order and
