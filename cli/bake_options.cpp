@@ -192,8 +192,9 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   static const char* const kWalkableOnly[] = {"--walkable-from", "--agent-height", "--agent-radius",
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
-    for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
-                          "--chord-floor", "--chord-piece", "--chord-tiles", "--sweep", "--bound"})
+    for (const char* o :
+         {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor",
+          "--chord-piece", "--chord-tiles", "--chord-tile-size", "--sweep", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -232,9 +233,12 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
       const vislib::AdaptiveSpacing chords{
           a.chord_coarse.value_or(d.coarse), a.chord_floor.value_or(d.floor),
           a.chord_piece.value_or(d.piece),
-          a.chord_tiles.value_or(d.toward_new ? "new" : "all") == "new"};
+          a.chord_tiles.value_or(d.toward_new ? "new" : "all") == "new",
+          a.chord_tile_size.value_or(d.tile_size)};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
+      if (a.chord_tile_size && !chords.toward_new)
+        throw CLI::ValidationError("--chord-tile-size", "only applies with --chord-tiles new");
       o.adaptive = chords;
     }
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
@@ -372,6 +376,10 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "where those can appear, one tile around; docs/quake.md); default new with "
                   "--sweep portals, all with faces")
       ->check(CLI::IsMember({"all", "new"}));
+  cmd->add_option("--chord-tile-size", a.chord_tile_size,
+                  "bsp-leaves, --chord-tiles new: the side of those tiles in pixels (the margin "
+                  "is one tile; whole cubes keep the kernel's tiles; default 16)")
+      ->check(in_range(1, 4096));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

@@ -49,6 +49,7 @@ struct BakeArgs {
   // AdaptiveSpacing's defaults.
   std::optional<double> chord_coarse, chord_floor, chord_piece;
   std::optional<std::string> chord_tiles;
+  std::optional<int> chord_tile_size;      // --chord-tile-size (AdaptiveSpacing::tile_size)
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)

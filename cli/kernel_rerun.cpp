@@ -42,9 +42,14 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
       throw vislib::InputError(pvs, "metadata holds an invalid chord_tiles (all or new)");
     if (tiles == "new" && find_key(md, "chord_tile_margin") != vislib::kChordTileMargin)
       throw vislib::InputError(pvs, "metadata holds a chord_tile_margin this build cannot re-run");
-    co.adaptive =
-        vislib::AdaptiveSpacing{coarse.get<double>(), floor.get<double>(),
-                                piece.is_null() ? 0.0 : piece.get<double>(), tiles == "new"};
+    // Absent: the chords were masked by the kernel's tiles (kStaticTileSize).
+    const nlohmann::json tile_size = find_key(md, "chord_tile_size");
+    if (!tile_size.is_null() && !(tile_size.is_number_integer() && tile_size.get<int>() >= 1 &&
+                                  tile_size.get<int>() <= 4096))
+      throw vislib::InputError(pvs, "metadata holds an invalid chord_tile_size");
+    co.adaptive = vislib::AdaptiveSpacing{
+        coarse.get<double>(), floor.get<double>(), piece.is_null() ? 0.0 : piece.get<double>(),
+        tiles == "new", tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>()};
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

@@ -1344,9 +1344,12 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_EQ(c["chord_piece"], kBspPortalChords.piece);
   EXPECT_EQ(c["chord_tiles"], "new");
   EXPECT_EQ(c["chord_tile_margin"], kChordTileMargin);
+  EXPECT_EQ(c["chord_tile_size"], kChordTileSize);
   c = cells_of("--chord-tiles all");
   EXPECT_EQ(c["chord_tiles"], "all");
   EXPECT_FALSE(c.contains("chord_tile_margin"));
+  EXPECT_FALSE(c.contains("chord_tile_size"));
+  EXPECT_EQ(cells_of("--chord-tile-size 32")["chord_tile_size"], 32);
   c = cells_of("--face-sweep even");
   EXPECT_EQ(c["face_sweep"], "even");
   EXPECT_FALSE(c.contains("chord_coarse"));
@@ -1363,6 +1366,12 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --sweep edges -o " + dir + "/x.pvs", &out),
             2);
   EXPECT_NE(out.find("--sweep"), std::string::npos) << out;
+  EXPECT_EQ(
+      run_pvs("bake " + map + " --cells bsp-leaves --chord-tiles all --chord-tile-size 8 -o " +
+                  dir + "/x.pvs",
+              &out),
+      2);
+  EXPECT_NE(out.find("--chord-tile-size"), std::string::npos) << out;
   // Leaf 2 (water, above z = 16): Quake (32, 48, 24) is scene (32, 24, -48).
   ASSERT_EQ(run_pvs("inspect --json " + dir + "/tiny.pvs --at 32,24,-48", &out), 0) << out;
   EXPECT_NE(out.find("\"leaf\": 2"), std::string::npos) << out;

@@ -424,18 +424,20 @@ TEST(SegmentVisibility, DirectionSidesHoldWhatThePixelsOfEachSideOfThePlaneSee) 
   EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
 }
 
-// A tile mask computes the flagged tiles' pixels only, each as the whole run does: two
-// complementary masks give the whole run's pixel lists between them and its set as their union,
-// and a mask of every tile is the whole run. The bake's refinement chords rely on this to look
-// only toward the ids that made them.
+// A tile mask computes the flagged tiles' pixels only, each as the whole run does, whatever tiles
+// the whole run is computed by (here 32 against the masks' 16): two complementary masks give the
+// whole run's pixel lists between them and its set as their union, and a mask of every tile is
+// the whole run. The bake's refinement chords rely on this to look only toward the ids that made
+// them, on tiles finer than the whole cubes'.
 TEST(SegmentVisibility, ATileMaskComputesExactlyTheWholeRunsPixelsInItsTiles) {
   const Scene s = random_soup(600, 17);
   SegmentOptions o;
   o.resolution = 64;
-  o.tile_size = 16;
+  o.tile_size = 32;
   o.want_pieces = true;
   const Vec3 a{-1, 0.5, 0}, b{1.5, -0.5, 1};
   const SegmentResult whole = segment_visibility(s, a, b, o);
+  o.tile_size = 16;
   const int tiles = tiles_per_side(o.resolution, o.tile_size);
   std::vector<uint8_t> even(size_t(6 * tiles * tiles)), odd(even.size());
   for (size_t i = 0; i < even.size(); ++i) {
@@ -477,4 +479,34 @@ TEST(SegmentVisibility, ATileMaskComputesExactlyTheWholeRunsPixelsInItsTiles) {
   EXPECT_TRUE(segment_visibility(s, a, b, o).visible.empty());
   o.tile_mask.resize(even.size() - 1);
   EXPECT_THROW(segment_visibility(s, a, b, o), std::invalid_argument);
+}
+
+// A region's masked runs are computed by the tiles of their masks
+// (RegionOptions::segment_tile_mask_size) and its whole runs by their own: a mask is a sampling
+// choice, the kernel's tiles a grain of work.
+TEST(RegionVisibility, MaskedRunsTakeTheTileSideOfTheirMasks) {
+  const Scene s = random_soup(600, 23);
+  RegionOptions r;
+  r.segment.resolution = 64;
+  r.segment.tile_size = 32;
+  r.runs = 1;
+  const Vec3 a{-1, 0.5, 0}, b{1.5, -0.5, 1};
+  const int fine = 8, tiles = tiles_per_side(r.segment.resolution, fine);
+  std::vector<uint8_t> mask(size_t(6 * tiles * tiles));
+  for (size_t i = 0; i < mask.size(); ++i) mask[i] = uint8_t(i % 3 == 0);
+  SegmentOptions m = r.segment;
+  m.tile_size = fine;
+  m.tile_mask = mask;
+  const std::vector<uint32_t> masked = segment_visibility(s, a, b, m).visible;
+  const std::vector<uint32_t> whole = segment_visibility(s, a, b, r.segment).visible;
+  ASSERT_LT(masked.size(), whole.size());
+  r.segment_tile_masks = {mask, {}};
+  r.segment_tile_mask_size = fine;
+  const std::vector<Segment> segs = {Segment{a, b}, Segment{a, b}};
+  const RegionResult rr = segments_visibility(s, segs, r);
+  ASSERT_EQ(rr.runs.size(), 2u);
+  EXPECT_EQ(rr.runs[0].visible, masked);
+  EXPECT_EQ(rr.runs[1].visible, whole);
+  r.segment_tile_mask_size = 0;  // the mask is then read by tiles of 32: the wrong size
+  EXPECT_THROW(segments_visibility(s, segs, r), std::invalid_argument);
 }

@@ -368,7 +368,10 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
     d["chord_floor"] = options.adaptive->floor;
     d["chord_piece"] = options.adaptive->piece;
     d["chord_tiles"] = options.adaptive->toward_new ? "new" : "all";
-    if (options.adaptive->toward_new) d["chord_tile_margin"] = kChordTileMargin;
+    if (options.adaptive->toward_new) {
+      d["chord_tile_margin"] = kChordTileMargin;
+      d["chord_tile_size"] = options.adaptive->tile_size;
+    }
   }
   cells.description = d.dump();
   return cells;

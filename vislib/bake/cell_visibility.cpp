@@ -163,6 +163,7 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     o.segment_users = std::move(users);
     o.segment_bvhs = std::move(bvhs);
     o.segment_tile_masks = std::move(masks);
+    o.segment_tile_mask_size = cells ? cells->sweep_spacing.tile_size : 0;
     std::function<void(size_t, size_t)> run_done;
     if (progress) run_done = [&](size_t done, size_t) { report(double(done)); };
     RegionResult rr = segments_visibility(scene, segs, o, run_done);
@@ -218,6 +219,7 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     o.shared_runs = nullptr;
     o.segment_bvhs = bvhs;
     o.segment_tile_masks = masks;
+    o.segment_tile_mask_size = cells ? cells->sweep_spacing.tile_size : 0;
     rerun = segments_visibility(scene, segs, o).runs;
     return rerun;
   };
@@ -252,8 +254,9 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   for (size_t f = 0; f < sweeps.size(); ++f)
     if (sweeps[f].side_normal == Vec3{0, 0, 0}) bases[f] = base;
   // A chord below a probe that saw new ids looks only toward them (AdaptiveSpacing::toward_new):
-  // the tiles of its run 0 where they can appear (chord_tiles_toward), a sided run's ids of
-  // either side being triangles; the whole cube when one is a sphere.
+  // the tiles of its run 0 where they can appear (chord_tiles_toward, tiles of
+  // AdaptiveSpacing::tile_size pixels), a sided run's ids of either side being triangles; the whole
+  // cube when one is a sphere.
   const bool toward_new =
       cells && cells->sweep_spacing.toward_new && scene.sphere_count() == 0 && !scene.is_dynamic();
   auto tiles_toward = [&](const std::vector<Segment>& segs,
@@ -267,10 +270,9 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
       tri.clear();
       for (uint32_t id : fresh[i]) tri.push_back(id >= ids ? id - ids : id);
       if (std::any_of(tri.begin(), tri.end(), [&](uint32_t t) { return t >= tris; })) continue;
-      std::optional<std::vector<uint8_t>> m = chord_tiles_toward(
-          scene, options.segment.state, segs[i], tri, options.segment.resolution,
-          options.segment.tile_size > 0 ? options.segment.tile_size : kStaticTileSize,
-          kChordTileMargin);
+      std::optional<std::vector<uint8_t>> m =
+          chord_tiles_toward(scene, options.segment.state, segs[i], tri, options.segment.resolution,
+                             cells->sweep_spacing.tile_size, kChordTileMargin);
       if (!m) continue;
       masks[i] = std::move(*m);
       any = true;

@@ -62,6 +62,21 @@ std::vector<FaceSweep> sweep_strips(const FaceSweep& sweep, double length);
 // spacing. `spacing` > 0.
 std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double min_length);
 
+// The margin of chord_tiles_toward in the bake (tiles): what a gap newly opens is seen beside the
+// ids that showed it (the gap's other side, its neighbours). With tiles of 32 pixels, margin 0
+// cost lqdm1 whole about 0.9 of margin 1's CPU for 9 and 120 sampled miss rays against 8 and 98
+// (4 and 32 eyes a leaf), and e2m3's 47-leaf sample 0.88 for 16 against 7 (docs/quake.md).
+constexpr int kChordTileMargin = 1;
+
+// The default tile side of those masks and of the runs they mask (pixels; AdaptiveSpacing::
+// tile_size, RegionOptions::segment_tile_mask_size): the margin is one such tile, and a masked run
+// computes whole tiles, so finer tiles keep a run to what it looks for. The whole cubes keep the
+// kernel's tiles (kStaticTileSize), which are faster for them. Against 32 (measured in
+// alternating pairs): 0.93 of lqdm1 whole's CPU for 9 and 104 sampled miss rays against 8 and 98,
+// 0.92 and 0.85 of e2m3's 47-leaf and e1m2's 63-leaf samples' for the same 7 and 18
+// (docs/quake.md).
+constexpr int kChordTileSize = 16;
+
 // The spacings of the adaptive sweep (the sweeps' units): the first chords lie at most `coarse`
 // apart (the even sweep's positions); a chord is inserted midway between two neighbours (a face's
 // own extreme positions count as neighbours that see its base, below) whose distance is larger
@@ -70,13 +85,15 @@ std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double 
 // into strips at most `piece` long along its chords (sweep_strips), each refined on its own, so a
 // long chord's probes go on only over the stretches where new ids are seen (0: whole chords).
 // With `toward_new` a chord inserted below a probe that saw new ids looks only toward those
-// (the caller's choice of how: the bake runs it on the cube tiles where they can appear,
-// chord_tiles_toward); the sweep itself only hands each chord its parent's new ids (ChordRound).
+// (the caller's choice of how: the bake runs it on the cube tiles of `tile_size` pixels where they
+// can appear, chord_tiles_toward); the sweep itself only hands each chord its parent's new ids
+// (ChordRound).
 struct AdaptiveSpacing {
   double coarse = 64;
   double floor = 4;
   double piece = 0;
   bool toward_new = false;
+  int tile_size = kChordTileSize;
 };
 
 // Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
@@ -121,11 +138,6 @@ std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_
                                                        const Segment& chord,
                                                        const std::vector<uint32_t>& tris, int n,
                                                        int tile_size, int margin);
-
-// The margin of chord_tiles_toward in the bake (tiles): what a gap newly opens is seen beside the
-// ids that showed it (the gap's other side, its neighbours). On e1m2's 63-leaf sample margin 0
-// missed one sampled ray more than 1, and 2 cost as much as the whole cube for the same misses.
-constexpr int kChordTileMargin = 1;
 
 // Runs the adaptive sweep of `sweeps` together, round by round: round 0 holds every face's even
 // chords at `spacing.coarse`, round r + 1 the midpoints of the intervals that round r (or, for

@@ -70,8 +70,11 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       so.want_pieces = false;
       if (!options.segment_bvhs.empty() && options.segment_bvhs.at(s))
         so.bvh = options.segment_bvhs[s];
-      if (k == 0 && !options.segment_tile_masks.empty())
+      if (k == 0 && !options.segment_tile_masks.empty()) {
         so.tile_mask = options.segment_tile_masks.at(s);
+        if (!so.tile_mask.empty() && options.segment_tile_mask_size > 0)
+          so.tile_size = options.segment_tile_mask_size;
+      }
       const uint32_t users = options.segment_users.empty() ? 0 : options.segment_users.at(s);
       const Segment& seg = result.segments[s];
       const bool sided = !(seg.side_normal == Vec3{0, 0, 0});

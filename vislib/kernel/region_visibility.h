@@ -63,6 +63,10 @@ struct RegionOptions {
   // masked run goes through shared_runs only as a run of a family (segment_users > 1), whose
   // users must give it the same mask.
   std::vector<std::vector<uint8_t>> segment_tile_masks;
+  // The tile side (pixels) of segment_tile_masks and of the runs they mask (their
+  // SegmentOptions::tile_size, which changes no result: pixels are independent); 0: the side of
+  // `segment`. A mask is a sampling choice, so its tiles need not be the kernel's best grain.
+  int segment_tile_mask_size = 0;
 };
 
 struct RunRecord {
