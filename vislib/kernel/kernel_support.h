@@ -58,23 +58,16 @@ struct FoundMarks {
   std::vector<double> witness_len;  // per primitive: length of the witness piece (-1 = none)
   std::vector<Witness> witness;     // per primitive
 
-  FoundMarks(size_t count, bool witnesses) : pages_((count + kMarkPageIds - 1) >> kMarkPageShift) {
+  FoundMarks(size_t count, bool witnesses) : marks_(count), groups_(count) {
     if (witnesses) {
       witness_len.assign(count, -1.0);
       witness.resize(count);
     }
   }
   // Primitive p's mark: 0 (not seen), 1, or a bit per part of a split segment.
-  uint8_t seen(uint32_t p) const {
-    const auto& page = pages_[p >> kMarkPageShift];
-    return page ? page[p & (kMarkPageIds - 1)] : uint8_t(0);
-  }
+  uint8_t seen(uint32_t p) const { return marks_.get(p); }
   // Sets `bits` in primitive p's mark.
-  void add(uint32_t p, uint8_t bits) {
-    auto& page = pages_[p >> kMarkPageShift];
-    if (!page) page.reset(new uint8_t[kMarkPageIds]());
-    page[p & (kMarkPageIds - 1)] |= bits;
-  }
+  void add(uint32_t p, uint8_t bits) { marks_.add(p, bits); }
   // Marks primitive p visible through a piece of length `len` (in t) with witness w.
   void mark(uint32_t p, double len, const Witness& w) {
     add(p, 1);
@@ -83,24 +76,46 @@ struct FoundMarks {
       witness[p] = w;
     }
   }
+  // A kernel's note on group g (< count) of primitives, such as the mark bits that every
+  // primitive of a fan holds already (marks only grow in a run, so such a note stays true): 0
+  // until noted. Not part of the result.
+  uint8_t group_note(uint32_t g) const { return groups_.get(g); }
+  void add_group_note(uint32_t g, uint8_t bits) { groups_.add(g, bits); }
   // ORs these marks into seen (size: the primitive count).
-  void unite_into(std::vector<uint8_t>& seen) const {
-    for (size_t g = 0; g < pages_.size(); ++g) {
-      if (!pages_[g]) continue;
-      const size_t first = g << kMarkPageShift;
-      const size_t n = std::min(kMarkPageIds, seen.size() - first);
-      for (size_t i = 0; i < n; ++i) seen[first + i] |= pages_[g][i];
-    }
-  }
-  // Bytes held by the marks (the page table and the pages in use).
-  size_t mark_bytes() const {
-    size_t n = pages_.size() * sizeof(pages_[0]);
-    for (const auto& page : pages_) n += page ? kMarkPageIds : 0;
-    return n;
-  }
+  void unite_into(std::vector<uint8_t>& seen) const { marks_.unite_into(seen); }
+  // Bytes held by the marks and notes (the page tables and the pages in use).
+  size_t mark_bytes() const { return marks_.bytes() + groups_.bytes(); }
 
  private:
-  std::vector<std::unique_ptr<uint8_t[]>> pages_;
+  // A byte per id in [0, count), in pages allocated on their first non-zero byte.
+  struct Pages {
+    explicit Pages(size_t count) : pages((count + kMarkPageIds - 1) >> kMarkPageShift) {}
+    uint8_t get(uint32_t p) const {
+      const auto& page = pages[p >> kMarkPageShift];
+      return page ? page[p & (kMarkPageIds - 1)] : uint8_t(0);
+    }
+    void add(uint32_t p, uint8_t bits) {
+      auto& page = pages[p >> kMarkPageShift];
+      if (!page) page.reset(new uint8_t[kMarkPageIds]());
+      page[p & (kMarkPageIds - 1)] |= bits;
+    }
+    void unite_into(std::vector<uint8_t>& seen) const {
+      for (size_t g = 0; g < pages.size(); ++g) {
+        if (!pages[g]) continue;
+        const size_t first = g << kMarkPageShift;
+        const size_t n = std::min(kMarkPageIds, seen.size() - first);
+        for (size_t i = 0; i < n; ++i) seen[first + i] |= pages[g][i];
+      }
+    }
+    size_t bytes() const {
+      size_t n = pages.size() * sizeof(pages[0]);
+      for (const auto& page : pages) n += page ? kMarkPageIds : 0;
+      return n;
+    }
+    std::vector<std::unique_ptr<uint8_t[]>> pages;
+  };
+  Pages marks_;
+  Pages groups_;
 };
 
 // Marks primitive p visible from the parts of a split segment (SegmentOptions::splits) that the

@@ -367,6 +367,13 @@ class StaticKind {
     if (!(opt.side_normal == Vec3{0, 0, 0})) {
       sides_ = true;
       all_sides_ = opt.side_only < 0 ? 3 : 1;
+      for (int f = 0; f < kCubeFaces; ++f) {
+        const FaceAxes& a = face_axes_[size_t(f)];
+        side_dots_[size_t(f)] = {dot(a.F, opt.side_normal), dot(a.S, opt.side_normal),
+                                 dot(a.T, opt.side_normal)};
+      }
+      const double tol = kSideTolerance * length(opt.side_normal);  // per unit of |d|
+      side_tol2_ = tol * tol;
     }
   }
 
@@ -606,10 +613,13 @@ class StaticKind {
     const uint8_t sides = side_mask(face, x, y);
     if (sides == 0) return;  // a pixel of the side not asked for
     const bool witnesses = !found.witness_len.empty();
+    // Remembered per fan (FoundMarks::group_note): a fan is met again in most pixels of a run.
     auto settled = [&](uint32_t p) {
       if (witnesses) return false;
+      if ((found.group_note(p) & sides) == sides) return true;
       for (uint32_t t = first_triangle(p), e = end_triangle(p); t < e; ++t)
         if ((found.seen(t) & sides) != sides) return false;
+      found.add_group_note(p, sides);
       return true;
     };
     for_each_visible(
@@ -668,14 +678,15 @@ class StaticKind {
   // The sides (SegmentOptions::side_normal) pixel (x, y) of `face` counts for, as the mark's
   // bits: 1 (side 0), 2 (side 1) or 3 (both, on the plane) when the sides are split; 1 when it
   // is on the side asked for (side_only), 0 when not; 1 without sides.
+  // Called for every pixel with pieces, so the plane's terms are taken per face (side_dots_)
+  // and |dn| <= tol is tested squared, without a root.
   uint8_t side_mask(int face, int x, int y) const {
     if (!sides_) return 1;
-    const FaceAxes& a = face_axes_[size_t(face)];
+    const std::array<double, 3>& n = side_dots_[size_t(face)];
     const double sc = pixel_centers_[size_t(x)], tc = pixel_centers_[size_t(y)];
-    const Vec3 d = a.F + a.S * sc + a.T * tc;
-    const double dn = dot(d, opt_.side_normal);
-    const double tol = kSideTolerance * std::sqrt(1 + sc * sc + tc * tc) * length(opt_.side_normal);
-    const uint8_t mask = uint8_t((dn >= -tol ? 1 : 0) | (dn <= tol ? 2 : 0));
+    const double dn = n[0] + n[1] * sc + n[2] * tc;  // dot(d, side_normal), d = F + S sc + T tc
+    const uint8_t mask =
+        dn * dn <= side_tol2_ * (1 + sc * sc + tc * tc) ? uint8_t(3) : dn > 0 ? uint8_t(1) : uint8_t(2);
     if (opt_.side_only < 0) return mask;
     return uint8_t(mask >> opt_.side_only & 1);
   }
@@ -783,6 +794,10 @@ class StaticKind {
   std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
   bool sides_ = false;               // side_normal given
   uint8_t all_sides_ = 1;            // the mark of an id seen on every side that counts
+  // With sides: dot(F, side_normal), dot(S, ...), dot(T, ...) of each face's axes, and
+  // (kSideTolerance |side_normal|)^2 (side_mask).
+  std::array<std::array<double, 3>, kCubeFaces> side_dots_{};
+  double side_tol2_ = 0;
   std::array<FaceAxes, kCubeFaces> face_axes_{};  // world axes of each face
   TriangleGroups own_groups_;                     // built for this call (no tree, fans)
   const TriangleGroups* groups_ = nullptr;        // the primitives' fans; null: triangles
