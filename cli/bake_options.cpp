@@ -379,7 +379,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--chord-tile-size", a.chord_tile_size,
                   "bsp-leaves, --chord-tiles new: the side of those tiles in pixels (the margin "
                   "is one tile; whole cubes keep the kernel's tiles; default 16)")
-      ->check(in_range(1, 4096));
+      ->check(in_range(1, vislib::kMaxTileSize));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");
@@ -450,7 +450,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--tile", a.tile,
                   "Kernel tile side in pixels; 0: 32 for static scenes, 16 with moving triangles "
                   "or spheres")
-      ->check(in_range(0, 4096))
+      ->check(in_range(0, vislib::kMaxTileSize))
       ->capture_default_str();
   cmd->add_option("--long-segments", a.long_segments,
                   "Run the world-aligned pass of up to this many cell edges lying end to end as "

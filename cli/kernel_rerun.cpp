@@ -45,7 +45,7 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     // Absent: the chords were masked by the kernel's tiles (kStaticTileSize).
     const nlohmann::json tile_size = find_key(md, "chord_tile_size");
     if (!tile_size.is_null() && !(tile_size.is_number_integer() && tile_size.get<int>() >= 1 &&
-                                  tile_size.get<int>() <= 4096))
+                                  tile_size.get<int>() <= vislib::kMaxTileSize))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_tile_size");
     co.adaptive = vislib::AdaptiveSpacing{
         coarse.get<double>(), floor.get<double>(), piece.is_null() ? 0.0 : piece.get<double>(),

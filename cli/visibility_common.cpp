@@ -34,7 +34,7 @@ void add_common(CLI::App* cmd, VisibilityArgs& a) {
   cmd->add_option("--tile", a.tile,
                   "Tile side in pixels (memory/parallelism grain); 0: 32 for static scenes, 16 "
                   "with moving triangles or spheres")
-      ->check(in_range(0, 4096))
+      ->check(in_range(0, vislib::kMaxTileSize))
       ->capture_default_str();
   add_import_options(cmd, a.import);
   cmd->add_option("--states", a.states,

@@ -52,6 +52,10 @@ enum class CoplanarRule { Both, First };
 // 2.5x less memory; the static cases are slower with 16 (docs/performance.md).
 constexpr int kStaticTileSize = 32;
 constexpr int kDynamicTileSize = 16;
+// The largest tile side taken from a user or a file (pixels): a thread's tile scratch holds
+// tile_size^2 pixel lists, so this bounds what one bad number can allocate (about 400 MB of
+// empty lists at 4096).
+constexpr int kMaxTileSize = 4096;
 
 // Tiles along a cube face's side at resolution `n` and tile side `tile_size` (> 0).
 constexpr int tiles_per_side(int n, int tile_size) {
