@@ -685,8 +685,8 @@ class StaticKind {
     const std::array<double, 3>& n = side_dots_[size_t(face)];
     const double sc = pixel_centers_[size_t(x)], tc = pixel_centers_[size_t(y)];
     const double dn = n[0] + n[1] * sc + n[2] * tc;  // dot(d, side_normal), d = F + S sc + T tc
-    const uint8_t mask =
-        dn * dn <= side_tol2_ * (1 + sc * sc + tc * tc) ? uint8_t(3) : dn > 0 ? uint8_t(1) : uint8_t(2);
+    const double tol2 = side_tol2_ * (1 + sc * sc + tc * tc);  // (tolerance |d|)^2
+    const uint8_t mask = uint8_t(dn * dn <= tol2 ? 3 : dn > 0 ? 1 : 2);
     if (opt_.side_only < 0) return mask;
     return uint8_t(mask >> opt_.side_only & 1);
   }
