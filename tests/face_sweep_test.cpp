@@ -197,26 +197,27 @@ TEST(FaceSweep, AdaptiveSweepHandsEachInsertedChordItsParentsNewIds) {
 }
 
 // The tiles toward some triangles hold every pixel where one of them can appear from an eye of
-// the chord (sampled: eyes along it, points of the triangles), and a run on those tiles sees
-// every one of them that the whole run sees; the whole cube (none) where a triangle is not in
-// front of one face from both ends.
+// the chord (sampled: eyes along it, points of the triangles), on every face it spans, and a run
+// on those tiles sees every one of them that the whole run sees; the whole cube (none) only for
+// a triangle that meets the chord.
 TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
   const Scene s = vislib_test::random_soup(400, 5);
   const Segment chord{{-1, 0, 0}, {1, 0.5, 0.3}};
   const int n = 64, ts = 8, tiles = tiles_per_side(n, ts);
   Rng rng(11);
-  size_t masked = 0, whole = 0, flagged = 0;
+  size_t flagged = 0, across = 0;
   for (uint32_t t = 0; t < s.triangle_count(); ++t) {
     const auto m = chord_tiles_toward(s, 0, chord, {t}, n, ts, 0);
-    if (!m) {
-      ++whole;
-      continue;
-    }
-    ++masked;
+    ASSERT_TRUE(m.has_value()) << "triangle " << t << " does not meet the chord";
     ASSERT_EQ(m->size(), size_t(6 * tiles * tiles));
     flagged += size_t(std::count(m->begin(), m->end(), 1));
+    int faces = 0;
+    for (int f = 0; f < 6; ++f)
+      faces += std::any_of(m->begin() + f * tiles * tiles, m->begin() + (f + 1) * tiles * tiles,
+                           [](uint8_t b) { return b != 0; });
+    across += faces > 1;
     const auto c = s.corners(t);
-    for (int k = 0; k < 50; ++k) {
+    for (int k = 0; k < 200; ++k) {
       const Vec3 eye = chord.from + (chord.to - chord.from) * rng.uniform();
       double u = rng.uniform(), v = rng.uniform();
       if (u + v > 1) u = 1 - u, v = 1 - v;
@@ -234,15 +235,30 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
           << "triangle " << t << " face " << f << " pixel " << x << "," << y;
     }
   }
-  EXPECT_GT(masked, 150u);  // of 400: the others cross a face's edge seen from the chord
-  EXPECT_GT(whole, 0u);     // near the chord, across two faces
-  EXPECT_LT(flagged, masked * size_t(6 * tiles * tiles) / 10);  // a small part of the cube
+  EXPECT_GT(across, 50u);  // of 400: seen from the chord across a face's edge
+  EXPECT_LT(flagged, s.triangle_count() * size_t(6 * tiles * tiles) / 10);  // a small part
   EXPECT_FALSE(chord_tiles_toward(s, 0, chord, {}, n, ts, 0).has_value());
+  // A triangle through the chord is seen in every direction around it: the whole cube.
+  const Scene through = vislib_test::soup({{Vec3{0, -1, -1}, Vec3{0, 2, -1}, Vec3{0, -1, 2}}});
+  EXPECT_FALSE(chord_tiles_toward(through, 0, chord, {0}, n, ts, 0).has_value());
+  // A triangle that fills a face's whole view holds none of its corners' images there: the face's
+  // corner rays pass through it, and every tile of the face counts.
+  const Scene wall =
+      vislib_test::soup({{Vec3{-100, -100, 5}, Vec3{100, -100, 5}, Vec3{0, 200, 5}}});
+  const auto w = chord_tiles_toward(wall, 0, Segment{{0, 0, 0}, {0.1, 0, 0}}, {0}, n, ts, 0);
+  ASSERT_TRUE(w.has_value());
+  for (int f = 0; f < 6; ++f) {
+    const double z = face_axes(f, Mat3{}).F.z;
+    if (std::abs(z) < 0.5) continue;  // the sides see its far parts
+    for (int y = 0; y < tiles; ++y)
+      for (int x = 0; x < tiles; ++x)
+        EXPECT_EQ((*w)[tile_mask_index(f, x, y, tiles)], z > 0 ? 1 : 0)
+            << f << " " << x << "," << y;
+  }
 
   // A run on the tiles toward 30 triangles sees each of them that the whole run sees.
   std::vector<uint32_t> some;
-  for (uint32_t t = 0; t < s.triangle_count() && some.size() < 30; t += 7)
-    if (chord_tiles_toward(s, 0, chord, {t}, n, ts, 0)) some.push_back(t);
+  for (uint32_t t = 0; t < s.triangle_count() && some.size() < 30; t += 7) some.push_back(t);
   SegmentOptions o;
   o.resolution = n;
   o.tile_size = ts;

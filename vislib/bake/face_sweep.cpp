@@ -132,6 +132,102 @@ double expected_adaptive_probes(const std::vector<FaceSweep>& sweeps,
   return expected;
 }
 
+namespace {
+
+// Tolerance of the cone tests of chord_tiles_toward (cosine of the angle by which a direction may
+// lie outside a face of the cone and still count as inside): the test only decides whether a
+// cube corner's tile is flagged, so erring inside flags more and stays conservative.
+constexpr double kConeSlack = 1e-9;
+
+// The directions p - e (p a point of a triangle, e an eye of a segment) form the cone over the
+// polytope P = conv{c_i - e_j} (3 corners, 2 ends: 6 points). Within a cube face's frustum that
+// cone is the cone over P ∩ frustum, whose image on the face is the convex hull of its vertices'
+// images: P's vertices inside the frustum, the points where P's edges cross the frustum's planes
+// (both are on the 15 segments between the 6 points, clipped to the frustum), and the frustum's
+// corner rays that pass through P (cone_holds). `box` grows to hold that image, in pixel
+// coordinates.
+struct DirectionCone {
+  Vec3 v[6];
+  Vec3 facet[15];  // the cone's bounding planes found among the pairs (normals pointing in)
+  int facets = 0;
+
+  // False when no pair of the points bounds the cone (the triangle meets the segment: its
+  // directions are not one side of any plane).
+  bool build() {
+    for (int i = 0; i < 6; ++i)
+      for (int j = i + 1; j < 6; ++j) {
+        const Vec3 n = cross(v[i], v[j]);
+        const double ln = length(n);
+        if (!(ln > 1e-12 * length(v[i]) * length(v[j]))) continue;  // parallel: no plane
+        bool pos = true, neg = true;
+        for (int k = 0; k < 6; ++k) {
+          const double d = dot(n, v[k]) / (ln * length(v[k]));
+          pos = pos && d >= -kConeSlack;
+          neg = neg && d <= kConeSlack;
+        }
+        if (pos)
+          facet[facets++] = n * (1 / ln);
+        else if (neg)
+          facet[facets++] = n * (-1 / ln);
+      }
+    return facets > 0;
+  }
+
+  // Whether direction c may lie in the cone (every bounding plane holds it, within kConeSlack):
+  // the planes found contain the cone, so this never says no for a direction in it.
+  bool cone_holds(Vec3 c) const {
+    const double lc = length(c);
+    for (int k = 0; k < facets; ++k)
+      if (dot(facet[k], c) < -kConeSlack * lc) return false;
+    return true;
+  }
+};
+
+// Grows lo/hi (pixel coordinates on `axes`' face, resolution n) by the image of the cone's part in
+// the face's frustum; false when nothing of it lies there.
+bool face_image(const DirectionCone& cone, const FaceAxes& axes, int n, double lo[2],
+                double hi[2]) {
+  bool any = false;
+  auto add = [&](Vec3 d) {
+    const double depth = dot(d, axes.F);
+    if (!(depth > 0)) return;  // the apex only (the frustum holds no other point of depth 0)
+    const double c[2] = {pixel_coord(std::clamp(dot(d, axes.S) / depth, -1.0, 1.0), n),
+                         pixel_coord(std::clamp(dot(d, axes.T) / depth, -1.0, 1.0), n)};
+    for (int k = 0; k < 2; ++k) {
+      lo[k] = std::min(lo[k], c[k]);
+      hi[k] = std::max(hi[k], c[k]);
+    }
+    any = true;
+  };
+  // The frustum: dot(d, F ± S) >= 0 and dot(d, F ± T) >= 0.
+  const Vec3 planes[4] = {axes.F + axes.S, axes.F - axes.S, axes.F + axes.T, axes.F - axes.T};
+  for (int i = 0; i < 6; ++i)
+    for (int j = i; j < 6; ++j) {  // j == i: the point itself
+      const Vec3 a = cone.v[i], b = cone.v[j];
+      double u0 = 0, u1 = 1;
+      for (const Vec3& pl : planes) {  // keep dot(a + u (b - a), pl) >= 0
+        const double ga = dot(a, pl), gb = dot(b, pl);
+        if (ga < 0 && gb < 0) {
+          u0 = 1, u1 = 0;
+          break;
+        }
+        if (ga < 0) u0 = std::max(u0, ga / (ga - gb));
+        if (gb < 0) u1 = std::min(u1, ga / (ga - gb));
+      }
+      if (u0 > u1) continue;
+      add(a + (b - a) * u0);
+      add(a + (b - a) * u1);
+    }
+  for (double s : {-1.0, 1.0})
+    for (double t : {-1.0, 1.0}) {
+      const Vec3 corner = axes.F + axes.S * s + axes.T * t;
+      if (cone.cone_holds(corner)) add(corner);
+    }
+  return any;
+}
+
+}  // namespace
+
 std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_t state,
                                                        const Segment& chord,
                                                        const std::vector<uint32_t>& tris, int n,
@@ -143,33 +239,24 @@ std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_
   FaceAxes axes[kCubeFaces];
   for (int f = 0; f < kCubeFaces; ++f) axes[f] = face_axes(f, Mat3{});
   for (uint32_t t : tris) {
-    int face = -1;
-    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};  // pixel coordinates
+    DirectionCone cone;
+    int k = 0;
     for (const Vec3& eye : {chord.from, chord.to})
-      for (const Vec3& p : scene.corners(t, state)) {
-        const Vec3 d = p - eye;
-        int best = 0;
-        for (int f = 1; f < kCubeFaces; ++f)
-          if (dot(d, axes[f].F) > dot(d, axes[best].F)) best = f;
-        const double depth = dot(d, axes[best].F);
-        if (!(depth > 0) || (face >= 0 && best != face)) return std::nullopt;
-        face = best;
-        const double c[2] = {pixel_coord(dot(d, axes[face].S) / depth, n),
-                             pixel_coord(dot(d, axes[face].T) / depth, n)};
-        for (int k = 0; k < 2; ++k) {
-          lo[k] = std::min(lo[k], c[k]);
-          hi[k] = std::max(hi[k], c[k]);
-        }
+      for (const Vec3& p : scene.corners(t, state)) cone.v[k++] = p - eye;
+    if (!cone.build()) return std::nullopt;
+    for (int face = 0; face < kCubeFaces; ++face) {
+      double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+      if (!face_image(cone, axes[face], n, lo, hi)) continue;
+      int first[2], last[2];  // tiles
+      for (int a = 0; a < 2; ++a) {
+        const int x0 = std::clamp(int(std::floor(lo[a])) - 1, 0, n - 1);
+        const int x1 = std::clamp(int(std::ceil(hi[a])) + 1, 0, n - 1);
+        first[a] = std::max(0, x0 / tile_size - margin);
+        last[a] = std::min(tiles - 1, x1 / tile_size + margin);
       }
-    int first[2], last[2];  // tiles
-    for (int k = 0; k < 2; ++k) {
-      const int x0 = std::clamp(int(std::floor(lo[k])) - 1, 0, n - 1);
-      const int x1 = std::clamp(int(std::ceil(hi[k])) + 1, 0, n - 1);
-      first[k] = std::max(0, x0 / tile_size - margin);
-      last[k] = std::min(tiles - 1, x1 / tile_size + margin);
+      for (int y = first[1]; y <= last[1]; ++y)
+        for (int x = first[0]; x <= last[0]; ++x) mask[tile_mask_index(face, x, y, tiles)] = 1;
     }
-    for (int y = first[1]; y <= last[1]; ++y)
-      for (int x = first[0]; x <= last[0]; ++x) mask[tile_mask_index(face, x, y, tiles)] = 1;
   }
   return mask;
 }

@@ -130,10 +130,11 @@ using SweepEstimate = std::function<void(size_t run, double expected)>;
 // The tiles of a world-aligned cube (SegmentOptions::tile_mask, resolution `n`, tiles of
 // `tile_size` pixels) in which a triangle of `tris` (of `scene` in key state `state`) can cover
 // a pixel's centre seen from an eye of `chord`, one pixel of slack around, grown by `margin`
-// tiles each way; std::nullopt (the whole cube) when a corner of one of them does not lie in
-// front of the same face from both of the chord's ends (nor when `tris` is empty). Conservative:
-// a point's image moves along a line while the eye moves along the chord, so the box of its images
-// from the ends holds every other, and a face's frustum is convex.
+// tiles each way, on every face where it can appear; std::nullopt (the whole cube) when one of
+// them meets the chord (its directions then surround the eyes), and when `tris` is empty.
+// Conservative: the directions from the chord's eyes to a triangle's points are the cone over
+// the convex hull of its corners minus the chord's ends, and a face's part of that cone is the
+// cone over the hull's part inside the face's frustum, whose image the tiles hold.
 std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_t state,
                                                        const Segment& chord,
                                                        const std::vector<uint32_t>& tris, int n,
