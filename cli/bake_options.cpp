@@ -230,15 +230,18 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     if (a.face_sweep.value_or(portals ? "adaptive" : "even") == "adaptive") {
       const vislib::AdaptiveSpacing d =
           portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
+      const std::string tiles = a.chord_tiles.value_or(!d.toward_new  ? "all"
+                                                       : d.every_face ? "new-every-face"
+                                                                      : "new");
       const vislib::AdaptiveSpacing chords{
-          a.chord_coarse.value_or(d.coarse), a.chord_floor.value_or(d.floor),
-          a.chord_piece.value_or(d.piece),
-          a.chord_tiles.value_or(d.toward_new ? "new" : "all") == "new",
-          a.chord_tile_size.value_or(d.tile_size)};
+          a.chord_coarse.value_or(d.coarse),       a.chord_floor.value_or(d.floor),
+          a.chord_piece.value_or(d.piece),         tiles != "all",
+          a.chord_tile_size.value_or(d.tile_size), tiles == "new-every-face"};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
       if (a.chord_tile_size && !chords.toward_new)
-        throw CLI::ValidationError("--chord-tile-size", "only applies with --chord-tiles new");
+        throw CLI::ValidationError("--chord-tile-size",
+                                   "only applies with --chord-tiles new or new-every-face");
       o.adaptive = chords;
     }
     if (!a.leaves.empty()) o.leaves = parse_leaves(a.leaves, vislib::bsp_cell_leaves(bsp));
@@ -371,11 +374,13 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "default 128 with --sweep portals, 0 with faces)")
       ->check(in_range(0.0, 1e6));
   cmd->add_option("--chord-tiles", a.chord_tiles,
-                  "bsp-leaves, adaptive: 'all' (every chord computes its whole cube) or 'new' "
-                  "(a chord inserted because its parent saw new ids computes only the cube tiles "
-                  "where those can appear, one tile around; docs/quake.md); default new with "
-                  "--sweep portals, all with faces")
-      ->check(CLI::IsMember({"all", "new"}));
+                  "bsp-leaves, adaptive: 'all' (every chord computes its whole cube), 'new' (a "
+                  "chord inserted because its parent saw new ids computes only the cube tiles "
+                  "where those can appear, one tile around, or its whole cube when one is seen "
+                  "across a cube face's edge) or 'new-every-face' (those tiles on every face; "
+                  "less CPU, more sampled misses; docs/quake.md); default new with --sweep "
+                  "portals, all with faces")
+      ->check(CLI::IsMember({"all", "new", "new-every-face"}));
   cmd->add_option("--chord-tile-size", a.chord_tile_size,
                   "bsp-leaves, --chord-tiles new: the side of those tiles in pixels (the margin "
                   "is one tile; whole cubes keep the kernel's tiles; default 16)")

@@ -38,9 +38,11 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     if (!piece.is_null() && !(piece.is_number() && piece.get<double>() >= 0))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_piece");
     const nlohmann::json tiles = find_key(md, "chord_tiles");  // absent: all
-    if (!tiles.is_null() && !(tiles == "all" || tiles == "new"))
-      throw vislib::InputError(pvs, "metadata holds an invalid chord_tiles (all or new)");
-    if (tiles == "new" && find_key(md, "chord_tile_margin") != vislib::kChordTileMargin)
+    if (!tiles.is_null() && !(tiles == "all" || tiles == "new" || tiles == "new-every-face"))
+      throw vislib::InputError(
+          pvs, "metadata holds an invalid chord_tiles (all, new or new-every-face)");
+    const bool toward_new = tiles == "new" || tiles == "new-every-face";
+    if (toward_new && find_key(md, "chord_tile_margin") != vislib::kChordTileMargin)
       throw vislib::InputError(pvs, "metadata holds a chord_tile_margin this build cannot re-run");
     // Absent: the chords were masked by the kernel's tiles (kStaticTileSize).
     const nlohmann::json tile_size = find_key(md, "chord_tile_size");
@@ -48,8 +50,12 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
                                   tile_size.get<int>() <= vislib::kMaxTileSize))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_tile_size");
     co.adaptive = vislib::AdaptiveSpacing{
-        coarse.get<double>(), floor.get<double>(), piece.is_null() ? 0.0 : piece.get<double>(),
-        tiles == "new", tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>()};
+        coarse.get<double>(),
+        floor.get<double>(),
+        piece.is_null() ? 0.0 : piece.get<double>(),
+        toward_new,
+        tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>(),
+        tiles == "new-every-face"};
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

@@ -207,7 +207,7 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
   Rng rng(11);
   size_t flagged = 0, across = 0;
   for (uint32_t t = 0; t < s.triangle_count(); ++t) {
-    const auto m = chord_tiles_toward(s, 0, chord, {t}, n, ts, 0);
+    const auto m = chord_tiles_toward(s, 0, chord, {t}, n, ts, 0, true);
     ASSERT_TRUE(m.has_value()) << "triangle " << t << " does not meet the chord";
     ASSERT_EQ(m->size(), size_t(6 * tiles * tiles));
     flagged += size_t(std::count(m->begin(), m->end(), 1));
@@ -236,16 +236,30 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
     }
   }
   EXPECT_GT(across, 50u);  // of 400: seen from the chord across a face's edge
+  // One face: the same tiles where every corner lies in front of one face from both ends, the
+  // whole cube for the others.
+  size_t one_face = 0, whole = 0;
+  for (uint32_t t = 0; t < s.triangle_count(); ++t) {
+    const auto m = chord_tiles_toward(s, 0, chord, {t}, n, ts, 0, false);
+    if (!m) {
+      ++whole;
+      continue;
+    }
+    ++one_face;
+    EXPECT_EQ(*m, *chord_tiles_toward(s, 0, chord, {t}, n, ts, 0, true)) << t;
+  }
+  EXPECT_GT(one_face, 150u);
+  EXPECT_GE(whole, across);
   EXPECT_LT(flagged, s.triangle_count() * size_t(6 * tiles * tiles) / 10);  // a small part
-  EXPECT_FALSE(chord_tiles_toward(s, 0, chord, {}, n, ts, 0).has_value());
+  EXPECT_FALSE(chord_tiles_toward(s, 0, chord, {}, n, ts, 0, true).has_value());
   // A triangle through the chord is seen in every direction around it: the whole cube.
   const Scene through = vislib_test::soup({{Vec3{0, -1, -1}, Vec3{0, 2, -1}, Vec3{0, -1, 2}}});
-  EXPECT_FALSE(chord_tiles_toward(through, 0, chord, {0}, n, ts, 0).has_value());
+  EXPECT_FALSE(chord_tiles_toward(through, 0, chord, {0}, n, ts, 0, true).has_value());
   // A triangle that fills a face's whole view holds none of its corners' images there: the face's
   // corner rays pass through it, and every tile of the face counts.
   const Scene wall =
       vislib_test::soup({{Vec3{-100, -100, 5}, Vec3{100, -100, 5}, Vec3{0, 200, 5}}});
-  const auto w = chord_tiles_toward(wall, 0, Segment{{0, 0, 0}, {0.1, 0, 0}}, {0}, n, ts, 0);
+  const auto w = chord_tiles_toward(wall, 0, Segment{{0, 0, 0}, {0.1, 0, 0}}, {0}, n, ts, 0, true);
   ASSERT_TRUE(w.has_value());
   for (int f = 0; f < 6; ++f) {
     const double z = face_axes(f, Mat3{}).F.z;
@@ -263,7 +277,7 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
   o.resolution = n;
   o.tile_size = ts;
   const SegmentResult all = segment_visibility(s, chord.from, chord.to, o);
-  o.tile_mask = *chord_tiles_toward(s, 0, chord, some, n, ts, 0);
+  o.tile_mask = *chord_tiles_toward(s, 0, chord, some, n, ts, 0, true);
   const SegmentResult toward = segment_visibility(s, chord.from, chord.to, o);
   std::vector<uint32_t> in_all, in_toward;
   std::set_intersection(all.visible.begin(), all.visible.end(), some.begin(), some.end(),

@@ -1350,6 +1350,9 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_FALSE(c.contains("chord_tile_margin"));
   EXPECT_FALSE(c.contains("chord_tile_size"));
   EXPECT_EQ(cells_of("--chord-tile-size 32")["chord_tile_size"], 32);
+  c = cells_of("--chord-tiles new-every-face");
+  EXPECT_EQ(c["chord_tiles"], "new-every-face");
+  EXPECT_EQ(c["chord_tile_size"], kChordTileSize);
   c = cells_of("--face-sweep even");
   EXPECT_EQ(c["face_sweep"], "even");
   EXPECT_FALSE(c.contains("chord_coarse"));
@@ -1468,6 +1471,15 @@ TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourWithWholeCubeChordsHoldTheirRays) 
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256, " --chord-tiles all");
+}
+
+// The same with the tiles toward new ids on every cube face they span (--chord-tiles
+// new-every-face, where the default computes the whole cube for ids seen across a face's edge).
+// Time budget: 20 s wall on the 2-core host.
+TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourWithTilesOnEveryFaceHoldTheirRays) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256, " --chord-tiles new-every-face");
 }
 
 // --leaves picks the listed leaves of a real map: every 10th from 1 to 40, and 3.

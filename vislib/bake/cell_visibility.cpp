@@ -270,9 +270,9 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
       tri.clear();
       for (uint32_t id : fresh[i]) tri.push_back(id >= ids ? id - ids : id);
       if (std::any_of(tri.begin(), tri.end(), [&](uint32_t t) { return t >= tris; })) continue;
-      std::optional<std::vector<uint8_t>> m =
-          chord_tiles_toward(scene, options.segment.state, segs[i], tri, options.segment.resolution,
-                             cells->sweep_spacing.tile_size, kChordTileMargin);
+      std::optional<std::vector<uint8_t>> m = chord_tiles_toward(
+          scene, options.segment.state, segs[i], tri, options.segment.resolution,
+          cells->sweep_spacing.tile_size, kChordTileMargin, cells->sweep_spacing.every_face);
       if (!m) continue;
       masks[i] = std::move(*m);
       any = true;

@@ -231,32 +231,58 @@ bool face_image(const DirectionCone& cone, const FaceAxes& axes, int n, double l
 std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_t state,
                                                        const Segment& chord,
                                                        const std::vector<uint32_t>& tris, int n,
-                                                       int tile_size, int margin) {
+                                                       int tile_size, int margin, bool every_face) {
   assert(n >= 1 && tile_size >= 1 && margin >= 0);
   if (tris.empty()) return std::nullopt;
   const int tiles = tiles_per_side(n, tile_size);
   std::vector<uint8_t> mask(size_t(kCubeFaces) * size_t(tiles) * size_t(tiles), 0);
   FaceAxes axes[kCubeFaces];
   for (int f = 0; f < kCubeFaces; ++f) axes[f] = face_axes(f, Mat3{});
-  for (uint32_t t : tris) {
-    DirectionCone cone;
-    int k = 0;
-    for (const Vec3& eye : {chord.from, chord.to})
-      for (const Vec3& p : scene.corners(t, state)) cone.v[k++] = p - eye;
-    if (!cone.build()) return std::nullopt;
-    for (int face = 0; face < kCubeFaces; ++face) {
-      double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
-      if (!face_image(cone, axes[face], n, lo, hi)) continue;
-      int first[2], last[2];  // tiles
-      for (int a = 0; a < 2; ++a) {
-        const int x0 = std::clamp(int(std::floor(lo[a])) - 1, 0, n - 1);
-        const int x1 = std::clamp(int(std::ceil(hi[a])) + 1, 0, n - 1);
-        first[a] = std::max(0, x0 / tile_size - margin);
-        last[a] = std::min(tiles - 1, x1 / tile_size + margin);
-      }
-      for (int y = first[1]; y <= last[1]; ++y)
-        for (int x = first[0]; x <= last[0]; ++x) mask[tile_mask_index(face, x, y, tiles)] = 1;
+  // Flags the tiles of a box of pixel coordinates on `face`, with the slack and margin.
+  auto flag = [&](int face, const double lo[2], const double hi[2]) {
+    int first[2], last[2];  // tiles
+    for (int a = 0; a < 2; ++a) {
+      const int x0 = std::clamp(int(std::floor(lo[a])) - 1, 0, n - 1);
+      const int x1 = std::clamp(int(std::ceil(hi[a])) + 1, 0, n - 1);
+      first[a] = std::max(0, x0 / tile_size - margin);
+      last[a] = std::min(tiles - 1, x1 / tile_size + margin);
     }
+    for (int y = first[1]; y <= last[1]; ++y)
+      for (int x = first[0]; x <= last[0]; ++x) mask[tile_mask_index(face, x, y, tiles)] = 1;
+  };
+  for (uint32_t t : tris) {
+    if (every_face) {
+      DirectionCone cone;
+      int k = 0;
+      for (const Vec3& eye : {chord.from, chord.to})
+        for (const Vec3& p : scene.corners(t, state)) cone.v[k++] = p - eye;
+      if (!cone.build()) return std::nullopt;
+      for (int face = 0; face < kCubeFaces; ++face) {
+        double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+        if (face_image(cone, axes[face], n, lo, hi)) flag(face, lo, hi);
+      }
+      continue;
+    }
+    // One face: the box of the corners' images from both ends, when they all lie in front of it.
+    int face = -1;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};  // pixel coordinates
+    for (const Vec3& eye : {chord.from, chord.to})
+      for (const Vec3& p : scene.corners(t, state)) {
+        const Vec3 d = p - eye;
+        int best = 0;
+        for (int f = 1; f < kCubeFaces; ++f)
+          if (dot(d, axes[f].F) > dot(d, axes[best].F)) best = f;
+        const double depth = dot(d, axes[best].F);
+        if (!(depth > 0) || (face >= 0 && best != face)) return std::nullopt;
+        face = best;
+        const double c[2] = {pixel_coord(dot(d, axes[face].S) / depth, n),
+                             pixel_coord(dot(d, axes[face].T) / depth, n)};
+        for (int a = 0; a < 2; ++a) {
+          lo[a] = std::min(lo[a], c[a]);
+          hi[a] = std::max(hi[a], c[a]);
+        }
+      }
+    flag(face, lo, hi);
   }
   return mask;
 }

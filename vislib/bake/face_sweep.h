@@ -94,6 +94,10 @@ struct AdaptiveSpacing {
   double piece = 0;
   bool toward_new = false;
   int tile_size = kChordTileSize;
+  // With toward_new: the tiles on every cube face where the new ids can appear, where otherwise a
+  // chord whose parent's new ids are seen across a face's edge computes its whole cube
+  // (chord_tiles_toward).
+  bool every_face = false;
 };
 
 // Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
@@ -130,22 +134,22 @@ using SweepEstimate = std::function<void(size_t run, double expected)>;
 // The tiles of a world-aligned cube (SegmentOptions::tile_mask, resolution `n`, tiles of
 // `tile_size` pixels) in which a triangle of `tris` (of `scene` in key state `state`) can cover
 // a pixel's centre seen from an eye of `chord`, one pixel of slack around, grown by `margin`
-// tiles each way, on every face where it can appear; std::nullopt (the whole cube) when one of
-// them meets the chord (its directions then surround the eyes), and when `tris` is empty.
-// Conservative: the directions from the chord's eyes to a triangle's points are the cone over
-// the convex hull of its corners minus the chord's ends, and a face's part of that cone is the
-// cone over the hull's part inside the face's frustum, whose image the tiles hold.
+// tiles each way; std::nullopt (the whole cube) when `tris` is empty and:
+// - one face (`every_face` false): when a corner of one of them does not lie in front of the same
+//   face from both of the chord's ends. A point's image moves along a line while the eye moves
+//   along the chord, so the box of its images from the ends holds every other, and a face's
+//   frustum is convex.
+// - every face (`every_face`): on each face where one can appear; the whole cube only when one
+//   meets the chord (its directions then surround the eyes). The directions from the chord's eyes
+//   to a triangle's points are the cone over the convex hull of its corners minus the chord's
+//   ends; a face's part of it is the cone over the hull's part inside the face's frustum, whose
+//   image the tiles hold.
+// Conservative either way.
 std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_t state,
                                                        const Segment& chord,
                                                        const std::vector<uint32_t>& tris, int n,
-                                                       int tile_size, int margin);
+                                                       int tile_size, int margin, bool every_face);
 
-// Runs the adaptive sweep of `sweeps` together, round by round: round 0 holds every face's even
-// chords at `spacing.coarse`, round r + 1 the midpoints of the intervals that round r (or, for
-// round 1, the coarse grid with its ends) left open. `bases[f]` (sorted; one per sweep) is what
-// face f's extreme positions see (the region's edges, say). A face's chords depend only on it,
-// its base and what its own chords see. Deterministic: the chords of each round are in face
-// order, then increasing position. Returns the number of chords run.
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
                       const std::vector<std::vector<uint32_t>>& bases, double min_length,
                       const ChordRound& run_round, const SweepEstimate& estimate = {});
