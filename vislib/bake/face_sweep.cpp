@@ -143,9 +143,8 @@ constexpr double kConeSlack = 1e-9;
 // polytope P = conv{c_i - e_j} (3 corners, 2 ends: 6 points). Within a cube face's frustum that
 // cone is the cone over P ∩ frustum, whose image on the face is the convex hull of its vertices'
 // images: P's vertices inside the frustum, the points where P's edges cross the frustum's planes
-// (both are on the 15 segments between the 6 points, clipped to the frustum), and the frustum's
-// corner rays that pass through P (cone_holds). `box` grows to hold that image, in pixel
-// coordinates.
+// (both are ends of the 15 segments between the 6 points, clipped to the frustum), and the
+// frustum's corner rays that pass through P (cone_holds). face_image takes the box of those.
 struct DirectionCone {
   Vec3 v[6];
   Vec3 facet[15];  // the cone's bounding planes found among the pairs (normals pointing in)
