@@ -382,7 +382,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "portals, all with faces")
       ->check(CLI::IsMember({"all", "new", "new-every-face"}));
   cmd->add_option("--chord-tile-size", a.chord_tile_size,
-                  "bsp-leaves, --chord-tiles new: the side of those tiles in pixels (the margin "
+                  "bsp-leaves, --chord-tiles new or new-every-face: the side of those tiles in "
+                  "pixels (the margin "
                   "is one tile; whole cubes keep the kernel's tiles; default 16)")
       ->check(in_range(1, vislib::kMaxTileSize));
   cmd->add_option("--leaves", a.leaves,
