@@ -30,6 +30,15 @@ Preset preset_values(const std::string& name) {
   return {512, 1, 2.0};  // default: the options' own defaults
 }
 
+// --chord-tiles' values, each AdaptiveSpacing::tiles' name.
+std::vector<std::string> chord_tiles_names() {
+  std::vector<std::string> names;
+  for (vislib::ChordTiles t :
+       {vislib::ChordTiles::All, vislib::ChordTiles::New, vislib::ChordTiles::NewEveryFace})
+    names.push_back(vislib::chord_tiles_name(t));
+  return names;
+}
+
 }  // namespace
 
 vislib::Shard parse_shard(const std::string& text) {
@@ -230,16 +239,14 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     if (a.face_sweep.value_or(portals ? "adaptive" : "even") == "adaptive") {
       const vislib::AdaptiveSpacing d =
           portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
-      const std::string tiles = a.chord_tiles.value_or(!d.toward_new  ? "all"
-                                                       : d.every_face ? "new-every-face"
-                                                                      : "new");
       const vislib::AdaptiveSpacing chords{
-          a.chord_coarse.value_or(d.coarse),       a.chord_floor.value_or(d.floor),
-          a.chord_piece.value_or(d.piece),         tiles != "all",
-          a.chord_tile_size.value_or(d.tile_size), tiles == "new-every-face"};
+          a.chord_coarse.value_or(d.coarse), a.chord_floor.value_or(d.floor),
+          a.chord_piece.value_or(d.piece),
+          a.chord_tiles ? *vislib::chord_tiles_named(*a.chord_tiles) : d.tiles,
+          a.chord_tile_size.value_or(d.tile_size)};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
-      if (a.chord_tile_size && !chords.toward_new)
+      if (a.chord_tile_size && chords.tiles == vislib::ChordTiles::All)
         throw CLI::ValidationError("--chord-tile-size",
                                    "only applies with --chord-tiles new or new-every-face");
       o.adaptive = chords;
@@ -380,11 +387,11 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "across a cube face's edge) or 'new-every-face' (those tiles on every face; "
                   "less CPU, more sampled misses; docs/quake.md); default new with --sweep "
                   "portals, all with faces")
-      ->check(CLI::IsMember({"all", "new", "new-every-face"}));
+      ->check(CLI::IsMember(chord_tiles_names()));
   cmd->add_option("--chord-tile-size", a.chord_tile_size,
                   "bsp-leaves, --chord-tiles new or new-every-face: the side of those tiles in "
-                  "pixels (the margin "
-                  "is one tile; whole cubes keep the kernel's tiles; default 16)")
+                  "pixels (the margin is one tile; whole cubes keep the kernel's tiles; default "
+                  "16)")
       ->check(in_range(1, vislib::kMaxTileSize));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "

@@ -44,9 +44,9 @@ struct BakeArgs {
   std::optional<std::string> face_sweep;
   std::string sweep = "portals";  // --sweep portals|faces (bsp-leaves)
   std::string bound = "portals";  // --bound none|portals|map-vis (bsp-leaves, --sweep portals)
-  // --chord-coarse, --chord-floor, --chord-piece, --chord-tiles all|new (adaptive: the last is
-  // AdaptiveSpacing::toward_new); unset: kBspPortalChords with --sweep portals, else
-  // AdaptiveSpacing's defaults.
+  // --chord-coarse, --chord-floor, --chord-piece, --chord-tiles (adaptive: the last is
+  // AdaptiveSpacing::tiles, by chord_tiles_name); unset: kBspPortalChords with --sweep portals,
+  // else AdaptiveSpacing's defaults.
   std::optional<double> chord_coarse, chord_floor, chord_piece;
   std::optional<std::string> chord_tiles;
   std::optional<int> chord_tile_size;      // --chord-tile-size (AdaptiveSpacing::tile_size)

@@ -38,11 +38,15 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     if (!piece.is_null() && !(piece.is_number() && piece.get<double>() >= 0))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_piece");
     const nlohmann::json tiles = find_key(md, "chord_tiles");  // absent: all
-    if (!tiles.is_null() && !(tiles == "all" || tiles == "new" || tiles == "new-every-face"))
+    const std::optional<vislib::ChordTiles> chord_tiles =
+        tiles.is_null()     ? vislib::ChordTiles::All
+        : tiles.is_string() ? vislib::chord_tiles_named(tiles.get<std::string>())
+                            : std::nullopt;
+    if (!chord_tiles)
       throw vislib::InputError(
           pvs, "metadata holds an invalid chord_tiles (all, new or new-every-face)");
-    const bool toward_new = tiles == "new" || tiles == "new-every-face";
-    if (toward_new && find_key(md, "chord_tile_margin") != vislib::kChordTileMargin)
+    if (*chord_tiles != vislib::ChordTiles::All &&
+        find_key(md, "chord_tile_margin") != vislib::kChordTileMargin)
       throw vislib::InputError(pvs, "metadata holds a chord_tile_margin this build cannot re-run");
     // Absent: the chords were masked by the kernel's tiles (kStaticTileSize).
     const nlohmann::json tile_size = find_key(md, "chord_tile_size");
@@ -50,12 +54,8 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
                                   tile_size.get<int>() <= vislib::kMaxTileSize))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_tile_size");
     co.adaptive = vislib::AdaptiveSpacing{
-        coarse.get<double>(),
-        floor.get<double>(),
-        piece.is_null() ? 0.0 : piece.get<double>(),
-        toward_new,
-        tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>(),
-        tiles == "new-every-face"};
+        coarse.get<double>(), floor.get<double>(), piece.is_null() ? 0.0 : piece.get<double>(),
+        *chord_tiles, tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>()};
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

@@ -289,6 +289,16 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
   EXPECT_LT(toward.visible.size(), all.visible.size());
 }
 
+// --chord-tiles and a bake's metadata name each value; a file is read back by the same names, and
+// a name from elsewhere is refused, not taken for a default.
+TEST(FaceSweep, ChordTilesNamesReadBackAsTheirValuesAndNoOtherNameIsOne) {
+  for (ChordTiles t : {ChordTiles::All, ChordTiles::New, ChordTiles::NewEveryFace})
+    EXPECT_EQ(chord_tiles_named(chord_tiles_name(t)), t) << chord_tiles_name(t);
+  EXPECT_STREQ(chord_tiles_name(ChordTiles::NewEveryFace), "new-every-face");
+  for (const char* other : {"", "New", "new ", "every-face", "none"})
+    EXPECT_FALSE(chord_tiles_named(other).has_value()) << other;
+}
+
 // The sweep's estimate of what it runs, which the bake's progress and ETA use: exact at both
 // ends of the refine rate (an interval of 128 over a floor of 8 holds 15 positions of the even
 // grid at 8, one when nothing refines), and, over a face where every probe sees a new id, exact

@@ -1266,7 +1266,8 @@ TEST(QuakeBake, AdaptivePortalSweepInsertsTheSameChordsForBothLeavesAndRunsEachO
     o.scene.bsp_liquids = BspLiquids::see_through;
     o.sweep = BspSweep::Portals;
     // -1: whole chords, each inserted chord looking only toward its parent's new ids.
-    o.adaptive = AdaptiveSpacing{32, 2, std::max(piece, 0.0), piece < 0};
+    o.adaptive =
+        AdaptiveSpacing{32, 2, std::max(piece, 0.0), piece < 0 ? ChordTiles::New : ChordTiles::All};
     const ViewCells cells = bsp_leaf_cells(m, o, &scene);
     ASSERT_EQ(cells.sweeps.size(), 2u);
     ASSERT_EQ(cells.sweeps[0].size(), cells.sweeps[1].size());

@@ -367,10 +367,8 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
     d["chord_coarse"] = options.adaptive->coarse;
     d["chord_floor"] = options.adaptive->floor;
     d["chord_piece"] = options.adaptive->piece;
-    d["chord_tiles"] = !options.adaptive->toward_new  ? "all"
-                       : options.adaptive->every_face ? "new-every-face"
-                                                      : "new";
-    if (options.adaptive->toward_new) {
+    d["chord_tiles"] = chord_tiles_name(options.adaptive->tiles);
+    if (options.adaptive->tiles != ChordTiles::All) {
       d["chord_tile_margin"] = kChordTileMargin;
       d["chord_tile_size"] = options.adaptive->tile_size;
     }

@@ -59,7 +59,7 @@ constexpr double kBspPortalSpacing = 8.0;
 // tiles lie on one face (a chord whose parent's new ids are seen across a face's edge computes its
 // whole cube): on every face they cost 0.70-0.76 of the CPU on e1m2 and e2m3 whole for 1.2-1.4
 // times the sampled misses.
-constexpr AdaptiveSpacing kBspPortalChords{128.0, 4.0, 128.0, true};
+constexpr AdaptiveSpacing kBspPortalChords{128.0, 4.0, 128.0, ChordTiles::New};
 
 // The segments a convex region's visibility is computed on (Quake coordinates in, scene
 // coordinates out, quake_to_scene): first every edge of every face of `region`, in face order and

@@ -253,12 +253,12 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   if (!adaptive) return;
   for (size_t f = 0; f < sweeps.size(); ++f)
     if (sweeps[f].side_normal == Vec3{0, 0, 0}) bases[f] = base;
-  // A chord below a probe that saw new ids looks only toward them (AdaptiveSpacing::toward_new):
+  // A chord below a probe that saw new ids looks only toward them (AdaptiveSpacing::tiles):
   // the tiles of its run 0 where they can appear (chord_tiles_toward, tiles of
   // AdaptiveSpacing::tile_size pixels), a sided run's ids of either side being triangles; the whole
   // cube when one is a sphere.
-  const bool toward_new =
-      cells && cells->sweep_spacing.toward_new && scene.sphere_count() == 0 && !scene.is_dynamic();
+  const bool toward_new = cells && cells->sweep_spacing.tiles != ChordTiles::All &&
+                          scene.sphere_count() == 0 && !scene.is_dynamic();
   auto tiles_toward = [&](const std::vector<Segment>& segs,
                           const std::vector<std::vector<uint32_t>>& fresh) {
     std::vector<std::vector<uint8_t>> masks;
@@ -270,9 +270,10 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
       tri.clear();
       for (uint32_t id : fresh[i]) tri.push_back(id >= ids ? id - ids : id);
       if (std::any_of(tri.begin(), tri.end(), [&](uint32_t t) { return t >= tris; })) continue;
-      std::optional<std::vector<uint8_t>> m = chord_tiles_toward(
-          scene, options.segment.state, segs[i], tri, options.segment.resolution,
-          cells->sweep_spacing.tile_size, kChordTileMargin, cells->sweep_spacing.every_face);
+      std::optional<std::vector<uint8_t>> m =
+          chord_tiles_toward(scene, options.segment.state, segs[i], tri, options.segment.resolution,
+                             cells->sweep_spacing.tile_size, kChordTileMargin,
+                             cells->sweep_spacing.tiles == ChordTiles::NewEveryFace);
       if (!m) continue;
       masks[i] = std::move(*m);
       any = true;

@@ -100,6 +100,28 @@ double even_position(const FaceSweep& sweep, int k, int steps) {
 
 }  // namespace
 
+namespace {
+
+constexpr std::pair<ChordTiles, const char*> kChordTilesNames[] = {
+    {ChordTiles::All, "all"},
+    {ChordTiles::New, "new"},
+    {ChordTiles::NewEveryFace, "new-every-face"}};
+
+}  // namespace
+
+const char* chord_tiles_name(ChordTiles tiles) {
+  for (const auto& [value, name] : kChordTilesNames)
+    if (value == tiles) return name;
+  assert(false);
+  return "";
+}
+
+std::optional<ChordTiles> chord_tiles_named(std::string_view name) {
+  for (const auto& [value, n] : kChordTilesNames)
+    if (name == n) return value;
+  return std::nullopt;
+}
+
 std::vector<Segment> even_chords(const FaceSweep& sweep, double spacing, double min_length) {
   assert(spacing > 0);
   std::vector<Segment> out;
@@ -138,6 +160,10 @@ namespace {
 // lie outside a face of the cone and still count as inside): the test only decides whether a
 // cube corner's tile is flagged, so erring inside flags more and stays conservative.
 constexpr double kConeSlack = 1e-9;
+// Sine of the angle under which two of the cone's points count as parallel and bound no plane:
+// their cross product's direction is then rounding noise. Skipping a pair only drops a candidate
+// plane, so cone_holds says yes more often.
+constexpr double kConeParallel = 1e-12;
 
 // The directions p - e (p a point of a triangle, e an eye of a segment) form the cone over the
 // polytope P = conv{c_i - e_j} (3 corners, 2 ends: 6 points). Within a cube face's frustum that
@@ -153,14 +179,16 @@ struct DirectionCone {
   // False when no pair of the points bounds the cone (the triangle meets the segment: its
   // directions are not one side of any plane).
   bool build() {
+    double lv[6];
+    for (int k = 0; k < 6; ++k) lv[k] = length(v[k]);
     for (int i = 0; i < 6; ++i)
       for (int j = i + 1; j < 6; ++j) {
         const Vec3 n = cross(v[i], v[j]);
         const double ln = length(n);
-        if (!(ln > 1e-12 * length(v[i]) * length(v[j]))) continue;  // parallel: no plane
+        if (!(ln > kConeParallel * lv[i] * lv[j])) continue;  // parallel: no plane
         bool pos = true, neg = true;
         for (int k = 0; k < 6; ++k) {
-          const double d = dot(n, v[k]) / (ln * length(v[k]));
+          const double d = dot(n, v[k]) / (ln * lv[k]);
           pos = pos && d >= -kConeSlack;
           neg = neg && d <= kConeSlack;
         }
@@ -201,7 +229,7 @@ bool face_image(const DirectionCone& cone, const FaceAxes& axes, int n, double l
   // The frustum: dot(d, F ± S) >= 0 and dot(d, F ± T) >= 0.
   const Vec3 planes[4] = {axes.F + axes.S, axes.F - axes.S, axes.F + axes.T, axes.F - axes.T};
   for (int i = 0; i < 6; ++i)
-    for (int j = i; j < 6; ++j) {  // j == i: the point itself
+    for (int j = i + 1; j < 6; ++j) {  // every point ends 5 of the 15 segments
       const Vec3 a = cone.v[i], b = cone.v[j];
       double u0 = 0, u1 = 1;
       for (const Vec3& pl : planes) {  // keep dot(a + u (b - a), pl) >= 0

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <functional>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "vislib/base/vec.h"
@@ -77,6 +78,18 @@ constexpr int kChordTileMargin = 1;
 // (docs/quake.md).
 constexpr int kChordTileSize = 16;
 
+// What a chord inserted below a probe that saw new ids computes:
+// - All: its whole cube, as every other chord;
+// - New: the tiles of one cube face where those ids can appear, or its whole cube when one of
+//   them is seen across a face's edge;
+// - NewEveryFace: the tiles on every cube face where they can appear (chord_tiles_toward).
+enum class ChordTiles { All, New, NewEveryFace };
+
+// The name of each value in `pvs bake --chord-tiles` and in a bake's metadata ("all", "new",
+// "new-every-face"), and the value of a name (std::nullopt for any other string).
+const char* chord_tiles_name(ChordTiles tiles);
+std::optional<ChordTiles> chord_tiles_named(std::string_view name);
+
 // The spacings of the adaptive sweep (the sweeps' units): the first chords lie at most `coarse`
 // apart (the even sweep's positions); a chord is inserted midway between two neighbours (a face's
 // own extreme positions count as neighbours that see its base, below) whose distance is larger
@@ -84,20 +97,15 @@ constexpr int kChordTileSize = 16;
 // that neither neighbour saw. 0 < floor <= coarse. With `piece` > 0 each swept face is first cut
 // into strips at most `piece` long along its chords (sweep_strips), each refined on its own, so a
 // long chord's probes go on only over the stretches where new ids are seen (0: whole chords).
-// With `toward_new` a chord inserted below a probe that saw new ids looks only toward those
-// (the caller's choice of how: the bake runs it on the cube tiles of `tile_size` pixels where they
-// can appear, chord_tiles_toward); the sweep itself only hands each chord its parent's new ids
-// (ChordRound).
+// With `tiles` other than All a chord inserted below a probe that saw new ids looks only toward
+// those (the bake runs it on the cube tiles of `tile_size` pixels where they can appear,
+// chord_tiles_toward); the sweep itself only hands each chord its parent's new ids (ChordRound).
 struct AdaptiveSpacing {
   double coarse = 64;
   double floor = 4;
   double piece = 0;
-  bool toward_new = false;
+  ChordTiles tiles = ChordTiles::All;
   int tile_size = kChordTileSize;
-  // With toward_new: the tiles on every cube face where the new ids can appear, where otherwise a
-  // chord whose parent's new ids are seen across a face's edge computes its whole cube
-  // (chord_tiles_toward).
-  bool every_face = false;
 };
 
 // Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
