@@ -201,9 +201,9 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   static const char* const kWalkableOnly[] = {"--walkable-from", "--agent-height", "--agent-radius",
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
-    for (const char* o :
-         {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor",
-          "--chord-piece", "--chord-tiles", "--chord-tile-size", "--sweep", "--bound"})
+    for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
+                          "--chord-floor", "--chord-piece", "--chord-tiles", "--chord-tile-size",
+                          "--chord-cross", "--sweep", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -240,10 +240,12 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
       const vislib::AdaptiveSpacing d =
           portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
       const vislib::AdaptiveSpacing chords{
-          a.chord_coarse.value_or(d.coarse), a.chord_floor.value_or(d.floor),
+          a.chord_coarse.value_or(d.coarse),
+          a.chord_floor.value_or(d.floor),
           a.chord_piece.value_or(d.piece),
           a.chord_tiles ? *vislib::chord_tiles_named(*a.chord_tiles) : d.tiles,
-          a.chord_tile_size.value_or(d.tile_size)};
+          a.chord_tile_size.value_or(d.tile_size),
+          a.chord_cross ? *a.chord_cross == "on" : d.crossed};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
       if (a.chord_tile_size && chords.tiles == vislib::ChordTiles::All)
@@ -393,6 +395,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "pixels (the margin is one tile; whole cubes keep the kernel's tiles; default "
                   "16)")
       ->check(in_range(1, vislib::kMaxTileSize));
+  cmd->add_option("--chord-cross", a.chord_cross,
+                  "bsp-leaves, adaptive: 'on' also sweeps each polygon with chords perpendicular "
+                  "to the first, refined the same way (a slit seen through a thin patch of a "
+                  "portal is crossed by one of the two; more CPU, fewer sampled misses; "
+                  "docs/quake.md); default off")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

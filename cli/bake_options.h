@@ -50,6 +50,7 @@ struct BakeArgs {
   std::optional<double> chord_coarse, chord_floor, chord_piece;
   std::optional<std::string> chord_tiles;
   std::optional<int> chord_tile_size;      // --chord-tile-size (AdaptiveSpacing::tile_size)
+  std::optional<std::string> chord_cross;  // --chord-cross on|off (AdaptiveSpacing::crossed)
   std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
   std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)

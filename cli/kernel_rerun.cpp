@@ -53,9 +53,16 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
     if (!tile_size.is_null() && !(tile_size.is_number_integer() && tile_size.get<int>() >= 1 &&
                                   tile_size.get<int>() <= vislib::kMaxTileSize))
       throw vislib::InputError(pvs, "metadata holds an invalid chord_tile_size");
+    const nlohmann::json crossed = find_key(md, "chord_crossed");  // absent: one family
+    if (!crossed.is_null() && !crossed.is_boolean())
+      throw vislib::InputError(pvs, "metadata holds an invalid chord_crossed");
     co.adaptive = vislib::AdaptiveSpacing{
-        coarse.get<double>(), floor.get<double>(), piece.is_null() ? 0.0 : piece.get<double>(),
-        *chord_tiles, tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>()};
+        coarse.get<double>(),
+        floor.get<double>(),
+        piece.is_null() ? 0.0 : piece.get<double>(),
+        *chord_tiles,
+        tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>(),
+        !crossed.is_null() && crossed.get<bool>()};
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

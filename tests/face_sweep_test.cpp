@@ -289,6 +289,30 @@ TEST(FaceSweep, ChordTilesTowardTrianglesHoldEveryPixelTheyCoverFromTheChord) {
   EXPECT_LT(toward.visible.size(), all.visible.size());
 }
 
+// The crossed sweep of a face runs its chords perpendicular to the first family's, over the same
+// face from one extreme to the other, on the same side.
+TEST(FaceSweep, CrossedSweepChordsArePerpendicularAndSpanTheFace) {
+  const std::vector<Vec3> face = {{0, 0, 0}, {8, 0, 0}, {8, 0, 2}, {0, 0, 2}};
+  std::optional<FaceSweep> s = face_sweep_of(face, {0, 1, 0}, kSweepMinChord);
+  ASSERT_TRUE(s.has_value());
+  s->side_normal = {0, 1, 0};
+  s->side = 1;
+  const FaceSweep x = crossed_sweep(*s);
+  EXPECT_NEAR(std::abs(dot(x.along, s->along)), 0, 1e-12);
+  EXPECT_NEAR(std::abs(dot(x.along, s->across)), 1, 1e-12);
+  EXPECT_EQ(x.side_normal, s->side_normal);
+  EXPECT_EQ(x.side, 1);
+  EXPECT_NEAR(x.hi - x.lo, 8, 1e-12);  // the first chords run along the long edge, 8
+  EXPECT_NEAR(s->hi - s->lo, 2, 1e-12);
+  for (double h : {x.lo + 1, x.lo + 4, x.hi - 1}) {
+    std::optional<Segment> c = face_chord(x, h, kSweepMinChord);
+    ASSERT_TRUE(c.has_value()) << h;
+    EXPECT_NEAR(length(c->to - c->from), 2, 1e-12) << h;  // across the face's short side
+    EXPECT_NEAR(dot(c->to - c->from, s->along), 0, 1e-12) << h;
+    EXPECT_EQ(c->side, 1);
+  }
+}
+
 // --chord-tiles and a bake's metadata name each value; a file is read back by the same names, and
 // a name from elsewhere is refused, not taken for a default.
 TEST(FaceSweep, ChordTilesNamesReadBackAsTheirValuesAndNoOtherNameIsOne) {

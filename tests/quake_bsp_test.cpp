@@ -1354,6 +1354,9 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   c = cells_of("--chord-tiles new-every-face");
   EXPECT_EQ(c["chord_tiles"], "new-every-face");
   EXPECT_EQ(c["chord_tile_size"], kChordTileSize);
+  EXPECT_EQ(c.contains("chord_crossed"), kBspPortalChords.crossed);
+  EXPECT_EQ(cells_of("--chord-cross on")["chord_crossed"], true);
+  EXPECT_FALSE(cells_of("--chord-cross off").contains("chord_crossed"));
   c = cells_of("--face-sweep even");
   EXPECT_EQ(c["face_sweep"], "even");
   EXPECT_FALSE(c.contains("chord_coarse"));
@@ -1481,6 +1484,42 @@ TEST(QuakeBakeLibreQuake, Lqdm1LeavesOneToFourWithTilesOnEveryFaceHoldTheirRays)
   auto path = librequake("lqdm1.bsp");
   if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
   bake_lqdm1_and_cast(*path, "1-4", 4, 16, 256, " --chord-tiles new-every-face");
+}
+
+// Crossed chords (--chord-cross on): lqdm1's leaves 132, 162 and 243 see triangles 4066, 2869
+// and 350 through patches of their portals that are thin across the chords parallel to a
+// portal's longest edge, so no chord of that family lands on them; rays from random eyes of the
+// leaves hit them (`pvs vis-compare lqdm1.bsp OUT.pvs`, 4 eyes a leaf, on the whole map's default
+// bake). The perpendicular family crosses those patches, and the sets keep everything the first
+// family found. Time budget: 20 s wall on the 2-core host.
+TEST(QuakeBakeLibreQuake, CrossedChordsFindWhatIsSeenThroughPatchesThinAcrossTheFirstChords) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  const std::string dir = temp_dir("quake_bake_crossed");
+  const std::pair<uint32_t, uint32_t> seen[] = {{132, 4066}, {162, 2869}, {243, 350}};
+  std::vector<std::vector<uint32_t>> sets[2];
+  for (int crossed = 0; crossed < 2; ++crossed) {
+    const std::string pvs = dir + "/c" + std::to_string(crossed) + ".pvs";
+    std::string out;
+    ASSERT_EQ(
+        run_pvs("bake -q " + *path + " --cells bsp-leaves --res 128 -j 2 --leaves 132,162,243 -o " +
+                    pvs + (crossed ? " --chord-cross on" : ""),
+                &out),
+        0)
+        << out;
+    pvs::Reader r = pvs::Reader::from_memory(read_file(pvs));
+    ASSERT_EQ(r.cell_count(), 3u);
+    for (uint32_t c = 0; c < 3; ++c) {
+      ASSERT_EQ(r.info().layout.cell_leaf[c], seen[c].first);
+      sets[crossed].push_back(r.read_cell(c));
+    }
+  }
+  for (uint32_t c = 0; c < 3; ++c) {
+    const std::vector<uint32_t>&one = sets[0][c], &both = sets[1][c];
+    EXPECT_TRUE(std::includes(both.begin(), both.end(), one.begin(), one.end())) << c;
+    EXPECT_FALSE(std::binary_search(one.begin(), one.end(), seen[c].second)) << c;
+    EXPECT_TRUE(std::binary_search(both.begin(), both.end(), seen[c].second)) << c;
+  }
 }
 
 // --leaves picks the listed leaves of a real map: every 10th from 1 to 40, and 3.

@@ -46,13 +46,19 @@ FaceSweep scene_sweep(FaceSweep s) {
   return s;
 }
 
-// Appends `sweep` to `out`, cut into strips at most `piece` long when piece > 0 (AdaptiveSpacing).
-void add_sweep(std::vector<FaceSweep>& out, const FaceSweep& sweep, double piece) {
-  if (!(piece > 0)) {
-    out.push_back(sweep);
-    return;
+// Appends `sweep` to `out`, cut into strips at most `spacing.piece` long when that is > 0, then
+// with `spacing.crossed` its crossed sweep, cut the same way (AdaptiveSpacing).
+void add_sweep(std::vector<FaceSweep>& out, const FaceSweep& sweep,
+               const AdaptiveSpacing& spacing) {
+  for (const FaceSweep& family : spacing.crossed
+                                     ? std::vector<FaceSweep>{sweep, crossed_sweep(sweep)}
+                                     : std::vector<FaceSweep>{sweep}) {
+    if (!(spacing.piece > 0)) {
+      out.push_back(family);
+      continue;
+    }
+    for (FaceSweep& s : sweep_strips(family, spacing.piece)) out.push_back(std::move(s));
   }
-  for (FaceSweep& s : sweep_strips(sweep, piece)) out.push_back(std::move(s));
 }
 
 }  // namespace
@@ -254,7 +260,7 @@ void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& piece
         FaceSweep f = scene_sweep(*sweep);
         f.side_normal = normal;
         f.side = side;
-        add_sweep(cells.sweeps[c], f, options.adaptive->piece);
+        add_sweep(cells.sweeps[c], f, *options.adaptive);
       }
       if (bounded) {
         cells.segment_bound[c].resize(cells.segments[c].size(), uint32_t(index));
@@ -317,7 +323,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
     cells.segments[c].insert(cells.segments[c].end(), s.begin(), s.end());
     if (options.adaptive)
       for (const FaceSweep& f : region_sweeps(region.volume))
-        add_sweep(cells.sweeps[c], scene_sweep(f), options.adaptive->piece);
+        add_sweep(cells.sweeps[c], scene_sweep(f), *options.adaptive);
   }
   for (std::vector<ViewCells::OwnTriangle>& own : cells.own) {  // a leaf of several pieces
     std::stable_sort(own.begin(), own.end(),
@@ -372,6 +378,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
       d["chord_tile_margin"] = kChordTileMargin;
       d["chord_tile_size"] = options.adaptive->tile_size;
     }
+    if (options.adaptive->crossed) d["chord_crossed"] = true;
   }
   cells.description = d.dump();
   return cells;

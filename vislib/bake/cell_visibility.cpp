@@ -45,10 +45,12 @@ std::vector<Box3> band_rectangles(const Box3& region, int levels) {
 
 SegmentRunCache::Key sweep_family_key(const FaceSweep& sweep) {
   assert(sweep.face.size() >= 2);
-  // A strip's window tells it from the face's other strips.
+  // A strip's window tells it from the face's other strips, `across` the face's crossed sweep
+  // from its first (crossed_sweep).
   const auto end = [](double t) { return std::isfinite(t) ? t : 0.0; };
   return SegmentRunCache::key_of(sweep.face[0] + sweep.along * end(sweep.t_lo),
-                                 sweep.face[1] + sweep.along * end(sweep.t_hi), sweep.side_normal);
+                                 sweep.face[1] + sweep.along * end(sweep.t_hi) + sweep.across,
+                                 sweep.side_normal);
 }
 
 std::vector<Segment> cell_boundary_segments(const Box3& view_region, int levels) {

@@ -86,6 +86,19 @@ std::vector<FaceSweep> sweep_strips(const FaceSweep& sweep, double length) {
   return out;
 }
 
+FaceSweep crossed_sweep(const FaceSweep& sweep) {
+  FaceSweep out = sweep;
+  out.along = sweep.across;
+  out.across = sweep.along * -1.0;  // along x across keeps the face's normal
+  out.lo = INFINITY, out.hi = -INFINITY;
+  for (const Vec3& p : sweep.face) {
+    out.lo = std::min(out.lo, dot(out.across, p));
+    out.hi = std::max(out.hi, dot(out.across, p));
+  }
+  out.t_lo = -INFINITY, out.t_hi = INFINITY;
+  return out;
+}
+
 namespace {
 
 // The even grid's interval count over the sweep's width at most `spacing` apart (>= 1).

@@ -58,6 +58,12 @@ std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_l
 // ending where the next begins). One strip, `sweep` itself, when the face is not longer.
 std::vector<FaceSweep> sweep_strips(const FaceSweep& sweep, double length);
 
+// The sweep of `sweep`'s face by chords perpendicular to its chords (along becomes across), over
+// the whole face, with the same side_normal and side. What a polygon's points see in one direction
+// d is seen from a patch of it (the visible parts' shadow along d); a patch thin across one
+// family's chords, a slit's, is long along them, and the other family crosses it.
+FaceSweep crossed_sweep(const FaceSweep& sweep);
+
 // The even sweep: chords at h = lo + k (hi - lo) / n, k = 1 .. n - 1, with n = ceil((hi - lo) /
 // spacing) (at most `spacing` apart), in increasing k; none when the width is not larger than
 // spacing. `spacing` > 0.
@@ -100,12 +106,15 @@ std::optional<ChordTiles> chord_tiles_named(std::string_view name);
 // With `tiles` other than All a chord inserted below a probe that saw new ids looks only toward
 // those (the bake runs it on the cube tiles of `tile_size` pixels where they can appear,
 // chord_tiles_toward); the sweep itself only hands each chord its parent's new ids (ChordRound).
+// With `crossed` each face is also swept by chords perpendicular to the first (crossed_sweep),
+// refined on their own: a second family of sweeps over the same faces, with the same base.
 struct AdaptiveSpacing {
   double coarse = 64;
   double floor = 4;
   double piece = 0;
   ChordTiles tiles = ChordTiles::All;
   int tile_size = kChordTileSize;
+  bool crossed = false;
 };
 
 // Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
