@@ -386,8 +386,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "bsp-leaves, adaptive: 'all' (every chord computes its whole cube), 'new' (a "
                   "chord inserted because its parent saw new ids computes only the cube tiles "
                   "where those can appear, one tile around, or its whole cube when one is seen "
-                  "across a cube face's edge) or 'new-every-face' (those tiles on every face; "
-                  "less CPU, more sampled misses; docs/quake.md); default new with --sweep "
+                  "across a cube face's edge) or 'new-every-face' (those tiles on every face "
+                  "where they can appear; docs/quake.md); default new-every-face with --sweep "
                   "portals, all with faces")
       ->check(CLI::IsMember(chord_tiles_names()));
   cmd->add_option("--chord-tile-size", a.chord_tile_size,
@@ -398,8 +398,8 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--chord-cross", a.chord_cross,
                   "bsp-leaves, adaptive: 'on' also sweeps each polygon with chords perpendicular "
                   "to the first, refined the same way (a slit seen through a thin patch of a "
-                  "portal is crossed by one of the two; more CPU, fewer sampled misses; "
-                  "docs/quake.md); default off")
+                  "portal is crossed by one of the two; docs/quake.md); default on with --sweep "
+                  "portals, off with faces")
       ->check(CLI::IsMember({"on", "off"}));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
