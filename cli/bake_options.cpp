@@ -30,15 +30,6 @@ Preset preset_values(const std::string& name) {
   return {512, 1, 2.0};  // default: the options' own defaults
 }
 
-// --chord-tiles' values, each AdaptiveSpacing::tiles' name.
-std::vector<std::string> chord_tiles_names() {
-  std::vector<std::string> names;
-  for (vislib::ChordTiles t :
-       {vislib::ChordTiles::All, vislib::ChordTiles::New, vislib::ChordTiles::NewEveryFace})
-    names.push_back(vislib::chord_tiles_name(t));
-  return names;
-}
-
 }  // namespace
 
 vislib::Shard parse_shard(const std::string& text) {
@@ -203,7 +194,7 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   if (a.cells != "bsp-leaves") {
     for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
                           "--chord-floor", "--chord-piece", "--chord-tiles", "--chord-tile-size",
-                          "--chord-cross", "--sweep", "--bound"})
+                          "--chord-cross", "--chord-cross-floor", "--sweep", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -239,7 +230,7 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
     if (a.face_sweep.value_or(portals ? "adaptive" : "even") == "adaptive") {
       const vislib::AdaptiveSpacing d =
           portals ? vislib::kBspPortalChords : vislib::AdaptiveSpacing{};
-      const vislib::AdaptiveSpacing chords{
+      vislib::AdaptiveSpacing chords{
           a.chord_coarse.value_or(d.coarse),
           a.chord_floor.value_or(d.floor),
           a.chord_piece.value_or(d.piece),
@@ -248,6 +239,14 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
           a.chord_cross ? *a.chord_cross == "on" : d.crossed};
       if (!(chords.floor <= chords.coarse))
         throw CLI::ValidationError("--chord-floor", "must not exceed --chord-coarse");
+      // Unset: the default's, kept between the floor and the coarse spacing given.
+      chords.crossed_floor = a.chord_cross_floor.value_or(
+          std::min(chords.coarse, std::max(chords.floor, d.crossed_floor)));
+      if (a.chord_cross_floor && !chords.crossed)
+        throw CLI::ValidationError("--chord-cross-floor", "only applies with --chord-cross on");
+      if (!(chords.floor <= chords.crossed_floor && chords.crossed_floor <= chords.coarse))
+        throw CLI::ValidationError("--chord-cross-floor",
+                                   "must lie between --chord-floor and --chord-coarse");
       if (a.chord_tile_size && chords.tiles == vislib::ChordTiles::All)
         throw CLI::ValidationError("--chord-tile-size",
                                    "only applies with --chord-tiles new or new-every-face");
@@ -389,7 +388,10 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "across a cube face's edge) or 'new-every-face' (those tiles on every face "
                   "where they can appear; docs/quake.md); default new-every-face with --sweep "
                   "portals, all with faces")
-      ->check(CLI::IsMember(chord_tiles_names()));
+      ->check(CLI::IsMember([] {
+        const std::vector<std::string_view> names = vislib::chord_tiles_names();
+        return std::vector<std::string>(names.begin(), names.end());
+      }()));
   cmd->add_option("--chord-tile-size", a.chord_tile_size,
                   "bsp-leaves, --chord-tiles new or new-every-face: the side of those tiles in "
                   "pixels (the margin is one tile; whole cubes keep the kernel's tiles; default "
@@ -401,6 +403,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "portal is crossed by one of the two; docs/quake.md); default on with --sweep "
                   "portals, off with faces")
       ->check(CLI::IsMember({"on", "off"}));
+  cmd->add_option("--chord-cross-floor", a.chord_cross_floor,
+                  "bsp-leaves, --chord-cross on: no crossed chord is inserted closer than this to "
+                  "a neighbour (Quake units, between --chord-floor and --chord-coarse; the "
+                  "patches the crossed chords are there for are long across them; default 16 "
+                  "with --sweep portals, else --chord-floor)")
+      ->check(in_range(1e-3, 1e6));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

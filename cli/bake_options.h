@@ -49,12 +49,13 @@ struct BakeArgs {
   // else AdaptiveSpacing's defaults.
   std::optional<double> chord_coarse, chord_floor, chord_piece;
   std::optional<std::string> chord_tiles;
-  std::optional<int> chord_tile_size;      // --chord-tile-size (AdaptiveSpacing::tile_size)
-  std::optional<std::string> chord_cross;  // --chord-cross on|off (AdaptiveSpacing::crossed)
-  std::vector<std::string> walkable_from;  // --walkable-from x,y,z (repeatable)
-  std::optional<int> band_levels;          // --band-levels (grid and walkable cells)
-  std::string wall_traces;                 // --wall-traces on|off ("": the placement's default)
-  std::string vertical_edges;              // --vertical-edges on|off ("": the placement's default)
+  std::optional<int> chord_tile_size;       // --chord-tile-size (AdaptiveSpacing::tile_size)
+  std::optional<std::string> chord_cross;   // --chord-cross on|off (AdaptiveSpacing::crossed)
+  std::optional<double> chord_cross_floor;  // --chord-cross-floor (AdaptiveSpacing::crossed_floor)
+  std::vector<std::string> walkable_from;   // --walkable-from x,y,z (repeatable)
+  std::optional<int> band_levels;           // --band-levels (grid and walkable cells)
+  std::string wall_traces;                  // --wall-traces on|off ("": the placement's default)
+  std::string vertical_edges;               // --vertical-edges on|off ("": the placement's default)
   double agent_height = NAN, agent_radius = NAN, agent_step = NAN;  // --agent-*: NaN = default
 };
 

@@ -63,6 +63,14 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
         *chord_tiles,
         tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>(),
         !crossed.is_null() && crossed.get<bool>()};
+    // Absent: the crossed chords went down to the floor (crossed_floor 0).
+    const nlohmann::json cross_floor = find_key(md, "chord_cross_floor");
+    if (!cross_floor.is_null()) {
+      if (!cross_floor.is_number() || !(cross_floor.get<double>() >= co.adaptive->floor) ||
+          !(cross_floor.get<double>() <= co.adaptive->coarse))
+        throw vislib::InputError(pvs, "metadata holds an invalid chord_cross_floor");
+      co.adaptive->crossed_floor = cross_floor.get<double>();
+    }
   }
   co.leaves = cell_leaf;
   co.scene = scene_options;

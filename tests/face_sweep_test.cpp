@@ -313,11 +313,56 @@ TEST(FaceSweep, CrossedSweepChordsArePerpendicularAndSpanTheFace) {
   }
 }
 
+// The crossed family stops at its own floor: over a face where every probe sees a new id, the
+// first family's chords reach the floor (4) and the crossed family's stop at 16, each foreseen by
+// the estimate; with crossed_floor 0 both reach 4.
+TEST(FaceSweep, CrossedChordsAreInsertedDownToTheCrossedFloorOnly) {
+  uint32_t next_id = 10;
+  std::vector<std::pair<int, Vec3>> runs;  // the family and the first end of every chord run
+  const ChordRound round = [&](const std::vector<Segment>& chords, const std::vector<size_t>& of,
+                               const std::vector<std::vector<uint32_t>>&) {
+    std::vector<std::vector<uint32_t>> out;
+    for (size_t i = 0; i < chords.size(); ++i) {
+      runs.push_back({int(of[i]), chords[i].from});
+      out.push_back({next_id++});
+    }
+    return out;
+  };
+  const std::vector<FaceSweep> families = {wide(), crossed_sweep(wide())};
+  ASSERT_FALSE(families[0].crossed);
+  ASSERT_TRUE(families[1].crossed);
+  AdaptiveSpacing spacing{32, 4};
+  spacing.crossed = true;
+  spacing.crossed_floor = 16;
+  const size_t run = adaptive_sweep(families, spacing, {{1}, {1}}, kSweepMinChord, round);
+  // The first family: 3 coarse chords and 1 + 2 + 4 probes in each of 4 intervals of 25 (31);
+  // the crossed one: 3 coarse chords and one probe in each (7), its halves of 12.5 not wider
+  // than 16.
+  EXPECT_EQ(run, 38u);
+  EXPECT_EQ(double(run), expected_adaptive_probes(families, spacing, 1.0));
+  std::vector<double> crossed_at;
+  for (const auto& [family, from] : runs)
+    if (family == 1) crossed_at.push_back(dot(families[1].across, from));
+  ASSERT_EQ(crossed_at.size(), 7u);
+  std::sort(crossed_at.begin(), crossed_at.end());
+  for (size_t k = 0; k + 1 < crossed_at.size(); ++k)
+    EXPECT_NEAR(crossed_at[k + 1] - crossed_at[k], 12.5, 1e-9);
+  spacing.crossed_floor = 0;  // the floor
+  runs.clear();
+  EXPECT_EQ(adaptive_sweep(families, spacing, {{1}, {1}}, kSweepMinChord, round), 62u);
+}
+
 // --chord-tiles and a bake's metadata name each value; a file is read back by the same names, and
 // a name from elsewhere is refused, not taken for a default.
 TEST(FaceSweep, ChordTilesNamesReadBackAsTheirValuesAndNoOtherNameIsOne) {
-  for (ChordTiles t : {ChordTiles::All, ChordTiles::New, ChordTiles::NewEveryFace})
-    EXPECT_EQ(chord_tiles_named(chord_tiles_name(t)), t) << chord_tiles_name(t);
+  const std::vector<ChordTiles> values = {ChordTiles::All, ChordTiles::New,
+                                          ChordTiles::NewEveryFace};
+  const std::vector<std::string_view> names = chord_tiles_names();
+  ASSERT_EQ(names.size(), values.size());
+  for (size_t i = 0; i < values.size(); ++i) {
+    EXPECT_EQ(names[i], chord_tiles_name(values[i]));
+    EXPECT_EQ(chord_tiles_named(names[i]), values[i]) << names[i];
+  }
   EXPECT_STREQ(chord_tiles_name(ChordTiles::NewEveryFace), "new-every-face");
   for (const char* other : {"", "New", "new ", "every-face", "none"})
     EXPECT_FALSE(chord_tiles_named(other).has_value()) << other;

@@ -1357,7 +1357,20 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_EQ(c["chord_tile_size"], kChordTileSize);
   c = cells_of("--chord-tiles new");
   EXPECT_EQ(c["chord_tiles"], "new");
+  EXPECT_EQ(c["chord_cross_floor"], kBspPortalChords.crossed_floor);
   EXPECT_FALSE(cells_of("--chord-cross off").contains("chord_crossed"));
+  EXPECT_FALSE(cells_of("--chord-cross off").contains("chord_cross_floor"));
+  EXPECT_EQ(cells_of("--chord-cross-floor 8")["chord_cross_floor"], 8.0);
+  // Kept between the floor and the coarse spacing when only those are given.
+  EXPECT_EQ(cells_of("--chord-floor 32")["chord_cross_floor"], 32.0);
+  EXPECT_EQ(cells_of("--chord-coarse 8")["chord_cross_floor"], 8.0);
+  for (const char* bad : {"--chord-cross-floor 2", "--chord-cross-floor 256",
+                          "--chord-cross off --chord-cross-floor 8"}) {
+    EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves " + bad + " -o " + dir + "/x.pvs", &out),
+              2)
+        << bad;
+    EXPECT_NE(out.find("--chord-cross-floor"), std::string::npos) << out;
+  }
   c = cells_of("--face-sweep even");
   EXPECT_EQ(c["face_sweep"], "even");
   EXPECT_FALSE(c.contains("chord_coarse"));

@@ -378,7 +378,11 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
       d["chord_tile_margin"] = kChordTileMargin;
       d["chord_tile_size"] = options.adaptive->tile_size;
     }
-    if (options.adaptive->crossed) d["chord_crossed"] = true;
+    if (options.adaptive->crossed) {
+      d["chord_crossed"] = true;
+      d["chord_cross_floor"] = options.adaptive->crossed_floor > 0 ? options.adaptive->crossed_floor
+                                                                   : options.adaptive->floor;
+    }
   }
   cells.description = d.dump();
   return cells;

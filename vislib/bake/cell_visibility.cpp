@@ -259,12 +259,12 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   // the tiles of its run 0 where they can appear (chord_tiles_toward, tiles of
   // AdaptiveSpacing::tile_size pixels), a sided run's ids of either side being triangles; the whole
   // cube when one is a sphere.
-  const bool toward_new = cells && cells->sweep_spacing.tiles != ChordTiles::All &&
-                          scene.sphere_count() == 0 && !scene.is_dynamic();
+  const bool masked = cells && cells->sweep_spacing.tiles != ChordTiles::All &&
+                      scene.sphere_count() == 0 && !scene.is_dynamic();
   auto tiles_toward = [&](const std::vector<Segment>& segs,
                           const std::vector<std::vector<uint32_t>>& fresh) {
     std::vector<std::vector<uint8_t>> masks;
-    if (!toward_new) return masks;
+    if (!masked) return masks;
     masks.resize(segs.size());
     bool any = false;
     std::vector<uint32_t> tri;

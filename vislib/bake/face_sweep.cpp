@@ -96,6 +96,7 @@ FaceSweep crossed_sweep(const FaceSweep& sweep) {
     out.hi = std::max(out.hi, dot(out.across, p));
   }
   out.t_lo = -INFINITY, out.t_hi = INFINITY;
+  out.crossed = true;
   return out;
 }
 
@@ -111,10 +112,6 @@ double even_position(const FaceSweep& sweep, int k, int steps) {
   return sweep.lo + (sweep.hi - sweep.lo) * double(k) / double(steps);
 }
 
-}  // namespace
-
-namespace {
-
 constexpr std::pair<ChordTiles, const char*> kChordTilesNames[] = {
     {ChordTiles::All, "all"},
     {ChordTiles::New, "new"},
@@ -127,6 +124,12 @@ const char* chord_tiles_name(ChordTiles tiles) {
     if (value == tiles) return name;
   assert(false);
   return "";
+}
+
+std::vector<std::string_view> chord_tiles_names() {
+  std::vector<std::string_view> out;
+  for (const auto& [value, name] : kChordTilesNames) out.push_back(name);
+  return out;
 }
 
 std::optional<ChordTiles> chord_tiles_named(std::string_view name) {
@@ -162,7 +165,8 @@ double expected_adaptive_probes(const std::vector<FaceSweep>& sweeps,
   for (const FaceSweep& f : sweeps) {
     const int steps = even_steps(f, spacing.coarse);
     const double width = (f.hi - f.lo) / double(steps);
-    expected += double(steps - 1) + double(steps) * expected_probes(width, spacing.floor, refine);
+    expected +=
+        double(steps - 1) + double(steps) * expected_probes(width, spacing.floor_of(f), refine);
   }
   return expected;
 }
@@ -331,6 +335,8 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
                       const std::vector<std::vector<uint32_t>>& bases, double min_length,
                       const ChordRound& run_round, const SweepEstimate& estimate) {
   assert(spacing.floor > 0 && spacing.floor <= spacing.coarse);
+  assert(spacing.crossed_floor == 0 ||
+         (spacing.crossed_floor >= spacing.floor && spacing.crossed_floor <= spacing.coarse));
   assert(bases.size() == sweeps.size());
   // Every position's set, by index (f < sweeps.size(): face f's base, what its extreme positions
   // and a degenerate chord of it see); an open interval is one whose midpoint the next round
@@ -394,7 +400,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
       std::vector<size_t> at(grid[f].size(), f);
       for (size_t k = 1; k + 1 < grid[f].size(); ++k) at[k] = index[p++];
       for (size_t k = 0; k + 1 < grid[f].size(); ++k)
-        if (grid[f][k + 1] - grid[f][k] > spacing.floor)
+        if (grid[f][k + 1] - grid[f][k] > spacing.floor_of(sweeps[f]))
           open.push_back({f, grid[f][k], grid[f][k + 1], at[k], at[k + 1], 0});
     }
   }
@@ -404,7 +410,8 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b), i.fresh});
     if (estimate) {
       double expected = double(run);
-      for (const Interval& i : open) expected += expected_probes(i.b - i.a, spacing.floor, refine);
+      for (const Interval& i : open)
+        expected += expected_probes(i.b - i.a, spacing.floor_of(sweeps[i.face]), refine);
       estimate(run, expected);
     }
     const std::vector<size_t> index = run_probes();
@@ -420,7 +427,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
       const std::vector<uint32_t>& s = sets[index[k]];
       if (std::includes(both.begin(), both.end(), s.begin(), s.end())) continue;
       ++refined;
-      if (m - i.a > spacing.floor) {
+      if (m - i.a > spacing.floor_of(sweeps[i.face])) {
         std::vector<uint32_t> seen_new;
         std::set_difference(s.begin(), s.end(), both.begin(), both.end(),
                             std::back_inserter(seen_new));

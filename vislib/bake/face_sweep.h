@@ -35,6 +35,8 @@ struct FaceSweep {
   // The chords are cut to t_lo <= dot(along, x) <= t_hi: a strip of the face (sweep_strips). The
   // face's edges stay its base's (the adaptive sweep's extreme positions).
   double t_lo = -INFINITY, t_hi = INFINITY;
+  // A crossed family's sweep (crossed_sweep): refined down to AdaptiveSpacing::crossed_floor.
+  bool crossed = false;
 };
 
 // Chords shorter than this (scene units) are points and are not run (a chord at a face's vertex);
@@ -59,9 +61,9 @@ std::optional<Segment> face_chord(const FaceSweep& sweep, double h, double min_l
 std::vector<FaceSweep> sweep_strips(const FaceSweep& sweep, double length);
 
 // The sweep of `sweep`'s face by chords perpendicular to its chords (along becomes across), over
-// the whole face, with the same side_normal and side. What a polygon's points see in one direction
-// d is seen from a patch of it (the visible parts' shadow along d); a patch thin across one
-// family's chords, a slit's, is long along them, and the other family crosses it.
+// the whole face, with the same side_normal and side, marked `crossed`. What a polygon's points
+// see in one direction d is seen from a patch of it (the visible parts' shadow along d); a patch
+// thin across one family's chords, a slit's, is long along them, and the other family crosses it.
 FaceSweep crossed_sweep(const FaceSweep& sweep);
 
 // The even sweep: chords at h = lo + k (hi - lo) / n, k = 1 .. n - 1, with n = ceil((hi - lo) /
@@ -92,8 +94,10 @@ constexpr int kChordTileSize = 16;
 enum class ChordTiles { All, New, NewEveryFace };
 
 // The name of each value in `pvs bake --chord-tiles` and in a bake's metadata ("all", "new",
-// "new-every-face"), and the value of a name (std::nullopt for any other string).
+// "new-every-face"), every name in the enum's order, and the value of a name (std::nullopt for
+// any other string).
 const char* chord_tiles_name(ChordTiles tiles);
+std::vector<std::string_view> chord_tiles_names();
 std::optional<ChordTiles> chord_tiles_named(std::string_view name);
 
 // The spacings of the adaptive sweep (the sweeps' units): the first chords lie at most `coarse`
@@ -107,7 +111,9 @@ std::optional<ChordTiles> chord_tiles_named(std::string_view name);
 // those (the bake runs it on the cube tiles of `tile_size` pixels where they can appear,
 // chord_tiles_toward); the sweep itself only hands each chord its parent's new ids (ChordRound).
 // With `crossed` each face is also swept by chords perpendicular to the first (crossed_sweep),
-// refined on their own: a second family of sweeps over the same faces, with the same base.
+// refined on their own down to `crossed_floor` (floor <= crossed_floor <= coarse; 0: `floor`): a
+// second family of sweeps over the same faces, with the same base. The patches it is there for
+// are long across its chords, so it can stop coarser than the first family.
 struct AdaptiveSpacing {
   double coarse = 64;
   double floor = 4;
@@ -115,6 +121,11 @@ struct AdaptiveSpacing {
   ChordTiles tiles = ChordTiles::All;
   int tile_size = kChordTileSize;
   bool crossed = false;
+  double crossed_floor = 0;
+  // The floor of `sweep`'s chords: crossed_floor for a crossed family's when set, else floor.
+  double floor_of(const FaceSweep& sweep) const {
+    return sweep.crossed && crossed_floor > 0 ? crossed_floor : floor;
+  }
 };
 
 // Sees one round of chords: `chords` (run as one group of segments), `sweep_of` the index of the
