@@ -380,8 +380,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
     }
     if (options.adaptive->crossed) {
       d["chord_crossed"] = true;
-      d["chord_cross_floor"] = options.adaptive->crossed_floor > 0 ? options.adaptive->crossed_floor
-                                                                   : options.adaptive->floor;
+      d["chord_cross_floor"] = options.adaptive->crossed_floor_or_floor();
     }
   }
   cells.description = d.dump();

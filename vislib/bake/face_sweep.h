@@ -122,9 +122,11 @@ struct AdaptiveSpacing {
   int tile_size = kChordTileSize;
   bool crossed = false;
   double crossed_floor = 0;
-  // The floor of `sweep`'s chords: crossed_floor for a crossed family's when set, else floor.
+  // The crossed family's floor: crossed_floor when set, else floor.
+  double crossed_floor_or_floor() const { return crossed_floor > 0 ? crossed_floor : floor; }
+  // The floor of `sweep`'s chords: the crossed family's for a crossed sweep, else floor.
   double floor_of(const FaceSweep& sweep) const {
-    return sweep.crossed && crossed_floor > 0 ? crossed_floor : floor;
+    return sweep.crossed ? crossed_floor_or_floor() : floor;
   }
 };
 
