@@ -192,9 +192,10 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
   static const char* const kWalkableOnly[] = {"--walkable-from", "--agent-height", "--agent-radius",
                                               "--agent-step"};
   if (a.cells != "bsp-leaves") {
-    for (const char* o : {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse",
-                          "--chord-floor", "--chord-piece", "--chord-tiles", "--chord-tile-size",
-                          "--chord-cross", "--chord-cross-floor", "--sweep", "--bound"})
+    for (const char* o :
+         {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor",
+          "--chord-piece", "--chord-tiles", "--chord-tile-size", "--chord-cross",
+          "--chord-cross-floor", "--chord-new", "--sweep", "--bound"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -244,9 +245,10 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
           std::min(chords.coarse, std::max(chords.floor, d.crossed_floor)));
       if (a.chord_cross_floor && !chords.crossed)
         throw CLI::ValidationError("--chord-cross-floor", "only applies with --chord-cross on");
-      if (!(chords.floor <= chords.crossed_floor && chords.crossed_floor <= chords.coarse))
+      if (!chords.valid())  // the floor and the coarse spacing are checked above
         throw CLI::ValidationError("--chord-cross-floor",
                                    "must lie between --chord-floor and --chord-coarse");
+      chords.new_to_family = a.chord_new ? *a.chord_new == "family" : d.new_to_family;
       if (a.chord_tile_size && chords.tiles == vislib::ChordTiles::All)
         throw CLI::ValidationError("--chord-tile-size",
                                    "only applies with --chord-tiles new or new-every-face");
@@ -370,7 +372,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
       ->check(CLI::IsMember({"even", "adaptive"}));
   cmd->add_option("--chord-coarse", a.chord_coarse,
                   "bsp-leaves, adaptive: the first chords at most this far apart (Quake units; "
-                  "default 128 with --sweep portals, 64 with faces)")
+                  "default 256 with --sweep portals, 64 with faces)")
       ->check(in_range(1e-3, 1e6));
   cmd->add_option("--chord-floor", a.chord_floor,
                   "bsp-leaves, adaptive: no chord is inserted closer than this to a neighbour "
@@ -379,7 +381,7 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
   cmd->add_option("--chord-piece", a.chord_piece,
                   "bsp-leaves, adaptive: cut each swept polygon into strips at most this long "
                   "along its chords, each refined on its own (Quake units; 0 = whole chords; "
-                  "default 128 with --sweep portals, 0 with faces)")
+                  "default 256 with --sweep portals, 0 with faces)")
       ->check(in_range(0.0, 1e6));
   cmd->add_option("--chord-tiles", a.chord_tiles,
                   "bsp-leaves, adaptive: 'all' (every chord computes its whole cube), 'new' (a "
@@ -409,6 +411,13 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "patches the crossed chords are there for are long across them; default 16 "
                   "with --sweep portals, else --chord-floor)")
       ->check(in_range(1e-3, 1e6));
+  cmd->add_option("--chord-new", a.chord_new,
+                  "bsp-leaves, adaptive: when a probe's ids are new, so that chords are inserted "
+                  "beside it: 'neighbours' (neither neighbour saw one of them) or 'family' "
+                  "(nor did any chord of its family run before it: the strips of one polygon "
+                  "with one direction of chords); default family with --sweep portals, "
+                  "neighbours with faces")
+      ->check(CLI::IsMember({"neighbours", "family"}));
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

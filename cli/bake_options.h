@@ -52,6 +52,7 @@ struct BakeArgs {
   std::optional<int> chord_tile_size;       // --chord-tile-size (AdaptiveSpacing::tile_size)
   std::optional<std::string> chord_cross;   // --chord-cross on|off (AdaptiveSpacing::crossed)
   std::optional<double> chord_cross_floor;  // --chord-cross-floor (AdaptiveSpacing::crossed_floor)
+  std::optional<std::string> chord_new;     // --chord-new neighbours|family (new_to_family)
   std::vector<std::string> walkable_from;   // --walkable-from x,y,z (repeatable)
   std::optional<int> band_levels;           // --band-levels (grid and walkable cells)
   std::string wall_traces;                  // --wall-traces on|off ("": the placement's default)

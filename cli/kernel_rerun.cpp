@@ -63,13 +63,18 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
         *chord_tiles,
         tile_size.is_null() ? vislib::kStaticTileSize : tile_size.get<int>(),
         !crossed.is_null() && crossed.get<bool>()};
+    const nlohmann::json judged = find_key(md, "chord_new");  // absent: by the neighbours
+    if (!judged.is_null() && judged != "neighbours" && judged != "family")
+      throw vislib::InputError(pvs, "metadata holds an invalid chord_new (neighbours or family)");
+    co.adaptive->new_to_family = judged == "family";
     // Absent: the crossed chords went down to the floor (crossed_floor 0).
     const nlohmann::json cross_floor = find_key(md, "chord_cross_floor");
     if (!cross_floor.is_null()) {
-      if (!cross_floor.is_number() || !(cross_floor.get<double>() >= co.adaptive->floor) ||
-          !(cross_floor.get<double>() <= co.adaptive->coarse))
+      if (!cross_floor.is_number() || !(cross_floor.get<double>() > 0))
         throw vislib::InputError(pvs, "metadata holds an invalid chord_cross_floor");
       co.adaptive->crossed_floor = cross_floor.get<double>();
+      if (!co.adaptive->valid())
+        throw vislib::InputError(pvs, "metadata holds an invalid chord_cross_floor");
     }
   }
   co.leaves = cell_leaf;

@@ -196,6 +196,58 @@ TEST(FaceSweep, AdaptiveSweepHandsEachInsertedChordItsParentsNewIds) {
   EXPECT_GE(with_slit, 2u);
 }
 
+// With new_to_family a probe's ids are judged against everything its family ran before it, not
+// only its two neighbours: id 7, seen from the first probe at x = 50, is seen again at 87.5,
+// where neither neighbour (75, which sees an id 8 of its own, and the face's end) sees it. Judged
+// by the neighbours, 87.5 opens two intervals, probed at 81.25 and 93.75, which look toward 7;
+// judged by the family, 7 is not new there and the sweep stops. Strips of one face are one
+// family: the same holds when 50 and 87.5 lie on two strips of the face.
+TEST(FaceSweep, ProbesJudgedByTheirFamilyRefineOnlyWhereTheFamilySeesSomethingNew) {
+  auto see = [](double x) {
+    std::vector<uint32_t> ids = {1};
+    if (std::abs(x - 50) < 5 || std::abs(x - 87.5) < 1) ids.push_back(7);
+    if (std::abs(x - 75) < 1) ids.push_back(8);
+    return ids;
+  };
+  AdaptiveSpacing spacing{100, 1};
+  FakeScene by_neighbours{see, {}, {}};
+  EXPECT_EQ(adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, by_neighbours.round()), 7u);
+  EXPECT_EQ(by_neighbours.fresh_at.at(81.25), std::vector<uint32_t>{7});
+  spacing.new_to_family = true;
+  FakeScene by_family{see, {}, {}};
+  EXPECT_EQ(adaptive_sweep({wide()}, spacing, {{1}}, kSweepMinChord, by_family.round()), 5u);
+  EXPECT_EQ(by_family.fresh_at.count(81.25), 0u);
+  EXPECT_EQ(by_family.fresh_at.at(62.5), std::vector<uint32_t>{8});  // 75's own id stays new
+
+  // Two strips of the face (y below and above 50): the first sees 7 at x = 50, the second an id
+  // 9 of its own there, then 8 at 75 and 7 at 87.5.
+  const std::vector<FaceSweep> strips = sweep_strips(wide(), 50);
+  ASSERT_EQ(strips.size(), 2u);
+  auto strip_round = [&](size_t* runs) {
+    return [&see, runs](const std::vector<Segment>& chords, const std::vector<size_t>& of,
+                        const std::vector<std::vector<uint32_t>>&) {
+      std::vector<std::vector<uint32_t>> out;
+      for (size_t i = 0; i < chords.size(); ++i) {
+        const double x = position(chords[i]);
+        std::vector<uint32_t> ids = see(x);
+        if (of[i] == 0 && std::abs(x - 50) >= 5) ids.resize(1);  // 7 at 50 only
+        if (of[i] == 1 && std::abs(x - 50) < 5) ids = {1, 9};    // an id of its own at 50
+        out.push_back(ids);
+        ++*runs;
+      }
+      return out;
+    };
+  };
+  size_t strip_runs = 0;
+  spacing.new_to_family = false;
+  adaptive_sweep(strips, spacing, {{1}, {1}}, kSweepMinChord, strip_round(&strip_runs));
+  EXPECT_EQ(strip_runs, 2u + 4u + 2u + 2u);  // 87.5 on the second strip refines
+  strip_runs = 0;
+  spacing.new_to_family = true;
+  adaptive_sweep(strips, spacing, {{1}, {1}}, kSweepMinChord, strip_round(&strip_runs));
+  EXPECT_EQ(strip_runs, 2u + 4u + 2u);
+}
+
 // The tiles toward some triangles hold every pixel where one of them can appear from an eye of
 // the chord (sampled: eyes along it, points of the triangles), on every face it spans, and a run
 // on those tiles sees every one of them that the whole run sees; the whole cube (none) only for

@@ -1345,6 +1345,7 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   EXPECT_EQ(c["chord_piece"], kBspPortalChords.piece);
   EXPECT_EQ(c["chord_tiles"], "new-every-face");
   EXPECT_EQ(c["chord_crossed"], true);
+  EXPECT_EQ(c["chord_new"], kBspPortalChords.new_to_family ? "family" : "neighbours");
   EXPECT_EQ(c["chord_tile_margin"], kChordTileMargin);
   EXPECT_EQ(c["chord_tile_size"], kChordTileSize);
   c = cells_of("--chord-tiles all");
@@ -1364,7 +1365,13 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   // Kept between the floor and the coarse spacing when only those are given.
   EXPECT_EQ(cells_of("--chord-floor 32")["chord_cross_floor"], 32.0);
   EXPECT_EQ(cells_of("--chord-coarse 8")["chord_cross_floor"], 8.0);
-  for (const char* bad : {"--chord-cross-floor 2", "--chord-cross-floor 256",
+  EXPECT_EQ(cells_of("--chord-new neighbours")["chord_new"], "neighbours");
+  EXPECT_EQ(cells_of("--chord-new family")["chord_new"], "family");
+  EXPECT_EQ(
+      run_pvs("bake " + map + " --cells bsp-leaves --chord-new both -o " + dir + "/x.pvs", &out),
+      2);
+  EXPECT_NE(out.find("--chord-new"), std::string::npos) << out;
+  for (const char* bad : {"--chord-cross-floor 2", "--chord-cross-floor 512",
                           "--chord-cross off --chord-cross-floor 8"}) {
     EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves " + bad + " -o " + dir + "/x.pvs", &out),
               2)

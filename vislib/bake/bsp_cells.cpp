@@ -378,6 +378,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
       d["chord_tile_margin"] = kChordTileMargin;
       d["chord_tile_size"] = options.adaptive->tile_size;
     }
+    d["chord_new"] = options.adaptive->new_to_family ? "family" : "neighbours";
     if (options.adaptive->crossed) {
       d["chord_crossed"] = true;
       d["chord_cross_floor"] = options.adaptive->crossed_floor_or_floor();

@@ -50,23 +50,27 @@ constexpr double kBspFaceSpacing = 16.0;
 // sweep's at 16 for half its CPU (docs/quake.md "Portals").
 constexpr double kBspPortalSpacing = 8.0;
 // The default chords of a portal sweep (BspSweep::Portals, Quake units; `pvs bake` sweeps portals
-// adaptively unless told --face-sweep even): the first chords at most 128 apart, inserted down to
-// 4, each portal cut into strips at most 128 long along its chords, a chord inserted below a
-// probe that saw new ids computing only the cube tiles toward them, on every cube face where they
-// can appear, and a second family of chords perpendicular to the first, inserted down to 16.
-// Against the whole cube
-// down to 8 the tiles cost less CPU on lqdm1 whole and about as much on leaf samples of e1m2 and
-// e2m3, for fewer sampled misses on all three: the floor of 4 buys the misses back that the tiles
-// give up, and the tiles pay for the floor (docs/quake.md "Chords that look toward what made
-// them"). The crossed family finds views through patches of a portal thin across the first
-// family's chords, which no finer floor does: a third to a quarter of the sampled misses on the
-// three maps for 1.3-1.4 times the CPU. With it the tiles on every face miss as often as on one
-// face, for 0.65-0.86 of the CPU (docs/quake.md "Crossed chords"). The crossed chords stop at 16:
-// the patches they are there for are long across them; against 4 that costs 0.75 of e1m2's leaf
-// sample's CPU, for the same sampled misses on lqdm1 and one or two more rays in 100 million on
-// the big maps' samples.
-constexpr AdaptiveSpacing kBspPortalChords{128.0,          4.0,  128.0, ChordTiles::NewEveryFace,
-                                           kChordTileSize, true, 16.0};
+// adaptively unless told --face-sweep even): the first chords at most 256 apart, inserted down to
+// 4, each portal cut into strips at most 256 long along its chords, a chord inserted below a
+// probe that saw ids new to its family computing only the cube tiles toward them, on every cube
+// face where they can appear, and a second family of chords perpendicular to the first, inserted
+// down to 16.
+// Against the whole cube down to 8 the tiles cost less CPU on lqdm1 whole and about as much on
+// leaf samples of e1m2 and e2m3, for fewer sampled misses on all three: the floor of 4 buys the
+// misses back that the tiles give up, and the tiles pay for the floor (docs/quake.md "Chords that
+// look toward what made them"). The crossed family finds views through patches of a portal thin
+// across the first family's chords, which no finer floor does: a third to a quarter of the
+// sampled misses on the three maps for 1.3-1.4 times the CPU. With it the tiles on every face
+// miss as often as on one face, for 0.65-0.86 of the CPU (docs/quake.md "Crossed chords"). The
+// crossed chords stop at 16: the patches they are there for are long across them; against 4 that
+// costs 0.75 of e1m2's leaf sample's CPU, for the same sampled misses on lqdm1 and one or two
+// more rays in 100 million on the big maps' samples. A probe's ids count as new only when its
+// family has not seen them (AdaptiveSpacing::new_to_family), and the first chords lie 256 apart
+// where 128 had cost whole cubes that the masked chords inserted below them now replace: together
+// 0.6-0.8 of the CPU of the three maps' samples for one or two more sampled miss rays in 100
+// million (docs/quake.md "Chords new to their family").
+constexpr AdaptiveSpacing kBspPortalChords{256.0,          4.0,  256.0, ChordTiles::NewEveryFace,
+                                           kChordTileSize, true, 16.0,  true};
 
 // The segments a convex region's visibility is computed on (Quake coordinates in, scene
 // coordinates out, quake_to_scene): first every edge of every face of `region`, in face order and

@@ -102,6 +102,13 @@ FaceSweep crossed_sweep(const FaceSweep& sweep) {
 
 namespace {
 
+// Whether two sweeps are of one family (AdaptiveSpacing::new_to_family): strips of one face's
+// sweep, or that face's crossed sweep's, on one side.
+bool same_family(const FaceSweep& a, const FaceSweep& b) {
+  return a.face == b.face && a.along == b.along && a.crossed == b.crossed &&
+         a.side_normal == b.side_normal && a.side == b.side;
+}
+
 // The even grid's interval count over the sweep's width at most `spacing` apart (>= 1).
 int even_steps(const FaceSweep& sweep, double spacing) {
   const double width = sweep.hi - sweep.lo;
@@ -334,9 +341,7 @@ std::optional<std::vector<uint8_t>> chord_tiles_toward(const Scene& scene, size_
 size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacing& spacing,
                       const std::vector<std::vector<uint32_t>>& bases, double min_length,
                       const ChordRound& run_round, const SweepEstimate& estimate) {
-  assert(spacing.floor > 0 && spacing.floor <= spacing.coarse);
-  assert(spacing.crossed_floor == 0 ||
-         (spacing.crossed_floor >= spacing.floor && spacing.crossed_floor <= spacing.coarse));
+  assert(spacing.valid());
   assert(bases.size() == sweeps.size());
   // Every position's set, by index (f < sweeps.size(): face f's base, what its extreme positions
   // and a degenerate chord of it see); an open interval is one whose midpoint the next round
@@ -405,6 +410,32 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     }
   }
   double refine = kRefinePrior;  // the share of the last round's probes that saw a new id
+  // With new_to_family: each sweep's family (the first sweep of it), and what each family has
+  // seen before the round being judged.
+  std::vector<size_t> family(sweeps.size());
+  std::vector<std::vector<uint32_t>> family_seen(sweeps.size());
+  std::vector<uint32_t> merged;
+  auto add_seen = [&](size_t f, const std::vector<uint32_t>& ids) {
+    std::vector<uint32_t>& seen = family_seen[family[f]];
+    merged.clear();
+    std::set_union(seen.begin(), seen.end(), ids.begin(), ids.end(), std::back_inserter(merged));
+    seen.swap(merged);
+  };
+  if (spacing.new_to_family) {
+    for (size_t f = 0; f < sweeps.size(); ++f) {
+      family[f] = f;
+      for (size_t g = 0; g < f; ++g)
+        if (same_family(sweeps[g], sweeps[f])) {
+          family[f] = family[g];
+          break;
+        }
+      add_seen(f, sets[f]);
+    }
+    for (const Interval& i : open) {
+      add_seen(i.face, sets[i.set_a]);
+      add_seen(i.face, sets[i.set_b]);
+    }
+  }
   while (!open.empty()) {
     probes.clear();
     for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b), i.fresh});
@@ -424,6 +455,13 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
       both.clear();
       std::set_union(sets[i.set_a].begin(), sets[i.set_a].end(), sets[i.set_b].begin(),
                      sets[i.set_b].end(), std::back_inserter(both));
+      if (spacing.new_to_family) {
+        const std::vector<uint32_t>& seen = family_seen[family[i.face]];
+        merged.clear();
+        std::set_union(both.begin(), both.end(), seen.begin(), seen.end(),
+                       std::back_inserter(merged));
+        both.swap(merged);
+      }
       const std::vector<uint32_t>& s = sets[index[k]];
       if (std::includes(both.begin(), both.end(), s.begin(), s.end())) continue;
       ++refined;
@@ -436,6 +474,8 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
         next.push_back({i.face, m, i.b, index[k], i.set_b, fresh.size() - 1});
       }
     }
+    if (spacing.new_to_family)
+      for (size_t k = 0; k < open.size(); ++k) add_seen(open[k].face, sets[index[k]]);
     refine = double(refined) / double(open.size());
     open = std::move(next);
   }

@@ -114,6 +114,11 @@ std::optional<ChordTiles> chord_tiles_named(std::string_view name);
 // refined on their own down to `crossed_floor` (floor <= crossed_floor <= coarse; 0: `floor`): a
 // second family of sweeps over the same faces, with the same base. The patches it is there for
 // are long across its chords, so it can stop coarser than the first family.
+// With `new_to_family` a probe's ids count as new only when its family has not seen them either:
+// the sweeps over one face with one side and one direction of chords (a face's strips; its
+// crossed sweep is another family), from their base and every chord of an earlier round. An id
+// the family holds already adds nothing to the set, wherever it was seen; the chords inserted
+// below look toward the ids that are new so.
 struct AdaptiveSpacing {
   double coarse = 64;
   double floor = 4;
@@ -122,6 +127,12 @@ struct AdaptiveSpacing {
   int tile_size = kChordTileSize;
   bool crossed = false;
   double crossed_floor = 0;
+  bool new_to_family = false;
+  // The spacings are in range: 0 < floor <= coarse, and crossed_floor 0 or between them.
+  bool valid() const {
+    return floor > 0 && floor <= coarse &&
+           (crossed_floor == 0 || (floor <= crossed_floor && crossed_floor <= coarse));
+  }
   // The crossed family's floor: crossed_floor when set, else floor.
   double crossed_floor_or_floor() const { return crossed_floor > 0 ? crossed_floor : floor; }
   // The floor of `sweep`'s chords: the crossed family's for a crossed sweep, else floor.
