@@ -397,45 +397,44 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
     }
     return index;
   };
+  // With new_to_family: each sweep's family (the first sweep of it), and what each family has
+  // seen before the round being judged (its base, then every round's probes).
+  std::vector<size_t> family(sweeps.size());
+  std::vector<std::vector<uint32_t>> family_seen(sweeps.size());
+  std::vector<uint32_t> merged;
+  auto union_into = [&](std::vector<uint32_t>& out, const std::vector<uint32_t>& ids) {
+    merged.clear();
+    std::set_union(out.begin(), out.end(), ids.begin(), ids.end(), std::back_inserter(merged));
+    out.swap(merged);
+  };
+  auto add_seen = [&](size_t f, const std::vector<uint32_t>& ids) {
+    if (spacing.new_to_family) union_into(family_seen[family[f]], ids);
+  };
+  for (size_t f = 0; f < sweeps.size(); ++f) {
+    family[f] = f;
+    for (size_t g = 0; g < f && spacing.new_to_family; ++g)
+      if (same_family(sweeps[g], sweeps[f])) {
+        family[f] = family[g];
+        break;
+      }
+    add_seen(f, sets[f]);
+  }
   if (estimate) estimate(0, expected_adaptive_probes(sweeps, spacing, kRefinePrior));
   {
     const std::vector<size_t> index = run_probes();
     size_t p = 0;
     for (size_t f = 0; f < sweeps.size(); ++f) {
       std::vector<size_t> at(grid[f].size(), f);
-      for (size_t k = 1; k + 1 < grid[f].size(); ++k) at[k] = index[p++];
+      for (size_t k = 1; k + 1 < grid[f].size(); ++k) {
+        at[k] = index[p++];
+        add_seen(f, sets[at[k]]);
+      }
       for (size_t k = 0; k + 1 < grid[f].size(); ++k)
         if (grid[f][k + 1] - grid[f][k] > spacing.floor_of(sweeps[f]))
           open.push_back({f, grid[f][k], grid[f][k + 1], at[k], at[k + 1], 0});
     }
   }
   double refine = kRefinePrior;  // the share of the last round's probes that saw a new id
-  // With new_to_family: each sweep's family (the first sweep of it), and what each family has
-  // seen before the round being judged.
-  std::vector<size_t> family(sweeps.size());
-  std::vector<std::vector<uint32_t>> family_seen(sweeps.size());
-  std::vector<uint32_t> merged;
-  auto add_seen = [&](size_t f, const std::vector<uint32_t>& ids) {
-    std::vector<uint32_t>& seen = family_seen[family[f]];
-    merged.clear();
-    std::set_union(seen.begin(), seen.end(), ids.begin(), ids.end(), std::back_inserter(merged));
-    seen.swap(merged);
-  };
-  if (spacing.new_to_family) {
-    for (size_t f = 0; f < sweeps.size(); ++f) {
-      family[f] = f;
-      for (size_t g = 0; g < f; ++g)
-        if (same_family(sweeps[g], sweeps[f])) {
-          family[f] = family[g];
-          break;
-        }
-      add_seen(f, sets[f]);
-    }
-    for (const Interval& i : open) {
-      add_seen(i.face, sets[i.set_a]);
-      add_seen(i.face, sets[i.set_b]);
-    }
-  }
   while (!open.empty()) {
     probes.clear();
     for (const Interval& i : open) probes.push_back({i.face, 0.5 * (i.a + i.b), i.fresh});
@@ -455,13 +454,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
       both.clear();
       std::set_union(sets[i.set_a].begin(), sets[i.set_a].end(), sets[i.set_b].begin(),
                      sets[i.set_b].end(), std::back_inserter(both));
-      if (spacing.new_to_family) {
-        const std::vector<uint32_t>& seen = family_seen[family[i.face]];
-        merged.clear();
-        std::set_union(both.begin(), both.end(), seen.begin(), seen.end(),
-                       std::back_inserter(merged));
-        both.swap(merged);
-      }
+      if (spacing.new_to_family) union_into(both, family_seen[family[i.face]]);
       const std::vector<uint32_t>& s = sets[index[k]];
       if (std::includes(both.begin(), both.end(), s.begin(), s.end())) continue;
       ++refined;
@@ -474,8 +467,7 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
         next.push_back({i.face, m, i.b, index[k], i.set_b, fresh.size() - 1});
       }
     }
-    if (spacing.new_to_family)
-      for (size_t k = 0; k < open.size(); ++k) add_seen(open[k].face, sets[index[k]]);
+    for (size_t k = 0; k < open.size(); ++k) add_seen(open[k].face, sets[index[k]]);
     refine = double(refined) / double(open.size());
     open = std::move(next);
   }
