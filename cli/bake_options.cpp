@@ -195,7 +195,7 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
     for (const char* o :
          {"--face-spacing", "--leaves", "--face-sweep", "--chord-coarse", "--chord-floor",
           "--chord-piece", "--chord-tiles", "--chord-tile-size", "--chord-cross",
-          "--chord-cross-floor", "--chord-new", "--sweep", "--bound"})
+          "--chord-cross-floor", "--chord-new", "--sweep", "--bound", "--portal-edges"})
       if (cmd.count(o)) throw CLI::ValidationError(o, "only applies with --cells bsp-leaves");
     for (const char* o : kWalkableOnly)
       if (!a.walkable && cmd.count(o))
@@ -212,6 +212,8 @@ void check_cells_options(const BakeArgs& a, const CLI::App& cmd) {
                                  "the map's BSP leaves)");
   if (cmd.count("--bound") && a.sweep != "portals" && a.bound != "none")
     throw CLI::ValidationError("--bound", "restricts the runs of --sweep portals only");
+  if (cmd.count("--portal-edges") && a.sweep != "portals")
+    throw CLI::ValidationError("--portal-edges", "applies to --sweep portals only");
   if (!ends_with_bsp(a.scene))
     throw vislib::InputError(a.scene,
                              "--cells bsp-leaves needs a Quake map (.bsp): the cells are its BSP "
@@ -261,6 +263,7 @@ vislib::ViewCells make_cells(const BakeArgs& a, const vislib::Scene& scene,
               : a.bound == "portals" ? vislib::BspBound::Portals
               : a.bound == "map-vis" ? vislib::BspBound::MapVis
                                      : vislib::BspBound::None;
+    o.share_edges = a.portal_edges == "shared";
     return vislib::bsp_leaf_cells(bsp, o, &scene);
   }
   vislib::CellPlacement p = placement_of(a);
@@ -418,6 +421,12 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "with one direction of chords); default family with --sweep portals, "
                   "neighbours with faces")
       ->check(CLI::IsMember({"neighbours", "family"}));
+  cmd->add_option("--portal-edges", a.portal_edges,
+                  "bsp-leaves, --sweep portals: 'shared' (where open portals meet along a line, "
+                  "their edges, a few hundredths of a unit apart, share one run split by each "
+                  "portal's plane; docs/quake.md) or 'own' (each edge its own run)")
+      ->check(CLI::IsMember({"shared", "own"}))
+      ->capture_default_str();
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "
                   "A-B/K (every K-th from A), comma-separated");

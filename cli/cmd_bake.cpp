@@ -158,15 +158,17 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
         segments += g.size();
         if (cells.shared_runs)
           for (const vislib::Segment& s : g)
-            distinct.insert(vislib::SegmentRunCache::key_of(s.from, s.to, s.side_normal));
+            distinct.insert(vislib::SegmentRunCache::key_of(s.from, s.to, run_key_normal(s)));
       }
     std::printf("%u cell%s (%s), %u in shard %u/%u, %zu boundary segments x %d runs per cell%s", n,
                 plural_s(n), kind_name(cells), (n + shard.count - 1 - shard.index) / shard.count,
                 shard.index, shard.count, segments / n, a.runs,
                 cells.segments.empty() ? "" : " (mean)");
     if (cells.shared_runs)
-      std::printf("; %zu distinct segments in all (a portal's serve both of its leaves)",
-                  distinct.size());
+      std::printf(
+          "; %zu distinct segments in all (a portal's serve both of its leaves, an edge "
+          "the portals that meet there)",
+          distinct.size());
     std::printf("\n");
     return;
   }

@@ -74,7 +74,8 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
         throw vislib::InputError(pvs, "metadata holds an invalid chord_cross_floor");
       co.adaptive->crossed_floor = cross_floor.get<double>();
       if (!co.adaptive->valid())
-        throw vislib::InputError(pvs, "metadata holds an invalid chord_cross_floor");
+        throw vislib::InputError(
+            pvs, "metadata holds a chord_cross_floor outside chord_floor .. chord_coarse");
     }
   }
   co.leaves = cell_leaf;
@@ -82,6 +83,11 @@ KernelRerun::KernelRerun(const nlohmann::json& md, const std::string& pvs, const
   const nlohmann::json kind = find_key(md, "sweep");
   if (kind.is_string() && kind.get<std::string>() == "portals")
     co.sweep = vislib::BspSweep::Portals;
+  // Absent: baked before portals' edges shared their runs.
+  const nlohmann::json edges = find_key(md, "portal_edges");
+  if (!edges.is_null() && edges != "shared" && edges != "own")
+    throw vislib::InputError(pvs, "metadata holds an invalid portal_edges (shared or own)");
+  co.share_edges = edges == "shared";
   const nlohmann::json bound = find_key(md, "bound");  // absent: none
   if (bound.is_string() && co.sweep == vislib::BspSweep::Portals)
     co.bound = bound.get<std::string>() == "portals"   ? vislib::BspBound::Portals

@@ -32,6 +32,7 @@
 #include "vislib/base/file_util.h"
 #include "vislib/base/random.h"
 #include "vislib/eval/embree_scene.h"
+#include "vislib/kernel/segment_run_cache.h"
 #include "vislib/scene/import.h"
 #include "vislib/scene/quake_bsp_volumes.h"
 #include "vislib/scene/scene_fingerprint.h"
@@ -1333,11 +1334,12 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
   ASSERT_EQ(run_pvs("bake " + map + " --cells bsp-leaves --dry-run -o " + dir + "/d.pvs", &out), 0)
       << out;
   // One portal, its chords run once for both leaves.
-  EXPECT_NE(out.find("distinct segments in all (a portal's serve both of its leaves)"),
+  EXPECT_NE(out.find("distinct segments in all (a portal's serve both of its leaves"),
             std::string::npos)
       << out;
   nlohmann::json c = cells_of("");
   EXPECT_EQ(c["sweep"], "portals");
+  EXPECT_EQ(c["portal_edges"], "shared");
   EXPECT_EQ(c["face_spacing"], kBspPortalSpacing);
   EXPECT_EQ(c["face_sweep"], "adaptive");
   EXPECT_EQ(c["chord_coarse"], kBspPortalChords.coarse);
@@ -1371,6 +1373,14 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
       run_pvs("bake " + map + " --cells bsp-leaves --chord-new both -o " + dir + "/x.pvs", &out),
       2);
   EXPECT_NE(out.find("--chord-new"), std::string::npos) << out;
+  EXPECT_EQ(cells_of("--portal-edges own")["portal_edges"], "own");
+  for (const char* bad : {"--portal-edges both", "--sweep faces --portal-edges own"}) {
+    EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves " + bad + " -o " + dir + "/x.pvs", &out),
+              2)
+        << bad;
+    EXPECT_NE(out.find("--portal-edges"), std::string::npos) << out;
+  }
+  EXPECT_FALSE(cells_of("--sweep faces").contains("portal_edges"));
   for (const char* bad : {"--chord-cross-floor 2", "--chord-cross-floor 512",
                           "--chord-cross off --chord-cross-floor 8"}) {
     EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves " + bad + " -o " + dir + "/x.pvs", &out),
@@ -1542,6 +1552,64 @@ TEST(QuakeBakeLibreQuake, CrossedChordsFindWhatIsSeenThroughPatchesThinAcrossThe
     EXPECT_FALSE(std::binary_search(one.begin(), one.end(), seen[c].second)) << c;
     EXPECT_TRUE(std::binary_search(both.begin(), both.end(), seen[c].second)) << c;
   }
+}
+
+// Where lqdm1's open portals meet along a line, their clear parts' edges lie a few clearances
+// apart, and one run serves them all: each such segment carries the first edge's ends and every
+// member portal's plane (Segment::run_planes), its own at run_plane, so the bake keys them as one
+// run split by each plane (3,277 edges, 2,443 runs). Each member still counts
+// as an edge of its own portal's sweep (its base), whose polygon has a vertex within
+// kSharedRunEdgeDistance of each end. Without the sharing every edge is its own run.
+TEST(QuakeBakeLibreQuake, PortalEdgesMeetingAlongALineShareOneRunSplitByEachPortalsPlane) {
+  auto path = librequake("lqdm1.bsp");
+  if (!path) GTEST_SKIP() << "../shared/scenes/librequake is absent";
+  const QuakeBsp m = read_quake_bsp(*path);
+  const Scene scene = load_scene(*path);
+  BspCellOptions o;
+  o.sweep = BspSweep::Portals;
+  o.adaptive = kBspPortalChords;
+  const ViewCells cells = bsp_leaf_cells(m, o, &scene);
+  std::set<SegmentRunCache::Key> runs;
+  size_t segments = 0;
+  std::map<SegmentRunCache::Key, std::array<Vec3, kMaxSidePlanes>> planes_of;
+  size_t shared = 0;
+  for (uint32_t c = 0; c < cells.segments.size(); ++c)
+    for (const Segment& s : cells.segments[c]) {
+      ASSERT_FALSE((s.side_normal == Vec3{0, 0, 0}));
+      const SegmentRunCache::Key key = SegmentRunCache::key_of(s.from, s.to, run_key_normal(s));
+      runs.insert(key);
+      segments += s.side == 0;  // each portal's edge once (every leaf is a cell)
+      if (s.run_planes[0] == Vec3{0, 0, 0}) continue;
+      ++shared;
+      EXPECT_TRUE(s.run_planes[size_t(s.run_plane)] == s.side_normal);
+      EXPECT_FALSE((s.run_planes[1] == Vec3{0, 0, 0}));  // two portals or more
+      const auto [it, first] = planes_of.emplace(key, s.run_planes);
+      EXPECT_TRUE(it->second == s.run_planes);  // one run, one split for every member
+      bool own = false;                         // an edge of its own portal's sweep
+      for (const FaceSweep& f : cells.sweeps[c]) {
+        if (!(f.side_normal == s.side_normal)) continue;
+        bool from = false, to = false;
+        for (const Vec3& v : f.face) {
+          from = from || length(v - s.from) <= kSharedRunEdgeDistance;
+          to = to || length(v - s.to) <= kSharedRunEdgeDistance;
+        }
+        own = own || (from && to);
+      }
+      EXPECT_TRUE(own) << "cell " << c;
+    }
+  EXPECT_GT(shared, 0u);
+  EXPECT_EQ(segments, 3277u);  // each portal's edges, as each would run alone
+  EXPECT_EQ(runs.size(), 2443u);
+  o.share_edges = false;  // each edge its own run, as files baked without the sharing record
+  const ViewCells own = bsp_leaf_cells(m, o, &scene);
+  EXPECT_EQ(nlohmann::json::parse(own.description)["portal_edges"], "own");
+  std::set<SegmentRunCache::Key> own_runs;
+  for (const std::vector<Segment>& segs : own.segments)
+    for (const Segment& s : segs) {
+      EXPECT_TRUE((s.run_planes[0] == Vec3{0, 0, 0}));
+      own_runs.insert(SegmentRunCache::key_of(s.from, s.to, run_key_normal(s)));
+    }
+  EXPECT_EQ(own_runs.size(), 3277u);
 }
 
 // --leaves picks the listed leaves of a real map: every 10th from 1 to 40, and 3.

@@ -424,6 +424,46 @@ TEST(SegmentVisibility, DirectionSidesHoldWhatThePixelsOfEachSideOfThePlaneSee) 
   EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
 }
 
+// One run split by several planes (SegmentOptions::more_side_normals; the bake's run on an edge
+// where portals meet) gives, for each plane, the sides a run split by that plane alone gives, and
+// the same lists: the portals' leaves take their sets from it as from their own runs. More
+// planes need both sides, and the planes come first.
+TEST(SegmentVisibility, ARunSplitByMorePlanesGivesEachPlanesSidesAsARunSplitByItAlone) {
+  const Scene s = random_soup(300, 41);
+  SegmentOptions o;
+  o.resolution = 32;
+  o.orientation = random_orientation(7);
+  o.want_pieces = true;
+  const Vec3 v0{-2, 0, 0.3}, v1{2, 0.5, 0};
+  const Vec3 planes[] = {{0.3, 1, -0.2}, {0, 0, 1}, {-1, 0.2, 0.4}, {0.5, -0.5, 1}};
+  SegmentOptions all = o;
+  all.side_normal = planes[0];
+  for (size_t k = 1; k < kMaxSidePlanes; ++k) all.more_side_normals[k - 1] = planes[k];
+  EXPECT_EQ(side_plane_count(all), int(kMaxSidePlanes));
+  const SegmentResult split = segment_visibility(s, v0, v1, all);
+  ASSERT_EQ(split.visible_sides.size(), 2 * kMaxSidePlanes);
+  for (size_t k = 0; k < kMaxSidePlanes; ++k) {
+    SegmentOptions one = o;
+    one.side_normal = planes[k];
+    const SegmentResult r = segment_visibility(s, v0, v1, one);
+    EXPECT_EQ(split.visible, r.visible);
+    EXPECT_TRUE(same_lists(split.pieces, r.pieces));
+    for (size_t side = 0; side < 2; ++side)
+      EXPECT_EQ(split.visible_sides[2 * k + side], r.visible_sides[side])
+          << "plane " << k << " side " << side;
+    EXPECT_NE(r.visible_sides[0], r.visible_sides[1]);
+  }
+  SegmentOptions bad = all;
+  bad.side_only = 0;
+  EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
+  bad = all;
+  bad.more_side_normals[0] = {0, 0, 0};  // a gap before the third plane
+  EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
+  bad = o;
+  bad.more_side_normals[0] = planes[1];  // no side normal
+  EXPECT_THROW(segment_visibility(s, v0, v1, bad), std::invalid_argument);
+}
+
 // A tile mask computes the flagged tiles' pixels only, each as the whole run does, whatever tiles
 // the whole run is computed by (here 32 against the masks' 16): two complementary masks give the
 // whole run's pixel lists between them and its set as their union, and a mask of every tile is

@@ -222,7 +222,7 @@ void plan_shared_runs(const Scene& scene, const BakeSettings& settings, const Vi
   for (uint32_t c = 0; c < n; ++c) {
     if (!in_shard(c, shard) || recovered[c]) continue;
     for (const std::vector<Segment>& g : cell_segment_groups(cells, c))
-      for (const Segment& s : g) shared_runs.expect(s.from, s.to, s.side_normal);
+      for (const Segment& s : g) shared_runs.expect(s.from, s.to, run_key_normal(s));
     // A portal's adaptive chords, the same for both of its leaves: one user per leaf computed.
     if (!cells.sweeps.empty())
       for (const FaceSweep& f : cells.sweeps[c])

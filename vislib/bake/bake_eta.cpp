@@ -52,7 +52,7 @@ std::vector<double> expected_cell_work(const std::vector<std::vector<Segment>>& 
       const double run = (length(s.to - s.from) + fixed) / unit;
       const bool first =
           !share_segments ||
-          computed.insert(SegmentRunCache::key_of(s.from, s.to, s.side_normal)).second;
+          computed.insert(SegmentRunCache::key_of(s.from, s.to, run_key_normal(s))).second;
       work[c] += run * double(runs - 1 + (first ? 1 : 0));
     }
   }

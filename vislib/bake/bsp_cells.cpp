@@ -6,7 +6,9 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -194,9 +196,88 @@ Vec3 polytope_centre(const ConvexPolytope& p) {
   return c * (1.0 / double(std::max<size_t>(n, 1)));
 }
 
+// A portal's runs (add_portal_runs): its segments (Quake coordinates), the first `edges` of them
+// its clear part's edges when no triangle lies on it (those may share a run with other portals'),
+// its sweep, and with a bound the bound of each segment (empty: the portal's own).
+struct PortalRuns {
+  bool swept = false;
+  std::vector<Segment> segs;
+  size_t edges = 0;
+  std::optional<FaceSweep> sweep;
+  std::vector<uint32_t> seg_bound;
+};
+
+// Where open portals meet along a line, their clear parts' edges lie within a few clearances of
+// one another (each is inset from the others' planes): one run on the first of them, split by
+// each such portal's plane (Segment::run_planes), serves them all. A group is an edge and up to
+// kMaxSidePlanes - 1 edges of other portals whose ends lie within kSharedRunEdgeDistance of its
+// ends (either way round), found in portal and edge order; each member takes the first's ends,
+// and no bound (the whole scene: a bound of each group, the union of its portals', would be one
+// more tree for every cell that uses it, which cost more than the restriction saved on the
+// shared runs). Deterministic.
+void share_portal_edges(const std::vector<BspPortal>& portals, std::vector<PortalRuns>& runs) {
+  static_assert(2 * kSharedRunEdgeDistance < 1.0, "a group's midpoints lie in adjacent cells");
+  using Cell = std::array<int64_t, 3>;
+  auto cell_of = [](Vec3 p) {
+    return Cell{int64_t(std::floor(p.x)), int64_t(std::floor(p.y)), int64_t(std::floor(p.z))};
+  };
+  struct Member {
+    uint32_t portal, edge;
+  };
+  std::vector<std::vector<Member>> groups;
+  std::map<Cell, std::vector<uint32_t>> by_cell;  // groups by their first edge's midpoint
+  auto close = [](Vec3 a, Vec3 b) { return length(a - b) <= kSharedRunEdgeDistance; };
+  for (uint32_t i = 0; i < runs.size(); ++i)
+    for (uint32_t e = 0; e < runs[i].edges; ++e) {
+      const Segment& s = runs[i].segs[e];
+      const Cell c = cell_of((s.from + s.to) * 0.5);
+      std::optional<uint32_t> found;
+      for (int64_t dx = -1; dx <= 1 && !found; ++dx)
+        for (int64_t dy = -1; dy <= 1 && !found; ++dy)
+          for (int64_t dz = -1; dz <= 1 && !found; ++dz) {
+            const auto it = by_cell.find(Cell{c[0] + dx, c[1] + dy, c[2] + dz});
+            if (it == by_cell.end()) continue;
+            for (uint32_t g : it->second) {
+              const std::vector<Member>& m = groups[g];
+              const Segment& f = runs[m[0].portal].segs[m[0].edge];
+              if (m.size() < kMaxSidePlanes &&
+                  std::none_of(m.begin(), m.end(), [&](Member x) { return x.portal == i; }) &&
+                  ((close(s.from, f.from) && close(s.to, f.to)) ||
+                   (close(s.from, f.to) && close(s.to, f.from)))) {
+                found = g;
+                break;
+              }
+            }
+          }
+      if (found) {
+        groups[*found].push_back({i, e});
+      } else {
+        by_cell[c].push_back(uint32_t(groups.size()));
+        groups.push_back({{i, e}});
+      }
+    }
+  for (const std::vector<Member>& m : groups) {
+    if (m.size() < 2) continue;
+    const Segment first = runs[m[0].portal].segs[m[0].edge];
+    std::array<Vec3, kMaxSidePlanes> planes{};
+    for (size_t k = 0; k < m.size(); ++k) planes[k] = portals[m[k].portal].normal;
+    for (size_t k = 0; k < m.size(); ++k) {
+      PortalRuns& r = runs[m[k].portal];
+      Segment& s = r.segs[m[k].edge];
+      s.from = first.from;
+      s.to = first.to;
+      s.run_planes = planes;
+      s.run_plane = int(k);
+      r.seg_bound.resize(r.segs.size(), m[k].portal);
+      r.seg_bound[m[k].edge] = ViewCells::kNoBound;
+    }
+  }
+}
+
 // The portal runs of the cells (BspSweep::Portals, bsp_leaf_cells): each portal's edges and
-// chords, or its sweep, for each of its two leaves that is a cell of `cells`, with the leaf's side.
-// With options.bound, each portal's runs are restricted to its bound (bsp_bound.h).
+// chords, or its sweep, for each of its two leaves that is a cell of `cells`, with the leaf's side,
+// open portals' edges shared with options.share_edges (share_portal_edges). With options.bound,
+// each portal's runs are restricted to its bound (bsp_bound.h), but for the shared edges.
 void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& pieces,
                      const std::vector<uint32_t>& all, const BspCellOptions& options,
                      const Scene& scene, ViewCells& cells) {
@@ -219,6 +300,7 @@ void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& piece
     cells.segment_bound.resize(cells.segments.size());
     cells.sweep_bound.resize(cells.sweeps.size());
   }
+  std::vector<PortalRuns> runs(portals.size());
   for (size_t index = 0; index < portals.size(); ++index) {
     const BspPortal& p = portals[index];
     const BspPortalCover cover = bsp_portal_cover(p, scene);
@@ -230,40 +312,55 @@ void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& piece
     const std::vector<Vec3> clear =
         bsp_portal_clear_part(p, side_volume(0), side_volume(1), clearance);
     if (clear.empty()) continue;  // nothing of it is clear of the walls: only they are seen
-    std::vector<Segment> whole;   // Quake coordinates
+    PortalRuns& r = runs[index];
+    r.swept = true;
+    std::vector<Segment> whole;  // Quake coordinates
     for (size_t i = 0; i < clear.size(); ++i) {
       const Vec3 a = clear[i], b = clear[(i + 1) % clear.size()];
       if (length(b - a) > kBspSameEndpoint) whole.push_back({a, b});
     }
-    std::optional<FaceSweep> sweep = face_sweep_of(clear, p.normal, kBspSameEndpoint);
+    r.sweep = face_sweep_of(clear, p.normal, kBspSameEndpoint);
     // A partly covered portal is swept evenly (at the adaptive sweep's floor spacing when the
     // bake's sweep is adaptive, whose chords are whole), its segments cut to the open part.
     const double spacing = !options.adaptive     ? options.face_spacing
                            : cover.parts.empty() ? 0.0
                                                  : options.adaptive->floor;
-    if (sweep && spacing > 0) {
-      const std::vector<Segment> c = even_chords(*sweep, spacing, kBspSameEndpoint);
+    if (cover.parts.empty()) r.edges = whole.size();
+    if (r.sweep && spacing > 0) {
+      const std::vector<Segment> c = even_chords(*r.sweep, spacing, kBspSameEndpoint);
       whole.insert(whole.end(), c.begin(), c.end());
     }
-    if (!cover.parts.empty()) sweep.reset();
-    std::vector<Segment> segs;
+    if (!cover.parts.empty()) r.sweep.reset();
     for (const Segment& s : whole)
       for (const Segment& piece : bsp_portal_open_pieces(s, p, cover, clearance, kBspSameEndpoint))
-        segs.push_back(piece);
+        r.segs.push_back(piece);
+    assert(!cover.parts.empty() || r.segs.size() == whole.size());  // the edges come first
+  }
+  if (options.share_edges) share_portal_edges(portals, runs);
+  for (size_t index = 0; index < portals.size(); ++index) {
+    const BspPortal& p = portals[index];
+    const PortalRuns& r = runs[index];
+    if (!r.swept) continue;
     const Vec3 normal = quake_to_scene(p.normal);
     for (int side = 0; side < 2; ++side) {
       const uint32_t c = cells.layout.leaf_cell[p.leaves[side]];
       if (c == pvs::kNoCell) continue;  // a leaf not baked
-      for (const Segment& s : segs)
-        cells.segments[c].push_back({quake_to_scene(s.from), quake_to_scene(s.to), normal, side});
-      if (sweep && options.adaptive) {
-        FaceSweep f = scene_sweep(*sweep);
+      for (const Segment& s : r.segs) {
+        Segment out{quake_to_scene(s.from), quake_to_scene(s.to), normal, side};
+        for (size_t k = 0; k < s.run_planes.size(); ++k)
+          out.run_planes[k] = quake_to_scene(s.run_planes[k]);
+        out.run_plane = s.run_plane;
+        cells.segments[c].push_back(out);
+      }
+      if (r.sweep && options.adaptive) {
+        FaceSweep f = scene_sweep(*r.sweep);
         f.side_normal = normal;
         f.side = side;
         add_sweep(cells.sweeps[c], f, *options.adaptive);
       }
       if (bounded) {
-        cells.segment_bound[c].resize(cells.segments[c].size(), uint32_t(index));
+        for (size_t i = 0; i < r.segs.size(); ++i)
+          cells.segment_bound[c].push_back(r.seg_bound.empty() ? uint32_t(index) : r.seg_bound[i]);
         if (!cells.sweeps.empty())
           cells.sweep_bound[c].resize(cells.sweeps[c].size(), uint32_t(index));
       }
@@ -364,6 +461,7 @@ ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options, con
       {"bound", options.bound == BspBound::Portals  ? "portals"
                 : options.bound == BspBound::MapVis ? "map-vis"
                                                     : "none"}};
+  if (portals) d["portal_edges"] = options.share_edges ? "shared" : "own";
   if (!cells.bound_leaves.empty()) {
     double leaves_sum = 0;
     for (const std::vector<uint32_t>& b : cells.bound_leaves) leaves_sum += double(b.size());

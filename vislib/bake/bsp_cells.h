@@ -110,6 +110,10 @@ struct BspCellOptions {
   // The bound each portal's runs are restricted to (bsp_bound.h; BspSweep::Portals only): exact
   // with Portals, trusting the map's vis with MapVis.
   BspBound bound = BspBound::None;
+  // BspSweep::Portals: the edges of open portals that meet along one line share one run, split by
+  // each portal's plane (share_portal_edges in bsp_cells.cpp; Segment::run_planes). False: each
+  // edge is its own run (how files baked without the sharing were made; their replay needs it).
+  bool share_edges = true;
 };
 
 // The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
@@ -117,7 +121,9 @@ struct BspCellOptions {
 // face_spacing), or (BspSweep::Portals) for each portal of its leaf in bsp_leaf_portals order
 // (among all of bsp_cell_leaves, whichever are baked) the polygon's edges and, with face_spacing >
 // 0 and no adaptive sweep, its even chords (face_sweep.h), all in scene coordinates with the
-// portal's normal and the leaf's side; with an adaptive sweep, the portal's FaceSweep; and
+// portal's normal and the leaf's side, an open portal's edges sharing their runs with the other
+// portals' that meet them along a line when options.share_edges says so (Segment::run_planes,
+// with no bound); with an adaptive sweep, the portal's FaceSweep; and
 // ViewCells::own from bsp_volume_triangles of its volume, each with a witness eye at the vertex
 // mean of the view region; with options.bound, the bound of each portal's segments and sweeps
 // (ViewCells::bound_leaves; std::invalid_argument with BspSweep::Faces). Portals need `scene`, the
@@ -125,7 +131,8 @@ struct BspCellOptions {
 // near_limit (only when some leaf's region clips the near distance), and a description (JSON)
 // recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
 // kBspLeafMinInset, the clearance, the counts of leaves inset less than kBspLeafInset, not inset
-// and with a clipped near distance) and the scene options.
+// and with a clipped near distance), whether portal edges share runs ("portal_edges") and the
+// scene options.
 // Throws std::invalid_argument for leaves that are not an increasing subset of bsp_cell_leaves.
 // Deterministic.
 ViewCells bsp_leaf_cells(const QuakeBsp& bsp, const BspCellOptions& options,

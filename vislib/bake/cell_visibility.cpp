@@ -225,13 +225,18 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     rerun = segments_visibility(scene, segs, o).runs;
     return rerun;
   };
-  // Whether segment `s` is an edge of the sweep's polygon (bit for bit: both are made from the
-  // same points).
+  // Whether segment `s` is an edge of the sweep's polygon: bit for bit (both are made from the
+  // same points), or within kSharedRunEdgeDistance for a segment of a shared run, which has the
+  // ends of another portal's edge.
   auto edge_of = [](const Segment& s, const FaceSweep& f) {
+    const bool shared = !(s.run_planes[0] == Vec3{0, 0, 0});
+    auto at = [&](Vec3 v, Vec3 p) {
+      return shared ? length(v - p) <= kSharedRunEdgeDistance : v == p;
+    };
     bool from = false, to = false;
     for (const Vec3& v : f.face) {
-      from = from || v == s.from;
-      to = to || v == s.to;
+      from = from || at(v, s.from);
+      to = to || at(v, s.to);
     }
     return from && to && s.side_normal == f.side_normal;
   };

@@ -399,8 +399,9 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
   };
   // With new_to_family: each sweep's family (the first sweep of it), and what each family has
   // seen before the round being judged (its base, then every round's probes).
-  std::vector<size_t> family(sweeps.size());
-  std::vector<std::vector<uint32_t>> family_seen(sweeps.size());
+  const size_t families = spacing.new_to_family ? sweeps.size() : 0;
+  std::vector<size_t> family(families);
+  std::vector<std::vector<uint32_t>> family_seen(families);
   std::vector<uint32_t> merged;
   auto union_into = [&](std::vector<uint32_t>& out, const std::vector<uint32_t>& ids) {
     merged.clear();
@@ -410,9 +411,9 @@ size_t adaptive_sweep(const std::vector<FaceSweep>& sweeps, const AdaptiveSpacin
   auto add_seen = [&](size_t f, const std::vector<uint32_t>& ids) {
     if (spacing.new_to_family) union_into(family_seen[family[f]], ids);
   };
-  for (size_t f = 0; f < sweeps.size(); ++f) {
+  for (size_t f = 0; f < families; ++f) {
     family[f] = f;
-    for (size_t g = 0; g < f && spacing.new_to_family; ++g)
+    for (size_t g = 0; g < f; ++g)
       if (same_family(sweeps[g], sweeps[f])) {
         family[f] = family[g];
         break;

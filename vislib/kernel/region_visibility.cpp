@@ -78,8 +78,13 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       const uint32_t users = options.segment_users.empty() ? 0 : options.segment_users.at(s);
       const Segment& seg = result.segments[s];
       const bool sided = !(seg.side_normal == Vec3{0, 0, 0});
-      so.side_normal = seg.side_normal;
+      // A shared run's planes (Segment::run_planes) without witnesses, else its own plane.
+      const bool planes = sided && !witnesses && !(seg.run_planes[0] == Vec3{0, 0, 0});
+      so.side_normal = planes ? seg.run_planes[0] : seg.side_normal;
+      if (planes)
+        std::copy(seg.run_planes.begin() + 1, seg.run_planes.end(), so.more_side_normals.begin());
       so.side_only = witnesses && sided ? seg.side : -1;
+      const size_t plane = planes ? size_t(seg.run_plane) : 0;
       SegmentResult sr;
       bool computed = true;
       // Phases for a caller that times them (phase_times.h): a run computed here, or one another
@@ -97,7 +102,7 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
               o.splits = splits;
               return segment_visibility(scene, a, b, o);
             },
-            &computed, seg.side_normal, users);
+            &computed, run_key_normal(seg), users);
         sr = *shared;  // a copy: the cache's result is shared with other regions
         if (!computed) sr.stats.seconds = 0;
       } else {
@@ -106,8 +111,8 @@ RegionResult segments_visibility(const Scene& scene, std::vector<Segment> segmen
       }
       std::vector<uint32_t> other_side;
       if (sided && !witnesses) {
-        other_side = std::move(sr.visible_sides.at(size_t(1 - seg.side)));
-        sr.visible = std::move(sr.visible_sides.at(size_t(seg.side)));
+        other_side = std::move(sr.visible_sides.at(2 * plane + size_t(1 - seg.side)));
+        sr.visible = std::move(sr.visible_sides.at(2 * plane + size_t(seg.side)));
       }
       PhaseScope merging(Phase::Merge);
       if (witnesses) {

@@ -27,7 +27,25 @@ struct Segment {
   Vec3 from, to;
   Vec3 side_normal{0, 0, 0};
   int side = 0;
+  // A run shared by the segments that stand for the edges of several portals meeting along one
+  // line, each with its own side_normal: the planes that run splits its directions by
+  // (SegmentOptions::more_side_normals), the same for every segment of it, side_normal among them
+  // at run_plane; all zero: side_normal alone. Its sides of its plane are those of a run split by
+  // that plane alone.
+  std::array<Vec3, kMaxSidePlanes> run_planes{};
+  int run_plane = 0;
 };
+
+// The segments of one shared run (Segment::run_planes) stand for edges whose ends lie within this
+// distance of its ends (scene units): the edges of portals that meet along one line, each inset
+// from the others' planes by a bake's clearance (about 0.02 at the default near distance).
+constexpr double kSharedRunEdgeDistance = 0.1;
+
+// The normal a segment's run is known by in a SegmentRunCache: run_planes[0] when set, else
+// side_normal.
+inline Vec3 run_key_normal(const Segment& s) {
+  return s.run_planes[0] == Vec3{0, 0, 0} ? s.side_normal : s.run_planes[0];
+}
 
 // Perimeter segments of `box` (min <= max on every axis), in a fixed documented order: edges
 // sorted by (axis of the edge, then the fixed coordinates' low/high pattern).

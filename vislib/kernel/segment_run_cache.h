@@ -66,8 +66,9 @@ class SegmentRunCache {
   void plan_chains(const std::vector<SegmentEnds>& segments, int max_parts);
 
   // Registers one future get() of the world-aligned run on (from, to), with its directions split
-  // by the plane of normal `side_normal` when that is not zero (Segment::side_normal: the run
-  // holds both sides, each user takes its own). Not thread-safe with get().
+  // by the plane of normal `side_normal` when that is not zero (run_key_normal of the segment:
+  // its side normal, or a run split by several planes by its first; the run holds every side,
+  // each user takes its own). Not thread-safe with get().
   void expect(Vec3 from, Vec3 to, Vec3 side_normal = {0, 0, 0});
 
   // Registers one future user of a family of runs not known in advance (a portal's adaptive

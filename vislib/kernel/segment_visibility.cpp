@@ -72,6 +72,14 @@ StaticTriangle prepare_static_triangle(const Vec3 c[3], Vec3 v0, Vec3 v1, const 
   return prepare_static_polygon(c, 3, v0, v1, lines, refs);
 }
 
+int side_plane_count(const SegmentOptions& opt) {
+  if (opt.side_normal == Vec3{0, 0, 0}) return 0;
+  int k = 1;
+  while (size_t(k) < kMaxSidePlanes && !(opt.more_side_normals[size_t(k - 1)] == Vec3{0, 0, 0}))
+    ++k;
+  return k;
+}
+
 namespace {
 
 // Keeps t with A t + B > 0 inside [lo, hi]; false when nothing is left.
@@ -366,14 +374,17 @@ class StaticKind {
     has_see_through_ = scene.has_see_through();
     if (!(opt.side_normal == Vec3{0, 0, 0})) {
       sides_ = true;
-      all_sides_ = opt.side_only < 0 ? 3 : 1;
-      for (int f = 0; f < kCubeFaces; ++f) {
-        const FaceAxes& a = face_axes_[size_t(f)];
-        side_dots_[size_t(f)] = {dot(a.F, opt.side_normal), dot(a.S, opt.side_normal),
-                                 dot(a.T, opt.side_normal)};
+      planes_ = side_plane_count(opt);
+      all_sides_ = opt.side_only < 0 ? uint8_t((1u << (2 * planes_)) - 1) : 1;
+      for (int k = 0; k < planes_; ++k) {
+        const Vec3 n = k == 0 ? opt.side_normal : opt.more_side_normals[size_t(k - 1)];
+        for (int f = 0; f < kCubeFaces; ++f) {
+          const FaceAxes& a = face_axes_[size_t(f)];
+          side_dots_[size_t(k)][size_t(f)] = {dot(a.F, n), dot(a.S, n), dot(a.T, n)};
+        }
+        const double tol = kSideTolerance * length(n);  // per unit of |d|
+        side_tol2_[size_t(k)] = tol * tol;
       }
-      const double tol = kSideTolerance * length(opt.side_normal);  // per unit of |d|
-      side_tol2_ = tol * tol;
     }
   }
 
@@ -680,13 +691,18 @@ class StaticKind {
   // is on the side asked for (side_only), 0 when not; 1 without sides.
   // Called for every pixel with pieces, so the plane's terms are taken per face (side_dots_)
   // and |dn| <= tol is tested squared, without a root.
+  // With more planes (SegmentOptions::more_side_normals) plane k's bits are shifted by 2 k.
   uint8_t side_mask(int face, int x, int y) const {
     if (!sides_) return 1;
-    const std::array<double, 3>& n = side_dots_[size_t(face)];
     const double sc = pixel_centers_[size_t(x)], tc = pixel_centers_[size_t(y)];
-    const double dn = n[0] + n[1] * sc + n[2] * tc;  // dot(d, side_normal), d = F + S sc + T tc
-    const double tol2 = side_tol2_ * (1 + sc * sc + tc * tc);  // (tolerance |d|)^2
-    const uint8_t mask = uint8_t(dn * dn <= tol2 ? 3 : dn > 0 ? 1 : 2);
+    const double d2 = 1 + sc * sc + tc * tc;  // |d|^2
+    uint8_t mask = 0;
+    for (int k = 0; k < planes_; ++k) {
+      const std::array<double, 3>& n = side_dots_[size_t(k)][size_t(face)];
+      const double dn = n[0] + n[1] * sc + n[2] * tc;  // dot(d, normal), d = F + S sc + T tc
+      const double tol2 = side_tol2_[size_t(k)] * d2;  // (tolerance |d|)^2
+      mask |= uint8_t((dn * dn <= tol2 ? 3 : dn > 0 ? 1 : 2) << (2 * k));
+    }
     if (opt_.side_only < 0) return mask;
     return uint8_t(mask >> opt_.side_only & 1);
   }
@@ -793,11 +809,12 @@ class StaticKind {
   const EdgeLines* lines_ = nullptr;
   std::vector<double> part_bounds_;  // 0, the splits, 1 (empty: not split)
   bool sides_ = false;               // side_normal given
+  int planes_ = 0;                   // with sides: side_plane_count
   uint8_t all_sides_ = 1;            // the mark of an id seen on every side that counts
-  // With sides: dot(F, side_normal), dot(S, ...), dot(T, ...) of each face's axes, and
-  // (kSideTolerance |side_normal|)^2 (side_mask).
-  std::array<std::array<double, 3>, kCubeFaces> side_dots_{};
-  double side_tol2_ = 0;
+  // With sides, for each plane k: dot(F, normal), dot(S, ...), dot(T, ...) of each face's axes,
+  // and (kSideTolerance |normal|)^2 (side_mask).
+  std::array<std::array<std::array<double, 3>, kCubeFaces>, kMaxSidePlanes> side_dots_{};
+  std::array<double, kMaxSidePlanes> side_tol2_{};
   std::array<FaceAxes, kCubeFaces> face_axes_{};  // world axes of each face
   TriangleGroups own_groups_;                     // built for this call (no tree, fans)
   const TriangleGroups* groups_ = nullptr;        // the primitives' fans; null: triangles
@@ -833,6 +850,12 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
     if (opt.side_only < 0 && opt.want_witnesses)
       throw std::invalid_argument("witnesses need one side (side_only 0 or 1), not both");
   }
+  const int planes = side_plane_count(opt);
+  for (size_t k = size_t(std::max(planes, 1)); k < kMaxSidePlanes; ++k)
+    if (!(opt.more_side_normals[k - 1] == Vec3{0, 0, 0}))
+      throw std::invalid_argument("more side planes come first, after a side normal");
+  if (planes > 1 && opt.side_only >= 0)
+    throw std::invalid_argument("more side planes need both sides (side_only -1)");
   if (!opt.tile_mask.empty()) {
     if (scene.sphere_count() > 0 || scene.is_dynamic())
       throw std::invalid_argument("a tile mask applies only to a static scene without spheres");
@@ -882,9 +905,9 @@ SegmentResult segment_visibility(const Scene& scene, Vec3 v0, Vec3 v1, const Seg
       if (opt.want_witnesses && opt.splits.empty()) result.witnesses.push_back(best[t]);
     }
   if (!(opt.side_normal == Vec3{0, 0, 0}) && opt.side_only < 0) {
-    result.visible_sides.resize(2);
+    result.visible_sides.resize(2 * size_t(side_plane_count(opt)));
     for (uint32_t t : result.visible)
-      for (size_t i = 0; i < 2; ++i)
+      for (size_t i = 0; i < result.visible_sides.size(); ++i)
         if (seen[t] >> i & 1) result.visible_sides[i].push_back(t);
   }
   if (!opt.splits.empty()) {

@@ -15,6 +15,7 @@
 // pieces at triple depth crossings: interval_list.h.)
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -68,6 +69,10 @@ constexpr size_t tile_mask_index(int face, int x, int y, int tiles) {
   return (size_t(face) * size_t(tiles) + size_t(y)) * size_t(tiles) + size_t(x);
 }
 
+// The most planes one run splits its directions by (SegmentOptions::more_side_normals): two marks
+// a plane in an id's 8 bits.
+constexpr size_t kMaxSidePlanes = 4;
+
 struct SegmentOptions {
   int resolution = 512;             // N: each cube face is N x N pixels; must be >= 1
   double near = kDefaultNear;       // z_near > 0, view depth in scene units
@@ -118,6 +123,12 @@ struct SegmentOptions {
   // on both sides, each with the directions that leave it (docs/quake.md "Portals").
   Vec3 side_normal{0, 0, 0};
   int side_only = -1;
+  // More planes through the eye (zero: none; with side_normal and side_only < 0): plane k (0 is
+  // side_normal, k >= 1 more_side_normals[k - 1], the non-zero ones first) splits the directions
+  // as side_normal does, and the result holds visible_sides[2 k + side] for each. One run then
+  // serves segments that stand for the edges of several portals meeting along one line, each
+  // with its own plane; the sides of plane k are those of a run split by plane k alone.
+  std::array<Vec3, kMaxSidePlanes - 1> more_side_normals{};
   // Static scenes without spheres: empty (the whole cube), or one flag per tile of the cube,
   // at tile_mask_index(face, x, y, tiles) (tiles = tiles_per_side(resolution, tile size), the tile
   // size tile_size or kStaticTileSize when 0), and only the flagged tiles'
@@ -125,6 +136,10 @@ struct SegmentOptions {
   // independent). Of another size, or in another scene: std::invalid_argument.
   std::vector<uint8_t> tile_mask;
 };
+
+// The planes a run's directions are split by: 0 without a side normal, else 1 and the leading
+// non-zero more_side_normals.
+int side_plane_count(const SegmentOptions& opt);
 
 constexpr size_t kMaxSplitParts = 8;
 // Pixels whose direction lies within this of a side plane (a cosine: |dot(d, n)| / (|d| |n|)) are
@@ -173,7 +188,8 @@ struct SegmentResult {
   // With options.splits: the sorted triangle ids visible from each part (visible is their union).
   std::vector<std::vector<uint32_t>> visible_parts;
   // With options.side_normal and side_only < 0: the sorted triangle ids visible at the pixels of
-  // side 0 and of side 1 (visible is their union).
+  // side 0 and of side 1 (visible is their union); with more_side_normals, 2 K lists, those of
+  // plane k at 2 k and 2 k + 1.
   std::vector<std::vector<uint32_t>> visible_sides;
   // If requested: final list of pixel (face, x, y) at index (face * N + y) * N + x.
   std::vector<PieceList> pieces;
