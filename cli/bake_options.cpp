@@ -422,10 +422,11 @@ void add_bake_options(CLI::App* cmd, BakeArgs& a) {
                   "neighbours with faces")
       ->check(CLI::IsMember({"neighbours", "family"}));
   cmd->add_option("--portal-edges", a.portal_edges,
-                  "bsp-leaves, --sweep portals: 'shared' (where open portals meet along a line, "
-                  "their edges, a few hundredths of a unit apart, share one run split by each "
-                  "portal's plane; docs/quake.md) or 'own' (each edge its own run)")
-      ->check(CLI::IsMember({"shared", "own"}))
+                  "bsp-leaves, --sweep portals: 'own' (each portal's edges are its own runs) or "
+                  "'shared' (where open portals meet along a line, their edges, a few hundredths "
+                  "of a unit apart, share one run split by each portal's plane: fewer runs, but "
+                  "a leaf can take ids seen past a wall that ends there; docs/quake.md)")
+      ->check(CLI::IsMember({"own", "shared"}))
       ->capture_default_str();
   cmd->add_option("--leaves", a.leaves,
                   "bsp-leaves: bake only these leaves, for a partial measurement: A, A-B, or "

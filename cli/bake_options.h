@@ -42,9 +42,9 @@ struct BakeArgs {
   std::string leaves;  // --leaves A-B (bsp-leaves)
   // --face-sweep even|adaptive (bsp-leaves); unset: adaptive with --sweep portals, even with faces.
   std::optional<std::string> face_sweep;
-  std::string sweep = "portals";  // --sweep portals|faces (bsp-leaves)
-  std::string bound = "portals";  // --bound none|portals|map-vis (bsp-leaves, --sweep portals)
-  std::string portal_edges = "shared";  // --portal-edges shared|own (BspCellOptions::share_edges)
+  std::string sweep = "portals";     // --sweep portals|faces (bsp-leaves)
+  std::string bound = "portals";     // --bound none|portals|map-vis (bsp-leaves, --sweep portals)
+  std::string portal_edges = "own";  // --portal-edges own|shared (BspCellOptions::share_edges)
   // --chord-coarse, --chord-floor, --chord-piece, --chord-tiles (adaptive: the last is
   // AdaptiveSpacing::tiles, by chord_tiles_name); unset: kBspPortalChords with --sweep portals,
   // else AdaptiveSpacing's defaults.

@@ -1339,7 +1339,7 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
       << out;
   nlohmann::json c = cells_of("");
   EXPECT_EQ(c["sweep"], "portals");
-  EXPECT_EQ(c["portal_edges"], "shared");
+  EXPECT_EQ(c["portal_edges"], "own");
   EXPECT_EQ(c["face_spacing"], kBspPortalSpacing);
   EXPECT_EQ(c["face_sweep"], "adaptive");
   EXPECT_EQ(c["chord_coarse"], kBspPortalChords.coarse);
@@ -1373,7 +1373,7 @@ TEST(QuakeBake, CliBakesLeavesAndRefusesOtherPlacementsAndOtherScenes) {
       run_pvs("bake " + map + " --cells bsp-leaves --chord-new both -o " + dir + "/x.pvs", &out),
       2);
   EXPECT_NE(out.find("--chord-new"), std::string::npos) << out;
-  EXPECT_EQ(cells_of("--portal-edges own")["portal_edges"], "own");
+  EXPECT_EQ(cells_of("--portal-edges shared")["portal_edges"], "shared");
   for (const char* bad : {"--portal-edges both", "--sweep faces --portal-edges own"}) {
     EXPECT_EQ(run_pvs("bake " + map + " --cells bsp-leaves " + bad + " -o " + dir + "/x.pvs", &out),
               2)
@@ -1555,7 +1555,8 @@ TEST(QuakeBakeLibreQuake, CrossedChordsFindWhatIsSeenThroughPatchesThinAcrossThe
 }
 
 // Where lqdm1's open portals meet along a line, their clear parts' edges lie a few clearances
-// apart, and one run serves them all: each such segment carries the first edge's ends and every
+// apart, and with BspCellOptions::share_edges (`--portal-edges shared`) one run serves them all:
+// each such segment carries the first edge's ends and every
 // member portal's plane (Segment::run_planes), its own at run_plane, so the bake keys them as one
 // run split by each plane (3,277 edges, 2,443 runs). Each member still counts
 // as an edge of its own portal's sweep (its base), whose polygon has a vertex within
@@ -1568,6 +1569,7 @@ TEST(QuakeBakeLibreQuake, PortalEdgesMeetingAlongALineShareOneRunSplitByEachPort
   BspCellOptions o;
   o.sweep = BspSweep::Portals;
   o.adaptive = kBspPortalChords;
+  o.share_edges = true;
   const ViewCells cells = bsp_leaf_cells(m, o, &scene);
   std::set<SegmentRunCache::Key> runs;
   size_t segments = 0;
@@ -1600,7 +1602,7 @@ TEST(QuakeBakeLibreQuake, PortalEdgesMeetingAlongALineShareOneRunSplitByEachPort
   EXPECT_GT(shared, 0u);
   EXPECT_EQ(segments, 3277u);  // each portal's edges, as each would run alone
   EXPECT_EQ(runs.size(), 2443u);
-  o.share_edges = false;  // each edge its own run, as files baked without the sharing record
+  o.share_edges = false;  // each edge its own run (the default)
   const ViewCells own = bsp_leaf_cells(m, o, &scene);
   EXPECT_EQ(nlohmann::json::parse(own.description)["portal_edges"], "own");
   std::set<SegmentRunCache::Key> own_runs;

@@ -111,9 +111,11 @@ struct BspCellOptions {
   // with Portals, trusting the map's vis with MapVis.
   BspBound bound = BspBound::None;
   // BspSweep::Portals: the edges of open portals that meet along one line share one run, split by
-  // each portal's plane (share_portal_edges in bsp_cells.cpp; Segment::run_planes). False: each
-  // edge is its own run (how files baked without the sharing were made; their replay needs it).
-  bool share_edges = true;
+  // each portal's plane (share_portal_edges in bsp_cells.cpp; Segment::run_planes). Cheaper, but
+  // the run's eyes lie up to a few clearances beyond a wall that ends where the portals meet, and
+  // a portal's leaves then take ids seen past it (docs/quake.md "Edges shared where portals
+  // meet"). False: each edge is its own run, on its own portal.
+  bool share_edges = false;
 };
 
 // The view cells of a map's BSP leaves: layout bsp_leaf_layout(bsp, leaves), cell c's segments
