@@ -165,10 +165,9 @@ void run_bake(BakeArgs& a, const CLI::App& cmd) {
                 shard.index, shard.count, segments / n, a.runs,
                 cells.segments.empty() ? "" : " (mean)");
     if (cells.shared_runs)
-      std::printf(
-          "; %zu distinct segments in all (a portal's serve both of its leaves, an edge "
-          "the portals that meet there)",
-          distinct.size());
+      std::printf("; %zu distinct segments in all (a portal's serve both of its leaves%s)",
+                  distinct.size(),
+                  a.portal_edges == "shared" ? ", an edge the portals that meet there" : "");
     std::printf("\n");
     return;
   }

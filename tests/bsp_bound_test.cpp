@@ -160,7 +160,7 @@ TEST(RunRestrictionLibreQuake, Lqdm1LeafSetsAreTheSameWithAndWithoutTheRestricti
   for (BspBound bound : {BspBound::None, BspBound::Portals, BspBound::MapVis}) {
     co.bound = bound;
     const ViewCells cells = bsp_leaf_cells(bsp, co, &scene);
-    EXPECT_EQ(cells.segment_bound.empty(), bound == BspBound::None);
+    EXPECT_EQ(cells.bound_leaves.empty(), bound == BspBound::None);
     size_t smaller = 0;  // portals whose bound leaves some triangle out
     for (const std::vector<uint32_t>& leaves : cells.bound_leaves)
       smaller += bound_triangles(cells.leaf_triangles, leaves).size() < scene.triangle_count();

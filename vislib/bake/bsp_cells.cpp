@@ -198,13 +198,12 @@ Vec3 polytope_centre(const ConvexPolytope& p) {
 
 // A portal's runs (add_portal_runs): its segments (Quake coordinates), the first `edges` of them
 // its clear part's edges when no triangle lies on it (those may share a run with other portals'),
-// its sweep, and with a bound the bound of each segment (empty: the portal's own).
+// and its sweep.
 struct PortalRuns {
   bool swept = false;
   std::vector<Segment> segs;
   size_t edges = 0;
   std::optional<FaceSweep> sweep;
-  std::vector<uint32_t> seg_bound;
 };
 
 // Where open portals meet along a line, their clear parts' edges lie within a few clearances of
@@ -268,8 +267,6 @@ void share_portal_edges(const std::vector<BspPortal>& portals, std::vector<Porta
       s.to = first.to;
       s.run_planes = planes;
       s.run_plane = int(k);
-      r.seg_bound.resize(r.segs.size(), m[k].portal);
-      r.seg_bound[m[k].edge] = ViewCells::kNoBound;
     }
   }
 }
@@ -297,9 +294,9 @@ void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& piece
   if (bounded) {
     cells.bound_leaves = bsp_portal_bound_leaves(bsp, portals, options.bound);
     cells.leaf_triangles = bsp_leaf_triangles(bsp, scene);
-    cells.segment_bound.resize(cells.segments.size());
-    cells.sweep_bound.resize(cells.sweeps.size());
   }
+  cells.segment_portal.resize(cells.segments.size());
+  cells.sweep_portal.resize(cells.sweeps.size());
   std::vector<PortalRuns> runs(portals.size());
   for (size_t index = 0; index < portals.size(); ++index) {
     const BspPortal& p = portals[index];
@@ -358,12 +355,9 @@ void add_portal_runs(const QuakeBsp& bsp, const std::vector<BspLeafPiece>& piece
         f.side = side;
         add_sweep(cells.sweeps[c], f, *options.adaptive);
       }
-      if (bounded) {
-        for (size_t i = 0; i < r.segs.size(); ++i)
-          cells.segment_bound[c].push_back(r.seg_bound.empty() ? uint32_t(index) : r.seg_bound[i]);
-        if (!cells.sweeps.empty())
-          cells.sweep_bound[c].resize(cells.sweeps[c].size(), uint32_t(index));
-      }
+      cells.segment_portal[c].resize(cells.segments[c].size(), uint32_t(index));
+      if (!cells.sweeps.empty())
+        cells.sweep_portal[c].resize(cells.sweeps[c].size(), uint32_t(index));
     }
   }
 }

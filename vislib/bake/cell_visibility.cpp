@@ -128,14 +128,15 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
   };
   bool wanted = true;
   // Trees over the bounds of the cell's runs (ViewCells::bound_leaves), each built once.
-  const bool bounded = cells && !cells->segment_bound.empty();
+  const bool bounded = cells && !cells->bound_leaves.empty();
+  constexpr uint32_t kWholeScene = UINT32_MAX;
   std::map<uint32_t, TriangleBvh> trees;
   // Their primitives: the bake's tree's, or without one the scene's fans when the runs take them
   // (built on the first bound).
   std::optional<TriangleGroups> own_fans;
   const TriangleGroups* fans = options.segment.bvh ? &options.segment.bvh->groups : nullptr;
   auto tree_of = [&](uint32_t b) -> const TriangleBvh* {
-    if (b == ViewCells::kNoBound) return nullptr;
+    if (b == kWholeScene) return nullptr;
     auto it = trees.find(b);
     if (it == trees.end()) {
       PhaseScope building(Phase::BoundTrees);
@@ -225,36 +226,28 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
     rerun = segments_visibility(scene, segs, o).runs;
     return rerun;
   };
-  // Whether segment `s` is an edge of the sweep's polygon: bit for bit (both are made from the
-  // same points), or within kSharedRunEdgeDistance for a segment of a shared run, which has the
-  // ends of another portal's edge.
-  auto edge_of = [](const Segment& s, const FaceSweep& f) {
-    const bool shared = !(s.run_planes[0] == Vec3{0, 0, 0});
-    auto at = [&](Vec3 v, Vec3 p) {
-      return shared ? length(v - p) <= kSharedRunEdgeDistance : v == p;
-    };
-    bool from = false, to = false;
-    for (const Vec3& v : f.face) {
-      from = from || at(v, s.from);
-      to = to || at(v, s.to);
-    }
-    return from && to && s.side_normal == f.side_normal;
+  // A cell whose runs lie on portals has one group, its own segments (cell_segment_groups); a
+  // sided segment is an edge of each sweep of its portal (ViewCells::segment_portal), and its
+  // bound is its portal's, but for a run that stands for several portals' edges.
+  const bool on_portals = cells && !cells->segment_portal.empty();
+  assert(!on_portals || (fixed == 1 && groups[0].size() == cells->segment_portal.at(cell).size()));
+  auto segment_bound = [&](size_t i) {
+    return groups[0][i].run_planes[0] == Vec3{0, 0, 0} ? cells->segment_portal[cell][i]
+                                                       : kWholeScene;
   };
   std::vector<uint32_t> base;
-  // A cell with bounds has one group, its own segments (cell_segment_groups).
-  assert(!bounded || (fixed == 1 && groups[0].size() == cells->segment_bound.at(cell).size()));
   for (size_t g = 0; g < fixed && (wanted || adaptive); ++g) {
-    const std::vector<const TriangleBvh*> bvhs =
-        trees_of(groups[g], [&](size_t i) { return cells->segment_bound[cell][i]; });
+    const std::vector<const TriangleBvh*> bvhs = trees_of(groups[g], segment_bound);
     const RegionResult rr = run_group(groups[g], g, {}, bvhs);
     if (!adaptive) continue;
     for (const RunRecord& r : rr.runs) ids_of_run(r, base);
     if (!any_sided) continue;
     for (const RunRecord& r : judging(groups[g], rr, bvhs)) {
       const Segment& s = groups[g].at(r.segment);
-      if (r.run != 0 || s.side_normal == Vec3{0, 0, 0}) continue;
+      if (r.run != 0 || s.side_normal == Vec3{0, 0, 0} || !on_portals) continue;
       for (size_t f = 0; f < sweeps.size(); ++f)
-        if (edge_of(s, sweeps[f])) both_sides(r, s.side, bases[f]);
+        if (cells->segment_portal[cell][r.segment] == cells->sweep_portal.at(cell).at(f))
+          both_sides(r, s.side, bases[f]);
     }
   }
   if (!adaptive) return;
@@ -296,7 +289,7 @@ void run_cell_groups(const Scene& scene, const ViewCells* cells,
         std::vector<uint32_t> segment_users(segs.size());
         for (size_t i = 0; i < segs.size(); ++i) segment_users[i] = users[sweep_of[i]];
         const std::vector<const TriangleBvh*> bvhs =
-            trees_of(segs, [&](size_t i) { return cells->sweep_bound.at(cell)[sweep_of[i]]; });
+            trees_of(segs, [&](size_t i) { return cells->sweep_portal.at(cell)[sweep_of[i]]; });
         const std::vector<std::vector<uint8_t>> masks = tiles_toward(segs, fresh);
         const RegionResult rr =
             run_group(segs, fixed + round++, std::move(segment_users), bvhs, masks);

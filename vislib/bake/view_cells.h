@@ -91,13 +91,18 @@ struct ViewCells {
   // portal's): a run's witness, an eye on the portal, is moved back along its ray into the
   // region, so that it is a ray from an eye of the cell (cell_witness_rays).
   std::vector<ConvexPolytope> regions;
-  // Empty, or the cells' runs restricted to bounds of what they can see (bsp_bound.h): bound b's
-  // leaves are bound_leaves[b] (increasing map leaf numbers), leaf_triangles[l] the triangles that
-  // touch leaf l, and segment_bound[c][i] is the bound of segments[c][i], sweep_bound[c][f] that
-  // of sweeps[c][f] (kNoBound: the whole scene). Each run composites its bound's triangles only
-  // (cell_visibility.h) and sees what it sees without the restriction.
-  static constexpr uint32_t kNoBound = UINT32_MAX;
-  std::vector<std::vector<uint32_t>> bound_leaves, leaf_triangles, segment_bound, sweep_bound;
+  // Empty, or one list per cell whose runs lie on portals (bsp_cells.h): the portal (an index of
+  // the bake's portal list, bsp_leaf_portals) that each of segments[c] lies on, and each of
+  // sweeps[c]. A portal that has sweeps has no chords among its segments: they are its polygon's
+  // edges, the base of each of its sweeps (cell_visibility.h).
+  std::vector<std::vector<uint32_t>> segment_portal, sweep_portal;
+  // Empty, or the cells' runs restricted to bounds of what they can see (bsp_bound.h): portal p's
+  // bound is the leaves bound_leaves[p] (increasing map leaf numbers), leaf_triangles[l] the
+  // triangles that touch leaf l. The runs of a segment or sweep composite the triangles of its
+  // portal's bound only (cell_visibility.h), but for a segment whose run stands for several
+  // portals' edges (Segment::run_planes), which composites the whole scene, and see what they see
+  // without the restriction.
+  std::vector<std::vector<uint32_t>> bound_leaves, leaf_triangles;
 };
 
 pvs::Box to_pvs_box(const Box3& b);
