@@ -127,8 +127,9 @@ struct BspCellOptions {
 // portals' that meet them along a line when options.share_edges says so (Segment::run_planes,
 // with no bound); with an adaptive sweep, the portal's FaceSweep; and
 // ViewCells::own from bsp_volume_triangles of its volume, each with a witness eye at the vertex
-// mean of the view region; with options.bound, the bound of each portal's segments and sweeps
-// (ViewCells::bound_leaves; std::invalid_argument with BspSweep::Faces). Portals need `scene`, the
+// mean of the view region; the portal each segment and sweep lies on (ViewCells::segment_portal,
+// sweep_portal); with options.bound, each portal's bound (ViewCells::bound_leaves;
+// std::invalid_argument with BspSweep::Faces). Portals need `scene`, the
 // map as loaded with options.scene (std::invalid_argument without it). The cells'
 // near_limit (only when some leaf's region clips the near distance), and a description (JSON)
 // recording the cells' kind ("bsp-leaves"), the spacing, the inset rule (kBspLeafInset,
