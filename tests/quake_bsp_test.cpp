@@ -1481,8 +1481,9 @@ void bake_lqdm1_and_cast(const std::string& path, const std::string& leaves, siz
       "triangles; %zu rays from random points of the regions, %zu hits not in the set\n",
       leaves.empty() ? "all" : leaves.c_str(), options.c_str(), r.cell_count(), seconds,
       total / r.cell_count(), scene.triangle_count(), rays, misses.size());
-  // A sampled check with a failure-rate threshold: the faces are swept at kBspFaceSpacing, so a
-  // triangle seen only between two chords can be missed (docs/quake.md measures how often).
+  // A sampled check with a failure-rate threshold: the sweep samples each portal with chords, so
+  // a triangle seen only between two chords, or between two pixel rays, can be missed
+  // (docs/quake.md measures how often).
   EXPECT_LE(misses.size(), rays / 1000);
   for (const auto& [c, tri] : misses)
     std::printf("  cell %u (leaf %u) misses triangle %u\n", c, cells.layout.cell_leaf[c], tri);

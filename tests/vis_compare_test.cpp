@@ -694,13 +694,12 @@ TEST(VisCompareLibreQuake, E1m2LeavesUnderFacesOnTheirPortalsSeeNothingThroughTh
 // where the set changes, kBspPortalChords; -j 2) and held against the map's vis. Every extra is
 // settled: none is left unconfirmed and no kernel witness is false (the map's T-junctions leaked
 // through cracks before edges took their runs' lines: edge_lines.h). Our sampled misses
-// (measured: 5 rays of 31.6 million; without the crossed chords, --chord-cross off --chord-tiles
-// new, 27; the even sweep at 8 units 23, the face sweep at 16 units 15) are triangles seen only
+// (measured: 10 rays of 31.6 million; the face sweep at 16 units, 15) are triangles seen only
 // between two chords (docs/quake.md, "Portals"):
 // bounded, not zero, at this spacing (the opt-in test below sweeps the faces at 4, where they are
 // zero). Release builds only: the sanitizers multiply the bake's cost, and the 4-leaf bake of
 // quake_bsp_test.cpp covers the same code under them. Time budget: printed; about 100 CPU s for
-// the bake and the comparison (1 minute wall on two idle cores; 102 s beside another bake).
+// the bake and the comparison (1 minute wall on two idle cores; 50 s beside another build).
 constexpr int kLqdm1N64MissBound = 16;  // sampled rays, of 31,555,584
 TEST(VisCompareLibreQuake, Lqdm1WholeBakedAtN64SettlesEveryExtraAndBoundsItsMisses) {
 #if defined(__SANITIZE_ADDRESS__)
