@@ -15,6 +15,9 @@ import path from "node:path";
 import os from "node:os";
 import puppeteer from "puppeteer-core";
 
+// How long to wait for the server's log to record the page's last requests (milliseconds).
+const kServerLogWaitMs = 10000;
+
 function args() {
   const a = {pngFrames: []};
   const argv = process.argv.slice(2);
@@ -177,8 +180,18 @@ async function main() {
       page_errors: errors,
     };
     if (a.serverLog && fs.existsSync(a.serverLog)) {
-      const served = fs.readFileSync(a.serverLog, "utf8").split("\n").filter((l) => l)
+      // The server records a request after its body is sent, so the page can hold the last
+      // block before the record is written: wait until the log holds every range request the
+      // page made, or kServerLogWaitMs. A line without its newline is still being written.
+      const servedNow = () => fs.readFileSync(a.serverLog, "utf8").split("\n").slice(0, -1)
+        .filter((l) => l)
         .map((l) => JSON.parse(l)).filter((r) => !a.pvsName || r.path.endsWith("/" + a.pvsName));
+      let served = servedNow();
+      for (const end = Date.now() + kServerLogWaitMs;
+        served.length < out.summary.range_requests && Date.now() < end;
+        served = servedNow()) {
+        await new Promise((done) => setTimeout(done, 50));
+      }
       out.server = {requests: served.length, bytes: served.reduce((s, r) => s + r.bytes, 0),
                     ranges: served.map((r) => r.range)};
     }
